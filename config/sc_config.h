@@ -1,0 +1,101 @@
+/*
+ * sc_config.h: compile-time limits and defaults of the engine.
+ *
+ * Every capacity of the engine object comes from here. Each is an #ifndef default so that a
+ * target overrides it from its build (the cortex-m7 image shrinks them to fit its RAM). A case
+ * or setting above a limit is refused at load time with a named error, never at frame time.
+ * Units are in the names.
+ */
+#ifndef SC_CONFIG_H
+#define SC_CONFIG_H
+
+/* ---- frame scheduler -------------------------------------------------------------------- */
+#ifndef SC_FRAME_RATE_DEFAULT_HZ
+#define SC_FRAME_RATE_DEFAULT_HZ 60u
+#endif
+#ifndef SC_FRAME_RATE_MIN_HZ
+#define SC_FRAME_RATE_MIN_HZ 1u
+#endif
+#ifndef SC_FRAME_RATE_MAX_HZ
+#define SC_FRAME_RATE_MAX_HZ 240u
+#endif
+#ifndef SC_SCHED_MAX_STAGES
+#define SC_SCHED_MAX_STAGES 8u
+#endif
+/* Frames with deadline misses among the last SC_HEALTH_MISS_WINDOW frames that make the
+ * engine DEGRADED. */
+#ifndef SC_HEALTH_MISS_WINDOW
+#define SC_HEALTH_MISS_WINDOW 64u
+#endif
+#ifndef SC_HEALTH_MISS_DEGRADED
+#define SC_HEALTH_MISS_DEGRADED 4u
+#endif
+
+/* ---- soft-tissue mesh (paper Table I: up to 32x16x16 nodes) ------------------------------ */
+#ifndef SC_MAX_MESH_NX
+#define SC_MAX_MESH_NX 32u
+#endif
+#ifndef SC_MAX_MESH_NY
+#define SC_MAX_MESH_NY 16u
+#endif
+#ifndef SC_MAX_MESH_NZ
+#define SC_MAX_MESH_NZ 16u
+#endif
+#ifndef SC_MAX_NODES
+#define SC_MAX_NODES (SC_MAX_MESH_NX * SC_MAX_MESH_NY * SC_MAX_MESH_NZ)
+#endif
+/* 5 tets per cube of the grid. */
+#ifndef SC_MAX_TETS
+#define SC_MAX_TETS (5u * (SC_MAX_MESH_NX - 1u) * (SC_MAX_MESH_NY - 1u) * (SC_MAX_MESH_NZ - 1u))
+#endif
+/* Physics iterations per frame and time step (paper section VI: 20 and 0.01 s). */
+#ifndef SC_PHYS_ITERATIONS_DEFAULT
+#define SC_PHYS_ITERATIONS_DEFAULT 20u
+#endif
+#ifndef SC_PHYS_ITERATIONS_MAX
+#define SC_PHYS_ITERATIONS_MAX 200u
+#endif
+#ifndef SC_PHYS_DT_DEFAULT_S
+#define SC_PHYS_DT_DEFAULT_S 0.01f
+#endif
+
+/* ---- labels and materials --------------------------------------------------------------- */
+#ifndef SC_MAX_LABELS
+#define SC_MAX_LABELS 16u
+#endif
+
+/* ---- case volume (read through hal storage, not copied) ---------------------------------- */
+#ifndef SC_MAX_VOLUME_DIM
+#define SC_MAX_VOLUME_DIM 1024u
+#endif
+#ifndef SC_MAX_VOLUME_VOXELS
+#define SC_MAX_VOLUME_VOXELS (256u * 1024u * 1024u)
+#endif
+
+/* ---- B-scan image ----------------------------------------------------------------------- */
+#ifndef SC_MAX_SCAN_LINES
+#define SC_MAX_SCAN_LINES 512u
+#endif
+#ifndef SC_MAX_SCAN_SAMPLES
+#define SC_MAX_SCAN_SAMPLES 512u
+#endif
+
+/* ---- CAN --------------------------------------------------------------------------------- */
+/* Frames drained from the CAN receive queue per frame, at most (bounds the rx stage). */
+#ifndef SC_CAN_RX_BURST_MAX
+#define SC_CAN_RX_BURST_MAX 64u
+#endif
+#ifndef SC_CAN_MAX_FILTERS
+#define SC_CAN_MAX_FILTERS 16u
+#endif
+
+_Static_assert(SC_FRAME_RATE_DEFAULT_HZ >= SC_FRAME_RATE_MIN_HZ &&
+                   SC_FRAME_RATE_DEFAULT_HZ <= SC_FRAME_RATE_MAX_HZ,
+               "default frame rate outside its range");
+_Static_assert(SC_MAX_MESH_NX >= 2u && SC_MAX_MESH_NY >= 2u && SC_MAX_MESH_NZ >= 2u,
+               "a mesh needs at least 2 nodes per axis");
+_Static_assert(SC_MAX_NODES <= 65535u * 16u, "node indices must fit 32-bit arithmetic");
+_Static_assert(SC_HEALTH_MISS_DEGRADED <= SC_HEALTH_MISS_WINDOW, "miss threshold above window");
+_Static_assert(SC_HEALTH_MISS_WINDOW <= 64u, "miss window is a 64-bit mask");
+
+#endif /* SC_CONFIG_H */

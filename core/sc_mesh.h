@@ -1,0 +1,58 @@
+/*
+ * sc_mesh.h: the regular tetrahedral soft-tissue mesh and the node state both solvers share.
+ *
+ * A box of the case volume (volume frame, mm; see sc_volume.h) carries NX x NY x NZ nodes;
+ * every cube of the grid is split into 5 tetrahedra with alternating orientation (by the parity
+ * of i+j+k) so that the face diagonals of neighbouring cubes agree and faces conform.
+ * 5x5x5 -> 125 nodes / 320 tets; 32x16x16 -> 8,192 nodes / 34,875 tets.
+ * Node index: i + nx * (j + ny * k), i along x, j along y, k along z (depth; k = 0 is the skin
+ * side, the top of the box, where the probe presses).
+ *
+ * Memory: everything in the caller's sc_mesh and sc_nodes, sized by config/sc_config.h.
+ * Never allocates, never calls the OS. Threads: one writer.
+ */
+#ifndef SC_MESH_H
+#define SC_MESH_H
+
+#include <stdint.h>
+
+#include "sc_config.h"
+
+#define SC_ALIGN_HOT _Alignas(64)
+
+typedef struct sc_mesh_def {
+    uint32_t nx, ny, nz;    /* nodes per axis, 2..SC_MAX_MESH_NX/NY/NZ */
+    float origin_mm[3];     /* corner of the box with the smallest coordinates */
+    float size_mm[3];       /* box extent, > 0 */
+} sc_mesh_def;
+
+/* Topology and rest configuration: written at case load, read-only at frame time. */
+typedef struct sc_mesh {
+    uint32_t nx, ny, nz;
+    uint32_t node_count;
+    uint32_t tet_count;
+    float origin_mm[3];
+    float cell_mm[3];
+    SC_ALIGN_HOT float rest_x[SC_MAX_NODES]; /* rest positions, mm */
+    SC_ALIGN_HOT float rest_y[SC_MAX_NODES];
+    SC_ALIGN_HOT float rest_z[SC_MAX_NODES];
+    uint32_t tet[SC_MAX_TETS][4];   /* node indices, positively oriented */
+    int32_t tet_nbr[SC_MAX_TETS][4]; /* tet across the face opposite vertex v, -1 on the hull */
+    uint8_t tet_label[SC_MAX_TETS]; /* majority label of the tet's volume */
+    uint8_t node_fixed[SC_MAX_NODES]; /* 1: Dirichlet node (bone, box bottom and sides) */
+} sc_mesh;
+
+/* Deformed state shared by MSDS and FEM so that switching keeps the shape (float32 SoA). */
+typedef struct sc_nodes {
+    SC_ALIGN_HOT float x[SC_MAX_NODES]; /* deformed positions, mm */
+    SC_ALIGN_HOT float y[SC_MAX_NODES];
+    SC_ALIGN_HOT float z[SC_MAX_NODES];
+    SC_ALIGN_HOT float vx[SC_MAX_NODES]; /* velocities, mm/s */
+    SC_ALIGN_HOT float vy[SC_MAX_NODES];
+    SC_ALIGN_HOT float vz[SC_MAX_NODES];
+    SC_ALIGN_HOT float fx[SC_MAX_NODES]; /* external forces (collider), N */
+    SC_ALIGN_HOT float fy[SC_MAX_NODES];
+    SC_ALIGN_HOT float fz[SC_MAX_NODES];
+} sc_nodes;
+
+#endif /* SC_MESH_H */
