@@ -55,4 +55,16 @@ typedef struct sc_nodes {
     SC_ALIGN_HOT float fz[SC_MAX_NODES];
 } sc_nodes;
 
+/* Default definition: 32x16x16 nodes over a 40 x 20 x 30 mm box at the origin. */
+sc_mesh_def sc_mesh_default_def(void);
+
+/* Build topology, rest positions and face neighbours of the regular 5-tet mesh. Labels are
+ * set to 0 and no node is fixed (see the material module for both). O(tets). Never allocates.
+ * Errors: SC_ERR_INVALID_ARG, SC_ERR_MESH_DIMS (counts outside 2..limits), SC_ERR_NOT_FINITE,
+ * SC_ERR_RANGE (non-positive size), SC_ERR_MESH_ORIENTATION (a tet not positive: a bug). */
+int sc_mesh_build(sc_mesh *m, const sc_mesh_def *def);
+
+/* Copy rest positions into the deformed state, zero velocities and external forces. O(nodes). */
+void sc_nodes_reset_to_rest(sc_nodes *n, const sc_mesh *m);
+
 #endif /* SC_MESH_H */
