@@ -67,4 +67,9 @@ int sc_mesh_build(sc_mesh *m, const sc_mesh_def *def);
 /* Copy rest positions into the deformed state, zero velocities and external forces. O(nodes). */
 void sc_nodes_reset_to_rest(sc_nodes *n, const sc_mesh *m);
 
+/* Signed volume (mm^3) of the tet with node indices tet[] in the SoA positions x, y, z
+ * (positive when positively oriented). O(1), never allocates, cannot fail. */
+float sc_mesh_tet_volume_mm3(const float *x, const float *y, const float *z,
+                             const uint32_t tet[4]);
+
 #endif /* SC_MESH_H */
