@@ -65,7 +65,8 @@ static inline int sc_display_frame_end(const sc_display_dev *dev, uint32_t frame
     return dev->ops->frame_end(dev->ctx, frame_no);
 }
 
-static inline int sc_display_link_state(const sc_display_dev *dev, sc_display_link_state *st)
+static inline int sc_display_get_link_state(const sc_display_dev *dev,
+                                            sc_display_link_state *st)
 {
     return dev->ops->link_state ? dev->ops->link_state(dev->ctx, st) : SC_ERR_NOT_SUPPORTED;
 }

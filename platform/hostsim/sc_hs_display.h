@@ -1,0 +1,43 @@
+/*
+ * sc_hs_display.h: an in-memory display for the host simulator.
+ *
+ * An sc_display_dev that assembles each frame from its lines into a fixed buffer, checks the
+ * protocol (begin/line/end order, line indices in range, each line once, frame numbers) and
+ * counts every violation; keeps the last complete frame and a hash (FNV-1a 64) of every frame
+ * in a bounded history, so tests and the replay compare frames bit for bit. Storage is fixed at
+ * compile time; nothing allocates.
+ */
+#ifndef SC_HS_DISPLAY_H
+#define SC_HS_DISPLAY_H
+
+#include <stdint.h>
+
+#include "sc_config.h"
+#include "sc_hal_display.h"
+
+#ifndef SC_HS_DISPLAY_HISTORY
+#define SC_HS_DISPLAY_HISTORY 4096u
+#endif
+
+typedef struct sc_hs_display {
+    sc_display_frame_info info;      /* of the frame being assembled / last one */
+    uint8_t in_frame;
+    uint32_t lines_seen;
+    uint8_t line_seen[SC_MAX_SCAN_LINES];
+    uint8_t image[SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES]; /* line-major: [line][sample] */
+    uint8_t last[SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES];  /* last complete frame */
+    sc_display_frame_info last_info;
+    uint64_t frames_complete;
+    uint64_t frames_incomplete;  /* ended with missing lines */
+    uint64_t lines;
+    uint64_t protocol_errors;    /* line outside a frame, bad index, duplicate, bad length */
+    uint64_t hashes[SC_HS_DISPLAY_HISTORY]; /* hash of complete frame i (i < history) */
+    uint32_t hash_count;
+} sc_hs_display;
+
+void sc_hs_display_init(sc_hs_display *d);
+sc_display_dev sc_hs_display_dev(sc_hs_display *d);
+/* FNV-1a 64 of a byte range: the frame hash used everywhere in tests. */
+uint64_t sc_hs_hash64(const void *data, uint64_t size, uint64_t seed);
+
+#endif /* SC_HS_DISPLAY_H */
