@@ -1,0 +1,11 @@
+# Fails if the linked bare-metal image contains a heap (malloc, free, _sbrk, ...).
+execute_process(COMMAND ${NM} ${IMAGE} OUTPUT_VARIABLE _out RESULT_VARIABLE _rc)
+if(NOT _rc EQUAL 0)
+  message(FATAL_ERROR "nm failed on ${IMAGE}")
+endif()
+foreach(_sym malloc _malloc_r free _free_r calloc realloc _sbrk _sbrk_r)
+  if(_out MATCHES "[ \t][TtWw][ \t]${_sym}\n")
+    message(FATAL_ERROR "bare-metal image contains ${_sym}: something allocates")
+  endif()
+endforeach()
+message(STATUS "image check: no heap symbols in ${IMAGE}")

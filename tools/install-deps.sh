@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# Installs the Debian packages a task needs, as root, on Debian 12. Idempotent and quick when
+# everything is present (no apt-get update then).
+#   tools/install-deps.sh base      build + tests on the host (default)
+#   tools/install-deps.sh cross     cortex-m7 (arm-none-eabi, newlib) and aarch64 (qemu-user)
+#   tools/install-deps.sh hil       the SocketCAN/KMS VM bench (qemu-system, busybox, kernel)
+set -euo pipefail
+
+base=(build-essential cmake pkg-config libccd-dev libcmocka-dev libpng-dev zlib1g-dev
+      python3 python3-canmatrix libsdl2-dev xvfb xauth can-utils)
+cross=(gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi
+       gcc-aarch64-linux-gnu qemu-user-static dpkg-dev)
+cross_arm64=(libcmocka-dev:arm64 libccd-dev:arm64)
+hil=(qemu-system-x86 busybox-static can-utils)
+
+if [ "$(id -u)" -ne 0 ]; then
+    echo "install-deps: run as root (apt-get needs it)" >&2
+    exit 2
+fi
+export DEBIAN_FRONTEND=noninteractive
+
+missing() {
+    local out=()
+    for p in "$@"; do
+        dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || out+=("$p")
+    done
+    echo "${out[@]:-}"
+}
+
+updated=0
+apt_install() {
+    local need
+    need=$(missing "$@")
+    [ -z "$need" ] && return 0
+    if [ "$updated" -eq 0 ]; then
+        apt-get update -q >/dev/null
+        updated=1
+    fi
+    # shellcheck disable=SC2086
+    apt-get install -y -q --no-install-recommends $need >/dev/null
+}
+
+want=${1:-base}
+case "$want" in
+base)
+    apt_install "${base[@]}"
+    ;;
+cross)
+    apt_install "${base[@]}"
+    if ! dpkg --print-foreign-architectures | grep -qx arm64; then
+        dpkg --add-architecture arm64
+        updated=0
+    fi
+    apt_install "${cross[@]}" "${cross_arm64[@]}"
+    ;;
+hil)
+    apt_install "${base[@]}" "${hil[@]}"
+    ;;
+*)
+    echo "usage: $0 [base|cross|hil]" >&2
+    exit 2
+    ;;
+esac
