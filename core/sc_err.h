@@ -40,6 +40,9 @@
     X(SC_ERR_CASE_MESH_NODES, -41, "case mesh node counts above limits")                      \
     X(SC_ERR_CASE_SECTION, -42, "case section missing, duplicated or misaligned")             \
     X(SC_ERR_CASE_MATERIAL, -43, "case material table invalid")                               \
+    X(SC_ERR_CASE_TEXT, -44, "case name or description not terminated or not printable")     \
+    X(SC_ERR_CASE_RESERVED, -45, "case reserved field or padding not zero")                   \
+    X(SC_ERR_CASE_SIZE, -46, "case section size disagrees with its contents")                 \
     /* CAN protocol and E2E: -64 .. -95 */                                                     \
     X(SC_ERR_CAN_ID, -64, "CAN identifier not in the protocol")                               \
     X(SC_ERR_CAN_DLC, -65, "CAN frame length wrong for the message")                          \
@@ -61,11 +64,15 @@
     X(SC_ERR_DLINK_VERSION, -130, "display link version unsupported")                         \
     X(SC_ERR_DLINK_CRC, -131, "display link packet CRC mismatch")                             \
     X(SC_ERR_DLINK_LENGTH, -132, "display link packet length wrong")                          \
+    X(SC_ERR_DLINK_TYPE, -133, "display link packet type unknown")                            \
+    X(SC_ERR_DLINK_FIELD, -134, "display link header field out of range")                     \
     /* configuration: -160 .. -191 */                                                          \
     X(SC_ERR_CFG_KEY, -160, "unknown configuration key")                                      \
     X(SC_ERR_CFG_VALUE, -161, "configuration value malformed")                                \
     X(SC_ERR_CFG_RANGE, -162, "configuration value out of range")                             \
-    X(SC_ERR_CFG_SYNTAX, -163, "configuration line syntax error")
+    X(SC_ERR_CFG_SYNTAX, -163, "configuration line syntax error")                           \
+    X(SC_ERR_CFG_DUPLICATE, -164, "configuration key given twice")                            \
+    X(SC_ERR_CFG_TOO_LONG, -165, "configuration line or value too long")
 
 typedef enum sc_err {
     SC_OK = 0,

@@ -1,0 +1,440 @@
+/* sc_dlink.c: display link packet codec and frame assembler (see sc_dlink.h, docs/display-link.md). */
+#include "sc_dlink.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "sc_crc32.h"
+#include "sc_err.h"
+
+/* Header byte offsets (docs/display-link.md). */
+enum {
+    OFF_MAGIC = 0,
+    OFF_VERSION = 4,
+    OFF_TYPE = 5,
+    OFF_FLAGS = 6,
+    OFF_FRAME = 8,
+    OFF_LINE = 12,
+    OFF_COUNT = 14,
+    OFF_SAMPLES = 16,
+    OFF_GEOMETRY = 18,
+    OFF_PAYLOAD_LEN = 20,
+    OFF_RESERVED = 22,
+    OFF_CRC = 24,
+};
+_Static_assert(OFF_CRC + 4 == SC_DLINK_HEADER_SIZE, "header layout");
+
+#define SC_DLINK_GEOMETRY_MAX 1u
+#define SC_DLINK_COMPRESSION_MAX 1000u
+
+static void put16(uint8_t *p, uint16_t v)
+{
+    p[0] = (uint8_t)(v & 0xFFu);
+    p[1] = (uint8_t)(v >> 8);
+}
+
+static void put32(uint8_t *p, uint32_t v)
+{
+    p[0] = (uint8_t)(v & 0xFFu);
+    p[1] = (uint8_t)((v >> 8) & 0xFFu);
+    p[2] = (uint8_t)((v >> 16) & 0xFFu);
+    p[3] = (uint8_t)(v >> 24);
+}
+
+static uint16_t get16(const uint8_t *p)
+{
+    return (uint16_t)((uint16_t)p[0] | (uint16_t)((uint16_t)p[1] << 8));
+}
+
+static uint32_t get32(const uint8_t *p)
+{
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) |
+           ((uint32_t)p[3] << 24);
+}
+
+static uint32_t f32_bits(float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, sizeof u);
+    return u;
+}
+
+static float f32_from_bits(uint32_t u)
+{
+    float f;
+    memcpy(&f, &u, sizeof f);
+    return f;
+}
+
+static int frame_fields_ok(const sc_dlink_frame *f)
+{
+    return f->line_count >= 1u && f->line_count <= SC_MAX_SCAN_LINES && f->samples >= 1u &&
+           f->samples <= SC_MAX_SCAN_SAMPLES && f->geometry_id <= SC_DLINK_GEOMETRY_MAX;
+}
+
+/* Write the header (CRC field excluded) of a packet of the given type and payload length. */
+static void write_header(uint8_t *buf, const sc_dlink_frame *f, sc_dlink_type type,
+                         uint16_t line_index, uint16_t payload_len)
+{
+    put32(buf + OFF_MAGIC, SC_DLINK_MAGIC);
+    buf[OFF_VERSION] = (uint8_t)SC_DLINK_VERSION;
+    buf[OFF_TYPE] = (uint8_t)type;
+    put16(buf + OFF_FLAGS, f->flags);
+    put32(buf + OFF_FRAME, f->frame_no);
+    put16(buf + OFF_LINE, line_index);
+    put16(buf + OFF_COUNT, f->line_count);
+    put16(buf + OFF_SAMPLES, f->samples);
+    put16(buf + OFF_GEOMETRY, f->geometry_id);
+    put16(buf + OFF_PAYLOAD_LEN, payload_len);
+    put16(buf + OFF_RESERVED, 0u);
+}
+
+/* CRC over header bytes before the CRC field, then the payload. */
+static uint32_t packet_crc(const uint8_t *hdr, const uint8_t *payload, size_t payload_len)
+{
+    uint32_t c = sc_crc32_update(SC_CRC32_INIT, hdr, OFF_CRC);
+    c = sc_crc32_update(c, payload, payload_len);
+    return sc_crc32_final(c);
+}
+
+static int finish(uint8_t *buf, uint16_t payload_len)
+{
+    put32(buf + OFF_CRC, packet_crc(buf, buf + SC_DLINK_HEADER_SIZE, payload_len));
+    return (int)(SC_DLINK_HEADER_SIZE + payload_len);
+}
+
+int sc_dlink_encode_begin(uint8_t *buf, size_t cap, const sc_dlink_frame *f,
+                          const sc_dlink_begin *b)
+{
+    if (!buf || !f || !b) {
+        return SC_ERR_INVALID_ARG;
+    }
+    if (cap < SC_DLINK_HEADER_SIZE + SC_DLINK_BEGIN_PAYLOAD) {
+        return SC_ERR_NO_SPACE;
+    }
+    if (!frame_fields_ok(f) || (b->compression_pm > SC_DLINK_COMPRESSION_MAX &&
+                                b->compression_pm != SC_DLINK_COMPRESSION_UNKNOWN)) {
+        return SC_ERR_DLINK_FIELD;
+    }
+    if (!isfinite(b->depth_mm) || !isfinite(b->width_mm)) {
+        return SC_ERR_NOT_FINITE;
+    }
+    write_header(buf, f, SC_DLINK_FRAME_BEGIN, 0u, (uint16_t)SC_DLINK_BEGIN_PAYLOAD);
+    uint8_t *p = buf + SC_DLINK_HEADER_SIZE;
+    put32(p + 0, f32_bits(b->depth_mm));
+    put32(p + 4, f32_bits(b->width_mm));
+    put16(p + 8, b->compression_pm);
+    put16(p + 10, 0u);
+    return finish(buf, (uint16_t)SC_DLINK_BEGIN_PAYLOAD);
+}
+
+int sc_dlink_encode_line(uint8_t *buf, size_t cap, const sc_dlink_frame *f, uint16_t line_index,
+                         const uint8_t *samples, uint16_t count)
+{
+    if (!buf || !f || !samples) {
+        return SC_ERR_INVALID_ARG;
+    }
+    if (!frame_fields_ok(f) || line_index >= f->line_count || count != f->samples) {
+        return SC_ERR_DLINK_FIELD;
+    }
+    if (cap < (size_t)SC_DLINK_HEADER_SIZE + count) {
+        return SC_ERR_NO_SPACE;
+    }
+    write_header(buf, f, SC_DLINK_LINE, line_index, count);
+    memcpy(buf + SC_DLINK_HEADER_SIZE, samples, count);
+    return finish(buf, count);
+}
+
+int sc_dlink_encode_end(uint8_t *buf, size_t cap, const sc_dlink_frame *f, const sc_dlink_end *e)
+{
+    if (!buf || !f || !e) {
+        return SC_ERR_INVALID_ARG;
+    }
+    if (cap < SC_DLINK_HEADER_SIZE + SC_DLINK_END_PAYLOAD) {
+        return SC_ERR_NO_SPACE;
+    }
+    if (!frame_fields_ok(f) || (uint32_t)e->lines_sent + e->lines_dropped > f->line_count) {
+        return SC_ERR_DLINK_FIELD;
+    }
+    write_header(buf, f, SC_DLINK_FRAME_END, 0u, (uint16_t)SC_DLINK_END_PAYLOAD);
+    uint8_t *p = buf + SC_DLINK_HEADER_SIZE;
+    put16(p + 0, e->lines_sent);
+    put16(p + 2, e->lines_dropped);
+    put32(p + 4, 0u);
+    return finish(buf, (uint16_t)SC_DLINK_END_PAYLOAD);
+}
+
+int sc_dlink_decode(const uint8_t *pkt, size_t len, sc_dlink_header *h, const uint8_t **payload)
+{
+    if (!pkt || !h || !payload) {
+        return SC_ERR_INVALID_ARG;
+    }
+    if (len < SC_DLINK_HEADER_SIZE) {
+        return SC_ERR_DLINK_LENGTH;
+    }
+    if (get32(pkt + OFF_MAGIC) != SC_DLINK_MAGIC) {
+        return SC_ERR_DLINK_MAGIC;
+    }
+    if (pkt[OFF_VERSION] != SC_DLINK_VERSION) {
+        return SC_ERR_DLINK_VERSION;
+    }
+    uint16_t plen = get16(pkt + OFF_PAYLOAD_LEN);
+    if ((size_t)SC_DLINK_HEADER_SIZE + plen != len) {
+        return SC_ERR_DLINK_LENGTH;
+    }
+    const uint8_t *pl = pkt + SC_DLINK_HEADER_SIZE;
+    if (packet_crc(pkt, pl, plen) != get32(pkt + OFF_CRC)) {
+        return SC_ERR_DLINK_CRC;
+    }
+    sc_dlink_header d;
+    d.version = pkt[OFF_VERSION];
+    d.type = pkt[OFF_TYPE];
+    d.flags = get16(pkt + OFF_FLAGS);
+    d.frame_no = get32(pkt + OFF_FRAME);
+    d.line_index = get16(pkt + OFF_LINE);
+    d.line_count = get16(pkt + OFF_COUNT);
+    d.samples = get16(pkt + OFF_SAMPLES);
+    d.geometry_id = get16(pkt + OFF_GEOMETRY);
+    d.payload_len = plen;
+    uint16_t expect_len;
+    switch (d.type) {
+    case SC_DLINK_FRAME_BEGIN:
+        expect_len = (uint16_t)SC_DLINK_BEGIN_PAYLOAD;
+        break;
+    case SC_DLINK_LINE:
+        expect_len = d.samples;
+        break;
+    case SC_DLINK_FRAME_END:
+        expect_len = (uint16_t)SC_DLINK_END_PAYLOAD;
+        break;
+    default:
+        return SC_ERR_DLINK_TYPE;
+    }
+    if (plen != expect_len) {
+        return SC_ERR_DLINK_LENGTH;
+    }
+    const sc_dlink_frame f = {d.frame_no, d.flags, d.line_count, d.samples, d.geometry_id};
+    if (!frame_fields_ok(&f) || get16(pkt + OFF_RESERVED) != 0u) {
+        return SC_ERR_DLINK_FIELD;
+    }
+    if (d.type == SC_DLINK_LINE) {
+        if (d.line_index >= d.line_count) {
+            return SC_ERR_DLINK_FIELD;
+        }
+    } else if (d.line_index != 0u) {
+        return SC_ERR_DLINK_FIELD;
+    }
+    if (d.type == SC_DLINK_FRAME_BEGIN) {
+        float depth = f32_from_bits(get32(pl + 0));
+        float width = f32_from_bits(get32(pl + 4));
+        uint16_t comp = get16(pl + 8);
+        if (!isfinite(depth) || !isfinite(width) || get16(pl + 10) != 0u ||
+            (comp > SC_DLINK_COMPRESSION_MAX && comp != SC_DLINK_COMPRESSION_UNKNOWN)) {
+            return SC_ERR_DLINK_FIELD;
+        }
+    } else if (d.type == SC_DLINK_FRAME_END) {
+        if ((uint32_t)get16(pl + 0) + get16(pl + 2) > d.line_count || get32(pl + 4) != 0u) {
+            return SC_ERR_DLINK_FIELD;
+        }
+    }
+    *h = d;
+    *payload = pl;
+    return 0;
+}
+
+void sc_dlink_parse_begin(const uint8_t *payload, sc_dlink_begin *b)
+{
+    b->depth_mm = f32_from_bits(get32(payload + 0));
+    b->width_mm = f32_from_bits(get32(payload + 4));
+    b->compression_pm = get16(payload + 8);
+}
+
+void sc_dlink_parse_end(const uint8_t *payload, sc_dlink_end *e)
+{
+    e->lines_sent = get16(payload + 0);
+    e->lines_dropped = get16(payload + 2);
+}
+
+/* ---- assembler ------------------------------------------------------------------------- */
+
+/* Serial-number difference a - b of 32-bit frame counters (RFC 1982 style). */
+static int32_t frame_diff(uint32_t a, uint32_t b)
+{
+    uint32_t d = a - b;
+    return (d <= 0x7FFFFFFFu) ? (int32_t)d : -(int32_t)(~d) - 1;
+}
+
+void sc_dlink_asm_init(sc_dlink_asm *a)
+{
+    memset(a, 0, sizeof *a);
+    a->begin.compression_pm = SC_DLINK_COMPRESSION_UNKNOWN;
+}
+
+static void count_reject(sc_dlink_rx_stats *s, int rc)
+{
+    s->rejected++;
+    switch (rc) {
+    case SC_ERR_DLINK_LENGTH:
+        s->rej_length++;
+        break;
+    case SC_ERR_DLINK_MAGIC:
+        s->rej_magic++;
+        break;
+    case SC_ERR_DLINK_VERSION:
+        s->rej_version++;
+        break;
+    case SC_ERR_DLINK_CRC:
+        s->rej_crc++;
+        break;
+    case SC_ERR_DLINK_TYPE:
+        s->rej_type++;
+        break;
+    default: /* SC_ERR_DLINK_FIELD and inconsistent frames */
+        s->rej_field++;
+        break;
+    }
+}
+
+static void close_frame(sc_dlink_asm *a, uint8_t end_seen)
+{
+    const uint32_t stride = SC_MAX_SCAN_SAMPLES;
+    uint8_t *img = a->image[a->cur];
+    const uint8_t *prev = a->image[a->cur ^ 1u];
+    const int carry = a->have_done && a->done.frame.samples == a->frame.samples;
+    uint16_t lost = 0;
+    for (uint32_t i = 0; i < a->frame.line_count; i++) {
+        if ((a->got[i / 32u] & (1u << (i % 32u))) == 0u) {
+            lost++;
+            if (carry) {
+                memcpy(img + i * stride, prev + i * stride, a->frame.samples);
+            } else {
+                memset(img + i * stride, 0, a->frame.samples);
+            }
+        }
+    }
+    a->stats.lines_lost += lost;
+    if (lost == 0u) {
+        a->stats.frames_complete++;
+    } else {
+        a->stats.frames_incomplete++;
+    }
+    if (!end_seen) {
+        a->stats.ends_missing++;
+    }
+    a->done.frame = a->frame;
+    a->done.begin = a->begin;
+    a->done.lines_received = a->received;
+    a->done.lines_lost = lost;
+    a->done.begin_seen = a->begin_seen;
+    a->done.end_seen = end_seen;
+    a->done.image = img;
+    a->have_done = 1u;
+    a->last_closed_no = a->frame.frame_no;
+    a->cur ^= 1u;
+    a->open = 0u;
+}
+
+static void open_frame(sc_dlink_asm *a, const sc_dlink_frame *f, uint8_t type)
+{
+    a->frame = *f;
+    a->open = 1u;
+    a->begin_seen = 0u;
+    a->received = 0u;
+    memset(a->got, 0, sizeof a->got);
+    if (type != SC_DLINK_FRAME_BEGIN) {
+        a->stats.begins_missing++;
+    }
+}
+
+static void count_late(sc_dlink_asm *a, uint8_t type)
+{
+    if (type == SC_DLINK_LINE) {
+        a->stats.lines_late++;
+    } else {
+        a->stats.frames_late++;
+    }
+}
+
+int sc_dlink_asm_push(sc_dlink_asm *a, const uint8_t *pkt, size_t len)
+{
+    sc_dlink_header h;
+    const uint8_t *pl = NULL;
+    a->stats.packets++;
+    int rc = sc_dlink_decode(pkt, len, &h, &pl);
+    if (rc < 0) {
+        count_reject(&a->stats, rc);
+        return rc;
+    }
+    const sc_dlink_frame f = {h.frame_no, h.flags, h.line_count, h.samples, h.geometry_id};
+    int closed = 0;
+    if (a->open && h.frame_no == a->frame.frame_no) {
+        if (h.line_count != a->frame.line_count || h.samples != a->frame.samples ||
+            h.geometry_id != a->frame.geometry_id) {
+            count_reject(&a->stats, SC_ERR_DLINK_FIELD);
+            return SC_ERR_DLINK_FIELD;
+        }
+    } else {
+        /* Reference: the open frame, else the last closed one. */
+        if (a->open || a->have_done) {
+            const uint32_t ref = a->open ? a->frame.frame_no : a->last_closed_no;
+            const int32_t d = frame_diff(h.frame_no, ref);
+            if (d <= 0 && d >= -(int32_t)SC_DLINK_RESYNC_FRAMES) {
+                count_late(a, h.type);
+                return 0;
+            }
+        }
+        if (a->open) {
+            close_frame(a, 0u);
+            closed = 1;
+        }
+        open_frame(a, &f, h.type);
+    }
+    switch ((sc_dlink_type)h.type) {
+    case SC_DLINK_FRAME_BEGIN:
+        if (a->begin_seen) {
+            a->stats.frames_late++; /* a repeated FRAME_BEGIN: ignored */
+            break;
+        }
+        sc_dlink_parse_begin(pl, &a->begin);
+        a->begin_seen = 1u;
+        a->frame.flags = h.flags;
+        break;
+    case SC_DLINK_LINE: {
+        const uint32_t i = h.line_index;
+        const uint32_t bit = 1u << (i % 32u);
+        if (a->got[i / 32u] & bit) {
+            a->stats.lines_duplicate++;
+            break;
+        }
+        a->got[i / 32u] |= bit;
+        memcpy(a->image[a->cur] + i * SC_MAX_SCAN_SAMPLES, pl, h.samples);
+        a->received++;
+        a->stats.lines_received++;
+        break;
+    }
+    case SC_DLINK_FRAME_END: {
+        sc_dlink_end e;
+        sc_dlink_parse_end(pl, &e);
+        a->stats.lines_sender_dropped += e.lines_dropped;
+        a->frame.flags = h.flags;
+        close_frame(a, 1u);
+        closed = 1;
+        break;
+    }
+    }
+    return closed;
+}
+
+int sc_dlink_asm_flush(sc_dlink_asm *a)
+{
+    if (!a->open) {
+        return 0;
+    }
+    close_frame(a, 0u);
+    return 1;
+}
+
+const sc_dlink_done *sc_dlink_asm_done(const sc_dlink_asm *a)
+{
+    return a->have_done ? &a->done : NULL;
+}

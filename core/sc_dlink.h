@@ -1,0 +1,182 @@
+/*
+ * sc_dlink.h: the display link: packet codec and receiver-side frame assembler.
+ *
+ * The engine sends each B-scan to the display controller as UDP datagrams (one per packet):
+ * a FRAME_BEGIN packet, one LINE packet per scan line (any order, each at most once), and a
+ * FRAME_END packet. Every packet starts with the same 28-byte little-endian header carrying
+ * magic, version, type, flags, frame number, line index, line count, samples per line,
+ * geometry id, payload length and a CRC-32 (core/sc_crc32.h) over header and payload. The wire
+ * format is specified byte by byte in docs/display-link.md; SC_DLINK_VERSION changes whenever
+ * that format changes.
+ *
+ * The link is loss-tolerant: the receiver never waits for a missing packet. The assembler
+ * closes a frame on its FRAME_END, or when a packet of a newer frame arrives; lines that never
+ * arrived by then are counted lost (and show the previous frame's line), lines that arrive for
+ * a closed frame are counted late, repeated lines duplicate, and malformed packets are rejected
+ * and counted by reason.
+ *
+ * Thread and memory rules: the codec functions are pure, reentrant and work on caller buffers.
+ * An sc_dlink_asm is driven by one thread; it holds two image planes of
+ * SC_MAX_SCAN_LINES x SC_MAX_SCAN_SAMPLES bytes (512 KiB with the default limits) and is meant
+ * for static storage. Never allocates, never calls the OS.
+ */
+#ifndef SC_DLINK_H
+#define SC_DLINK_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sc_config.h"
+
+#define SC_DLINK_MAGIC 0x4C444353u /* bytes 'S' 'C' 'D' 'L' on the wire (little-endian) */
+#define SC_DLINK_VERSION 1u
+#define SC_DLINK_HEADER_SIZE 28u
+#define SC_DLINK_BEGIN_PAYLOAD 12u /* depth_mm f32, width_mm f32, compression u16, rsvd u16 */
+#define SC_DLINK_END_PAYLOAD 8u    /* lines_sent u16, lines_dropped u16, reserved u32 */
+/* Largest packet: a line of SC_MAX_SCAN_SAMPLES samples (540 bytes with the default limits,
+ * below the 1472-byte UDP payload of a 1500-byte Ethernet MTU, so no IP fragmentation). */
+#define SC_DLINK_MAX_PACKET (SC_DLINK_HEADER_SIZE + SC_MAX_SCAN_SAMPLES)
+/* Compression measure unknown (the sender has none, e.g. no vessel in view). */
+#define SC_DLINK_COMPRESSION_UNKNOWN 0xFFFFu
+
+_Static_assert(SC_DLINK_MAX_PACKET <= 1472u, "a line packet must fit one unfragmented datagram");
+_Static_assert(SC_MAX_SCAN_LINES <= 65535u && SC_MAX_SCAN_SAMPLES <= 65535u,
+               "line index and sample count are 16-bit on the wire");
+
+typedef enum sc_dlink_type {
+    SC_DLINK_FRAME_BEGIN = 1,
+    SC_DLINK_LINE = 2,
+    SC_DLINK_FRAME_END = 3,
+} sc_dlink_type;
+
+/* Decoded header. For FRAME_BEGIN and FRAME_END line_index is 0. */
+typedef struct sc_dlink_header {
+    uint8_t version;
+    uint8_t type; /* sc_dlink_type */
+    uint16_t flags;       /* SC_DISPLAY_FLAG_* of hal/sc_hal_display.h */
+    uint32_t frame_no;
+    uint16_t line_index;  /* LINE: 0 .. line_count-1 */
+    uint16_t line_count;  /* lines of the frame: 1 .. SC_MAX_SCAN_LINES */
+    uint16_t samples;     /* samples per line: 1 .. SC_MAX_SCAN_SAMPLES */
+    uint16_t geometry_id; /* 0 linear, 1 curvilinear */
+    uint16_t payload_len; /* bytes after the header */
+} sc_dlink_header;
+
+/* FRAME_BEGIN payload. */
+typedef struct sc_dlink_begin {
+    float depth_mm;           /* imaging depth */
+    float width_mm;           /* linear: aperture width; curvilinear: sector angle in degrees */
+    uint16_t compression_pm;  /* vessel compression measure, permille; or ..._UNKNOWN */
+} sc_dlink_begin;
+
+/* FRAME_END payload: what the sender did with this frame's lines. */
+typedef struct sc_dlink_end {
+    uint16_t lines_sent;    /* handed to the network */
+    uint16_t lines_dropped; /* dropped by the sender (socket full, over its time budget) */
+} sc_dlink_end;
+
+/* Frame parameters shared by the packets of one frame. */
+typedef struct sc_dlink_frame {
+    uint32_t frame_no;
+    uint16_t flags;
+    uint16_t line_count;
+    uint16_t samples;
+    uint16_t geometry_id;
+} sc_dlink_frame;
+
+/* ---- codec ---------------------------------------------------------------------------------
+ * Encoders write one packet into buf (capacity cap) and return its length (> 0), or
+ * SC_ERR_NO_SPACE when cap is too small, SC_ERR_DLINK_FIELD when a field is outside the wire
+ * limits (line_count or samples 0 or above the SC_MAX_SCAN_* limits, line_index >= line_count,
+ * geometry_id > 1, count != samples, compression above 1000 and not unknown, lines_sent +
+ * lines_dropped above line_count), SC_ERR_NOT_FINITE for a non-finite depth or width,
+ * SC_ERR_INVALID_ARG for NULL pointers. O(header + payload), never allocates. */
+int sc_dlink_encode_begin(uint8_t *buf, size_t cap, const sc_dlink_frame *f,
+                          const sc_dlink_begin *b);
+int sc_dlink_encode_line(uint8_t *buf, size_t cap, const sc_dlink_frame *f, uint16_t line_index,
+                         const uint8_t *samples, uint16_t count);
+int sc_dlink_encode_end(uint8_t *buf, size_t cap, const sc_dlink_frame *f,
+                        const sc_dlink_end *e);
+
+/* Decode and check one received packet of len bytes. On success fills *h, points *payload at
+ * the payload inside pkt and returns 0. Checks, in this order: length at least a header
+ * (SC_ERR_DLINK_LENGTH), magic (SC_ERR_DLINK_MAGIC), version (SC_ERR_DLINK_VERSION), header
+ * plus payload_len equal to len (SC_ERR_DLINK_LENGTH), CRC (SC_ERR_DLINK_CRC), type
+ * (SC_ERR_DLINK_TYPE), payload length for the type (SC_ERR_DLINK_LENGTH), header and payload
+ * field ranges as for the encoders, reserved bytes zero (SC_ERR_DLINK_FIELD). A corrupted byte
+ * anywhere is thus refused: magic and version by name, everything else by the CRC. Errors:
+ * also SC_ERR_INVALID_ARG for NULL pointers. O(len), never allocates. */
+int sc_dlink_decode(const uint8_t *pkt, size_t len, sc_dlink_header *h, const uint8_t **payload);
+
+/* Payload accessors for a packet that sc_dlink_decode accepted with that type (the decoder
+ * has checked the payload: finite depth and width, compression <= 1000 or unknown, lines_sent +
+ * lines_dropped <= line_count, reserved bytes zero). O(1), cannot fail. */
+void sc_dlink_parse_begin(const uint8_t *payload, sc_dlink_begin *b);
+void sc_dlink_parse_end(const uint8_t *payload, sc_dlink_end *e);
+
+/* ---- receiver-side frame assembler ----------------------------------------------------- */
+
+typedef struct sc_dlink_rx_stats {
+    uint64_t packets;          /* datagrams offered */
+    uint64_t rejected;         /* failed sc_dlink_decode (sum of the reasons below) */
+    uint64_t rej_length, rej_magic, rej_version, rej_crc, rej_type, rej_field;
+    uint64_t lines_received;   /* stored in their frame */
+    uint64_t lines_lost;       /* expected, not received when the frame closed */
+    uint64_t lines_late;       /* arrived for a frame already closed */
+    uint64_t lines_duplicate;  /* same line twice in one frame */
+    uint64_t lines_sender_dropped; /* reported by the sender in FRAME_END */
+    uint64_t frames_complete;  /* closed with every line */
+    uint64_t frames_incomplete; /* closed with lines lost */
+    uint64_t begins_missing;   /* frame started by a line or end: its FRAME_BEGIN never came */
+    uint64_t ends_missing;     /* frame closed by a newer frame: its FRAME_END never came */
+    uint64_t frames_late;      /* FRAME_BEGIN/END of a frame older than the current one */
+} sc_dlink_rx_stats;
+
+/* A closed frame, ready to show: image rows 0..line_count-1, each `samples` bytes, stride
+ * SC_MAX_SCAN_SAMPLES. Lost rows hold the previous frame's row. */
+typedef struct sc_dlink_done {
+    sc_dlink_frame frame;
+    sc_dlink_begin begin;      /* from FRAME_BEGIN, or the previous frame's if it was lost */
+    uint16_t lines_received;
+    uint16_t lines_lost;
+    uint8_t begin_seen;
+    uint8_t end_seen;
+    const uint8_t *image;      /* valid until the next frame closes */
+} sc_dlink_done;
+
+typedef struct sc_dlink_asm {
+    uint8_t image[2][SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES]; /* assembling / last closed */
+    uint32_t got[(SC_MAX_SCAN_LINES + 31u) / 32u];              /* lines of the open frame */
+    uint8_t cur;                /* plane being assembled */
+    uint8_t open;               /* a frame is being assembled */
+    uint8_t have_done;          /* a closed frame exists */
+    uint8_t begin_seen;
+    sc_dlink_frame frame;       /* open frame */
+    sc_dlink_begin begin;       /* open frame's (or last known) begin payload */
+    uint16_t received;          /* lines of the open frame */
+    uint32_t last_closed_no;    /* frame number of the last closed frame */
+    sc_dlink_done done;         /* last closed frame */
+    sc_dlink_rx_stats stats;
+} sc_dlink_asm;
+
+/* Reset all state and statistics. O(SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES). */
+void sc_dlink_asm_init(sc_dlink_asm *a);
+
+/* A packet more than this many frames older than the last closed frame is taken as a sender
+ * restart (its frame counter began again), not as a late packet: the assembler resynchronises. */
+#define SC_DLINK_RESYNC_FRAMES 256u
+
+/* Offer one received datagram. Returns 1 when a frame closed (because of this packet; read it
+ * with sc_dlink_asm_done() before the next push), 0 when not, or the negative decode error when
+ * the packet was rejected (counted in stats, state unchanged). Frame numbers compare in serial
+ * arithmetic (wrap-safe): a packet of a frame newer than the open one closes it and opens the
+ * new one. O(len + samples), plus O(lines x samples) to carry lost rows over on a close. */
+int sc_dlink_asm_push(sc_dlink_asm *a, const uint8_t *pkt, size_t len);
+
+/* Close the open frame, if any (end of stream). Returns 1 when a frame closed, else 0. */
+int sc_dlink_asm_flush(sc_dlink_asm *a);
+
+/* The last closed frame, or NULL before the first. O(1). */
+const sc_dlink_done *sc_dlink_asm_done(const sc_dlink_asm *a);
+
+#endif /* SC_DLINK_H */
