@@ -80,6 +80,41 @@
 #define SC_MAX_SCAN_SAMPLES 512u
 #endif
 
+/* ---- B-scan synthesis (sc_bscan) --------------------------------------------------------- */
+/* Image regions of the paper's fast path (section IV: R = 32 measured best). */
+#ifndef SC_BSCAN_REGIONS_DEFAULT
+#define SC_BSCAN_REGIONS_DEFAULT 32u
+#endif
+#ifndef SC_BSCAN_MAX_REGIONS
+#define SC_BSCAN_MAX_REGIONS 64u
+#endif
+/* Time-gain compensation depth bands. */
+#ifndef SC_BSCAN_TGC_BANDS
+#define SC_BSCAN_TGC_BANDS 8u
+#endif
+/* Boundary triangles of the tet mesh (2 per boundary quad of the box). */
+#ifndef SC_BSCAN_MAX_HULL_FACES
+#define SC_BSCAN_MAX_HULL_FACES                                                                \
+    (4u * ((SC_MAX_MESH_NX - 1u) * (SC_MAX_MESH_NY - 1u) +                                     \
+           (SC_MAX_MESH_NX - 1u) * (SC_MAX_MESH_NZ - 1u) +                                     \
+           (SC_MAX_MESH_NY - 1u) * (SC_MAX_MESH_NZ - 1u)))
+#endif
+/* Tets cut by the image plane kept by the region (paper) path; a plane through the default
+ * 32x16x16 mesh cuts about 2,300 of them. Above it that path falls back to the walker. */
+#ifndef SC_BSCAN_MAX_PLANE_TETS
+#define SC_BSCAN_MAX_PLANE_TETS (SC_MAX_TETS / 4u)
+#endif
+#ifndef SC_BSCAN_MAX_REGION_REFS
+#define SC_BSCAN_MAX_REGION_REFS (4u * SC_BSCAN_MAX_PLANE_TETS)
+#endif
+/* Mesh-boundary crossings kept per scan line, and tet steps of the walker per scan line. */
+#ifndef SC_BSCAN_MAX_LINE_EVENTS
+#define SC_BSCAN_MAX_LINE_EVENTS 64u
+#endif
+#ifndef SC_BSCAN_MAX_WALK_STEPS
+#define SC_BSCAN_MAX_WALK_STEPS 4096u
+#endif
+
 /* ---- CAN --------------------------------------------------------------------------------- */
 /* Frames drained from the CAN receive queue per frame, at most (bounds the rx stage). */
 #ifndef SC_CAN_RX_BURST_MAX
@@ -97,5 +132,12 @@ _Static_assert(SC_MAX_MESH_NX >= 2u && SC_MAX_MESH_NY >= 2u && SC_MAX_MESH_NZ >=
 _Static_assert(SC_MAX_NODES <= 65535u * 16u, "node indices must fit 32-bit arithmetic");
 _Static_assert(SC_HEALTH_MISS_DEGRADED <= SC_HEALTH_MISS_WINDOW, "miss threshold above window");
 _Static_assert(SC_HEALTH_MISS_WINDOW <= 64u, "miss window is a 64-bit mask");
+_Static_assert(SC_BSCAN_REGIONS_DEFAULT >= 1u && SC_BSCAN_REGIONS_DEFAULT <= SC_BSCAN_MAX_REGIONS,
+               "default B-scan region count outside its range");
+_Static_assert(SC_MAX_SCAN_LINES >= 2u && SC_MAX_SCAN_LINES <= 65535u &&
+                   SC_MAX_SCAN_SAMPLES >= 2u && SC_MAX_SCAN_SAMPLES <= 65535u,
+               "scan lines and samples travel as 16-bit numbers");
+_Static_assert(SC_BSCAN_TGC_BANDS >= 1u, "at least one TGC band");
+_Static_assert(SC_BSCAN_MAX_LINE_EVENTS >= 2u, "a scan line needs an entry and an exit event");
 
 #endif /* SC_CONFIG_H */
