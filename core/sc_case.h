@@ -1,0 +1,146 @@
+/*
+ * sc_case.h: the patient case file (format v1, docs/case-format.md): constants, the validating
+ * loader and a pure writer.
+ *
+ * A case is one immutable little-endian byte image: a 64-byte file header, then 64-byte aligned
+ * sections, each a 64-byte section header (tag, payload size, payload CRC-32, header CRC-32) and
+ * its payload: INFO (name, description), GRID (dimensions, spacing, origin, orientation), VOXL
+ * (8-bit intensities), LABL (label map, same grid), MATL (material per label), MESH (mesh box in
+ * volume mm and node counts), XFRM (probe calibration, mannequin registration). It holds voxels
+ * and geometry only: there is no field for any patient identity.
+ *
+ * Loader: sc_case_load() validates every byte that the engine will use against config/ limits
+ * (sizes overflow-safe, CRCs, finite and rigid transforms, labels inside the material table,
+ * mesh box inside the volume, node counts within limits) and only then fills the caller's
+ * sc_case view; on any error the view is left untouched, so the running case stays. The view
+ * points into the bytes (voxels, labels, name, description are not copied): keep the bytes
+ * mapped while the view is used.
+ *
+ * Orientation: GRID stores the direction cosines of the grid axes in the mannequin (patient)
+ * frame. The loader accepts any rigid orientation and folds it into the registration:
+ * tracker_to_volume = R(orientation)^T o tracker_to_patient, so the engine always works in the
+ * axis-aligned volume frame of sc_volume.h. A non-rigid orientation is SC_ERR_CASE_TRANSFORM.
+ *
+ * Thread and memory rules: pure functions over caller memory, reentrant. Never allocates,
+ * never calls the OS, never writes to the case bytes.
+ */
+#ifndef SC_CASE_H
+#define SC_CASE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sc_config.h"
+#include "sc_mesh.h"
+#include "sc_pose.h"
+#include "sc_volume.h"
+
+/* ---- format constants (v1) --------------------------------------------------------------- */
+#define SC_CASE_MAGIC "\x89SCASE\r\n" /* 8 bytes, PNG-style: catches text-mode mangling */
+#define SC_CASE_MAGIC_LEN 8u
+#define SC_CASE_VERSION 1u
+#define SC_CASE_HEADER_SIZE 64u
+#define SC_CASE_SECTION_HEADER_SIZE 64u
+#define SC_CASE_ALIGN 64u
+#define SC_CASE_NAME_LEN 64u         /* bytes incl. the terminating NUL */
+#define SC_CASE_DESCRIPTION_LEN 960u /* bytes incl. the terminating NUL */
+#define SC_CASE_MATERIAL_RECORD_SIZE 16u
+/* Tolerance of the rigidity check of transforms and orientation (float32 round-off of a
+ * rotation written from doubles is ~1e-7; 1e-4 refuses anything visibly non-rigid). */
+#define SC_CASE_RIGID_TOL 1.0e-4f
+
+/* Section tags: four ASCII characters read as a little-endian u32. */
+#define SC_CASE_TAG(a, b, c, d)                                                                 \
+    ((uint32_t)(a) | ((uint32_t)(b) << 8) | ((uint32_t)(c) << 16) | ((uint32_t)(d) << 24))
+#define SC_CASE_TAG_INFO SC_CASE_TAG('I', 'N', 'F', 'O')
+#define SC_CASE_TAG_GRID SC_CASE_TAG('G', 'R', 'I', 'D')
+#define SC_CASE_TAG_VOXL SC_CASE_TAG('V', 'O', 'X', 'L')
+#define SC_CASE_TAG_LABL SC_CASE_TAG('L', 'A', 'B', 'L')
+#define SC_CASE_TAG_MATL SC_CASE_TAG('M', 'A', 'T', 'L')
+#define SC_CASE_TAG_MESH SC_CASE_TAG('M', 'E', 'S', 'H')
+#define SC_CASE_TAG_XFRM SC_CASE_TAG('X', 'F', 'R', 'M')
+#define SC_CASE_SECTION_COUNT 7u
+
+/* Payload sizes of the fixed-size sections. */
+#define SC_CASE_INFO_SIZE (SC_CASE_NAME_LEN + SC_CASE_DESCRIPTION_LEN) /* 1024 */
+#define SC_CASE_GRID_SIZE 80u  /* u32 dim[3], u32 0, f32 spacing[3], origin[3], orient[9], u32 0 */
+#define SC_CASE_MESH_SIZE 40u  /* f32 origin[3], size[3], u32 nx, ny, nz, u32 0 */
+#define SC_CASE_XFRM_SIZE 96u  /* image->probe, tracker->patient: 12 f32 each (r[9], t[3]) */
+#define SC_CASE_MATL_HEAD_SIZE 8u /* u32 count, u32 0; then count 16-byte records */
+
+_Static_assert(SC_MAX_LABELS >= 9u && SC_MAX_LABELS <= 256u, "labels are 8-bit");
+_Static_assert(SC_MAX_VOLUME_DIM >= 2u, "volume needs at least 2 voxels per axis");
+_Static_assert(SC_MAX_VOLUME_VOXELS <= (uint64_t)SC_MAX_VOLUME_DIM * SC_MAX_VOLUME_DIM *
+                                           SC_MAX_VOLUME_DIM,
+               "voxel limit above what the dimension limit allows");
+_Static_assert(SC_CASE_INFO_SIZE == 1024u, "INFO payload size");
+
+/* One material record per label value (index = label, config/sc_labels.h). */
+typedef struct sc_case_material {
+    float e_pa;          /* Young's modulus, Pa; finite, > 0 */
+    float poisson;       /* Poisson ratio, [0, 0.5) */
+    float density_kg_m3; /* finite, > 0 */
+} sc_case_material;
+
+/* The loaded case: a view into the case bytes plus small decoded copies (1 KiB or so). */
+typedef struct sc_case {
+    const char *name;        /* NUL-terminated, points into the bytes */
+    const char *description; /* NUL-terminated, points into the bytes */
+    sc_volume volume;        /* voxels and labels point into the bytes; labels never NULL */
+    float orientation[9];    /* grid axes in the mannequin frame, row-major, as stored */
+    uint32_t material_count; /* 1..SC_MAX_LABELS; every label value is < material_count */
+    sc_case_material materials[SC_MAX_LABELS];
+    sc_mesh_def mesh;             /* mesh box (volume frame, mm) and node counts */
+    sc_xform image_to_probe;      /* probe calibration */
+    sc_xform tracker_to_patient;  /* mannequin registration as stored */
+    sc_xform tracker_to_volume;   /* registration with the orientation folded in */
+    uint64_t voxel_count;
+    uint32_t case_id;             /* CRC-32 over the file and section headers (which hold the
+                                   * payload CRCs): identifies the case content */
+} sc_case;
+
+/* What the writer encodes. volume.voxels and volume.labels must both be non-NULL. */
+typedef struct sc_case_def {
+    const char *name;        /* < SC_CASE_NAME_LEN bytes, printable ASCII/UTF-8 */
+    const char *description; /* < SC_CASE_DESCRIPTION_LEN bytes */
+    sc_volume volume;
+    float orientation[9];
+    uint32_t material_count;
+    sc_case_material materials[SC_MAX_LABELS];
+    sc_mesh_def mesh;
+    sc_xform image_to_probe;
+    sc_xform tracker_to_patient;
+} sc_case_def;
+
+/* Defaults: empty name, identity orientation and transforms, no volume, no materials, the
+ * default mesh definition. O(1). */
+sc_case_def sc_case_default_def(void);
+
+/* Bytes the writer needs for def; 0 when def is unusable (NULL, dims product overflow).
+ * O(1). Never allocates. */
+size_t sc_case_encoded_size(const sc_case_def *def);
+
+/* Encode def into buf[0..cap). Writes *out_size on success. The writer checks only what it
+ * needs to produce a well-formed file (pointers, sizes, text lengths); it does NOT validate
+ * semantics (spacing, labels, transforms): load the result with sc_case_load() for that, as
+ * the case builder does. O(voxels) (two copies and CRCs), bounded by the dims of def.
+ * Never allocates. Errors: SC_ERR_INVALID_ARG (NULL pointers, count above SC_MAX_LABELS),
+ * SC_ERR_OVERFLOW (size does not fit size_t), SC_ERR_NO_SPACE (cap too small),
+ * SC_ERR_CASE_TEXT (name or description too long). */
+int sc_case_write(const sc_case_def *def, uint8_t *buf, size_t cap, size_t *out_size);
+
+/* Validate the case image bytes[0..size) and, only if all of it is valid, fill *out.
+ * O(size): CRC over every byte and one pass over the labels; bounded by SC_MAX_VOLUME_VOXELS.
+ * Never allocates, never writes to bytes. Errors (first failing check wins, in file order):
+ * SC_ERR_INVALID_ARG, SC_ERR_CASE_TRUNCATED, SC_ERR_CASE_MAGIC, SC_ERR_CASE_CRC,
+ * SC_ERR_CASE_VERSION, SC_ERR_CASE_SECTION (missing, duplicated, unknown-size header),
+ * SC_ERR_CASE_RESERVED, SC_ERR_CASE_SIZE, SC_ERR_CASE_TEXT, SC_ERR_CASE_DIMS,
+ * SC_ERR_CASE_SPACING, SC_ERR_CASE_TRANSFORM, SC_ERR_CASE_MATERIAL, SC_ERR_CASE_LABEL,
+ * SC_ERR_CASE_MESH_NODES, SC_ERR_CASE_MESH_BOX. */
+int sc_case_load(const uint8_t *bytes, size_t size, sc_case *out);
+
+/* Label histogram of a loaded case: counts[l] = voxels with label l, l < SC_MAX_LABELS.
+ * O(voxels). Never allocates, cannot fail for a case from sc_case_load(). */
+void sc_case_label_histogram(const sc_case *c, uint64_t counts[SC_MAX_LABELS]);
+
+#endif /* SC_CASE_H */
