@@ -58,6 +58,27 @@
 #ifndef SC_PHYS_DT_DEFAULT_S
 #define SC_PHYS_DT_DEFAULT_S 0.01f
 #endif
+/* MSDS springs (sc_springs.h, Algorithm 1): the 5-tet grid has one spring per grid edge
+ * (3 per node) and one per grid face diagonal (3 per node): at most 6 N. */
+#ifndef SC_MAX_SPRINGS
+#define SC_MAX_SPRINGS (6u * SC_MAX_NODES)
+#endif
+/* log2 of the build-time spring hash table (>= 2 SC_MAX_SPRINGS slots). */
+#ifndef SC_SPRINGS_HASH_BITS
+#define SC_SPRINGS_HASH_BITS 17u
+#endif
+/* Skin surface (sc_skin.h): a regular triangle grid over the top of the mesh box. */
+#ifndef SC_MAX_SKIN_NX
+#define SC_MAX_SKIN_NX 64u
+#endif
+#ifndef SC_MAX_SKIN_NY
+#define SC_MAX_SKIN_NY 64u
+#endif
+#ifndef SC_MAX_SKIN_NODES
+#define SC_MAX_SKIN_NODES (SC_MAX_SKIN_NX * SC_MAX_SKIN_NY)
+#endif
+_Static_assert((1u << SC_SPRINGS_HASH_BITS) >= 2u * SC_MAX_SPRINGS,
+               "spring hash table below twice the spring capacity");
 
 /* ---- labels and materials --------------------------------------------------------------- */
 #ifndef SC_MAX_LABELS
