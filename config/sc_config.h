@@ -136,6 +136,15 @@ _Static_assert((1u << SC_SPRINGS_HASH_BITS) >= 2u * SC_MAX_SPRINGS,
 #define SC_BSCAN_MAX_WALK_STEPS 4096u
 #endif
 
+/* ---- runtime configuration file (sc_rtcfg) ----------------------------------------------- */
+/* Longest line of the configuration file, and longest path or host value, in bytes. */
+#ifndef SC_RTCFG_LINE_MAX
+#define SC_RTCFG_LINE_MAX 512u
+#endif
+#ifndef SC_RTCFG_PATH_MAX
+#define SC_RTCFG_PATH_MAX 256u
+#endif
+
 /* ---- CAN --------------------------------------------------------------------------------- */
 /* Frames drained from the CAN receive queue per frame, at most (bounds the rx stage). */
 #ifndef SC_CAN_RX_BURST_MAX
@@ -160,5 +169,8 @@ _Static_assert(SC_MAX_SCAN_LINES >= 2u && SC_MAX_SCAN_LINES <= 65535u &&
                "scan lines and samples travel as 16-bit numbers");
 _Static_assert(SC_BSCAN_TGC_BANDS >= 1u, "at least one TGC band");
 _Static_assert(SC_BSCAN_MAX_LINE_EVENTS >= 2u, "a scan line needs an entry and an exit event");
+
+_Static_assert(SC_RTCFG_PATH_MAX >= 16u && SC_RTCFG_PATH_MAX < SC_RTCFG_LINE_MAX,
+               "a configuration path must fit a configuration line");
 
 #endif /* SC_CONFIG_H */
