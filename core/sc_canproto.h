@@ -1,0 +1,193 @@
+/*
+ * sc_canproto.h: the sonocomp CAN protocol codec (config/sonocomp.dbc is the source of truth;
+ * the tables here mirror it and tests/unit/test_sc_canproto.c checks them against the file).
+ *
+ * Messages (11-bit ids, Intel byte order, E2E header in bytes 0-1, see sc_e2e.h):
+ *   0x080 CmdSelectCase  0x081 CmdSetMethod  0x082 CmdSetImaging  0x083 CmdReset   (in, event)
+ *   0x100 ProbePosePos   0x101 ProbePoseQuat 0x102 ProbePoseAux                    (in, 10 ms)
+ *   0x110 ProbePoseFD    (in, 10 ms, CAN FD 20 bytes: the three above in one frame)
+ *   0x200 EngineStatus   0x201 EngineTiming  0x202 TrackerDiag                    (out, 100 ms)
+ * A classic pose spans the three 0x10x frames, tied by one E2E counter value shared by the
+ * three frames of a sample. E2E data ID = CAN id.
+ *
+ * All functions are pure: no state, no allocation, no OS; deterministic. Encoding validates
+ * every physical value (finite, representable) and fails with SC_ERR_NOT_FINITE or
+ * SC_ERR_CAN_SIGNAL; decoding validates the frame (id, FD flag, length: SC_ERR_CAN_ID,
+ * SC_ERR_CAN_DLC) and, for commands, the value ranges (SC_ERR_CAN_SIGNAL). Decoding never
+ * checks the E2E header: that is sc_e2e's job, done before. Costs are O(signals of the
+ * message), at most SC_CANPROTO_MAX_SIGS.
+ */
+#ifndef SC_CANPROTO_H
+#define SC_CANPROTO_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sc_e2e.h"
+#include "sc_hal_can.h"
+
+typedef enum sc_msg {
+    SC_MSG_CMD_CASE = 0,
+    SC_MSG_CMD_METHOD,
+    SC_MSG_CMD_IMAGING,
+    SC_MSG_CMD_RESET,
+    SC_MSG_POSE_POS,
+    SC_MSG_POSE_QUAT,
+    SC_MSG_POSE_AUX,
+    SC_MSG_POSE_FD,
+    SC_MSG_STATUS,
+    SC_MSG_TIMING,
+    SC_MSG_DIAG,
+    SC_MSG_COUNT
+} sc_msg;
+
+#define SC_CANPROTO_MAX_SIGS 11u
+
+enum {
+    SC_CANID_CMD_CASE = 0x080,
+    SC_CANID_CMD_METHOD = 0x081,
+    SC_CANID_CMD_IMAGING = 0x082,
+    SC_CANID_CMD_RESET = 0x083,
+    SC_CANID_POSE_POS = 0x100,
+    SC_CANID_POSE_QUAT = 0x101,
+    SC_CANID_POSE_AUX = 0x102,
+    SC_CANID_POSE_FD = 0x110,
+    SC_CANID_STATUS = 0x200,
+    SC_CANID_TIMING = 0x201,
+    SC_CANID_DIAG = 0x202,
+};
+
+/* One signal as in the DBC: raw little-endian bit field, phys = raw * factor + offset. */
+typedef struct sc_can_sig {
+    const char *name;
+    uint16_t start_bit; /* Intel: bit index of the LSB, byte * 8 + bit */
+    uint8_t bits;
+    uint8_t is_signed;
+    float factor;
+    float offset;
+    float min; /* DBC range of valid physical values */
+    float max;
+    const char *unit;
+} sc_can_sig;
+
+typedef struct sc_can_msg_info {
+    const char *name;
+    uint32_t can_id;
+    uint16_t data_id;    /* E2E data ID */
+    uint8_t len;         /* payload bytes */
+    uint8_t fd;          /* 1: CAN FD frame */
+    uint16_t cycle_ms;   /* 0: sent on event */
+    uint16_t timeout_ms; /* receive timeout, 0: none */
+    uint8_t sig_count;
+    const sc_can_sig *sigs;
+} sc_can_msg_info;
+
+/* Table entry of a message, NULL for an invalid index. O(1). */
+const sc_can_msg_info *sc_canproto_info(sc_msg m);
+
+/* Message of a received frame: SC_ERR_CAN_ID for an id not in the protocol (or extended, RTR,
+ * error frames), SC_ERR_CAN_DLC for a length or FD flag that does not match. O(SC_MSG_COUNT). */
+int sc_canproto_classify(const sc_can_frame *f, sc_msg *out);
+
+/* Raw bit field access (Intel byte order). get sign-extends signed signals. O(bits). */
+int64_t sc_canproto_get_raw(const uint8_t *data, const sc_can_sig *s);
+void sc_canproto_put_raw(uint8_t *data, const sc_can_sig *s, int64_t raw);
+/* Physical value to raw: round to nearest, SC_ERR_NOT_FINITE, SC_ERR_CAN_SIGNAL when the raw
+ * value does not fit the field. O(1). */
+int sc_canproto_phys_to_raw(const sc_can_sig *s, float phys, int64_t *raw);
+float sc_canproto_raw_to_phys(const sc_can_sig *s, int64_t raw);
+
+/* Decodes every signal of a classified frame into phys[0..sig_count-1] (table order).
+ * Errors of sc_canproto_classify; SC_ERR_NO_SPACE if cap < sig_count. */
+int sc_canproto_decode_phys(const sc_can_frame *f, sc_msg *msg, float *phys, size_t cap);
+
+/* ---- probe pose (in) ------------------------------------------------------------------- */
+enum { SC_TRACKING_OK = 0, SC_TRACKING_LOST = 1 };
+#define SC_FORCE_NOT_AVAILABLE_RAW 0xFFFFu
+
+typedef struct sc_pose_msg {
+    float pos_mm[3];
+    float q[4];        /* w, x, y, z as sent (not normalised) */
+    float force_n;     /* contact force, valid when force_valid */
+    uint8_t force_valid;
+    uint8_t tracking;  /* SC_TRACKING_* */
+} sc_pose_msg;
+
+/* Encodes one pose sample with E2E counter `counter` (same for all parts): 3 classic frames
+ * (0x100, 0x101, 0x102) or, with fd, 1 frame 0x110. *n gets the frame count. ts_ns of the
+ * frames is 0. SC_ERR_NO_SPACE when cap is too small. */
+int sc_canproto_encode_pose(const sc_pose_msg *m, uint8_t counter, int fd, sc_can_frame *out,
+                            size_t cap, size_t *n);
+/* Writes the fields that message `msg` carries into *m (other fields untouched); returns the
+ * part bit (1 << (msg - SC_MSG_POSE_POS)) for the classic parts, 7 for the FD frame. Errors of
+ * sc_canproto_classify, SC_ERR_CAN_ID for a frame that is not a pose. */
+int sc_canproto_decode_pose_part(const sc_can_frame *f, sc_pose_msg *m);
+#define SC_POSE_PARTS_ALL 7u
+
+/* ---- commands (in) ----------------------------------------------------------------------- */
+typedef enum sc_cmd_kind {
+    SC_CMD_SELECT_CASE = 1,
+    SC_CMD_SET_METHOD = 2,
+    SC_CMD_SET_IMAGING = 3,
+    SC_CMD_RESET = 4,
+} sc_cmd_kind;
+
+enum { SC_METHOD_MSDS = 0, SC_METHOD_FEM = 1 };
+enum { SC_SCAN_LINEAR = 0, SC_SCAN_CURVILINEAR = 1 };
+enum { SC_RESET_TISSUE = 1, SC_RESET_FAULTS = 2, SC_RESET_ALL = 3 };
+
+typedef struct sc_imaging_cmd {
+    float depth_mm;        /* 10..250 */
+    float gain_db;         /* -40..40, 0.5 dB steps */
+    float dyn_range_db;    /* 20..100 */
+    float tgc_db_per_cm;   /* 0..10 */
+    uint8_t geometry;      /* SC_SCAN_* */
+} sc_imaging_cmd;
+
+typedef struct sc_cmd {
+    sc_cmd_kind kind;
+    uint8_t case_id;       /* SELECT_CASE: 0..254 */
+    uint8_t method;        /* SET_METHOD: SC_METHOD_* */
+    uint8_t reset_target;  /* RESET: SC_RESET_* */
+    sc_imaging_cmd imaging; /* SET_IMAGING */
+} sc_cmd;
+
+/* One frame, E2E-protected with `counter`. SC_ERR_INVALID_ARG for an unknown kind,
+ * SC_ERR_CAN_SIGNAL / SC_ERR_NOT_FINITE for values outside the DBC ranges. */
+int sc_canproto_encode_cmd(const sc_cmd *c, uint8_t counter, sc_can_frame *out);
+/* Decodes and range-checks a command frame (SC_ERR_CAN_SIGNAL outside the DBC ranges). */
+int sc_canproto_decode_cmd(const sc_can_frame *f, sc_cmd *out);
+
+/* ---- engine status (out) ----------------------------------------------------------------- */
+#define SC_STATUS_CASE_NONE 255u
+#define SC_AREA_RATIO_NOT_AVAILABLE (-1.0f)
+
+typedef struct sc_status_msg {
+    uint8_t state;          /* sc_health_state */
+    uint8_t method;         /* SC_METHOD_* */
+    uint8_t probe_contact;  /* collider touching the skin */
+    uint8_t probe_lifted;   /* tracker silent or lost: collider removed */
+    uint16_t fault_bits;    /* sc_health active bits */
+    uint32_t deadline_misses;  /* saturates at 65535 on the bus */
+    uint8_t case_id;           /* SC_STATUS_CASE_NONE when none */
+    uint32_t worst_frame_us;   /* saturates at 65535 */
+    float vein_area_ratio;     /* lumen area / rest area, <0 not available */
+    float artery_area_ratio;
+    uint32_t poses_accepted;   /* sent modulo 65536 */
+    uint32_t rejected_e2e;     /* saturating on the bus */
+    uint32_t rejected_plausibility;
+    uint32_t lift_events;
+} sc_status_msg;
+
+#define SC_STATUS_FRAMES 3u
+/* Encodes EngineStatus, EngineTiming, TrackerDiag (in that order) into out[0..2], each
+ * protected with the counter of its sender state tx[0..2] (advanced). Counters saturate to
+ * their fields. SC_ERR_CAN_SIGNAL for a state/method out of range or a non-finite ratio. */
+int sc_canproto_encode_status(const sc_status_msg *s, sc_e2e_tx tx[SC_STATUS_FRAMES],
+                              sc_can_frame out[SC_STATUS_FRAMES]);
+/* Writes the fields one of the three status frames carries into *s (ratios that are "not
+ * available" decode to SC_AREA_RATIO_NOT_AVAILABLE). Errors of sc_canproto_classify,
+ * SC_ERR_CAN_ID for a frame that is not a status frame. */
+int sc_canproto_decode_status_part(const sc_can_frame *f, sc_status_msg *s);
+
+#endif /* SC_CANPROTO_H */

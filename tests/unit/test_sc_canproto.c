@@ -1,0 +1,438 @@
+/* test_sc_canproto.c: codec round trips for every message, frame validation, and the codec
+ * tables against config/sonocomp.dbc (the protocol's source of truth). */
+#include "sc_test.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sc_canproto.h"
+#include "sc_e2e.h"
+#include "sc_err.h"
+
+static uint32_t rng = 12345u;
+static uint32_t rnd(void)
+{
+    rng = rng * 1664525u + 1013904223u;
+    return rng >> 8;
+}
+static float rndf(float lo, float hi)
+{
+    return lo + (hi - lo) * (float)(rnd() & 0xFFFFu) / 65535.0f;
+}
+
+static int e2e_ok(const sc_can_frame *f)
+{
+    return f->data[0] == sc_e2e_crc((uint16_t)f->id, f->data, f->len);
+}
+
+/* ---- pose ------------------------------------------------------------------------------- */
+
+static void pose_round_trip_within_half_a_step_classic_and_fd(void **state)
+{
+    (void)state;
+    for (int it = 0; it < 2000; it++) {
+        sc_pose_msg p = {0};
+        for (int i = 0; i < 3; i++) {
+            p.pos_mm[i] = rndf(-1600.0f, 1600.0f);
+        }
+        for (int i = 0; i < 4; i++) {
+            p.q[i] = rndf(-1.9f, 1.9f);
+        }
+        p.force_valid = (uint8_t)(it % 3 != 0);
+        p.force_n = p.force_valid ? rndf(0.0f, 600.0f) : 0.0f;
+        p.tracking = (uint8_t)(it % 5 == 0);
+        const uint8_t counter = (uint8_t)(it % 16);
+        for (int fd = 0; fd <= 1; fd++) {
+            sc_can_frame f[3];
+            size_t n = 0;
+            assert_int_equal(sc_canproto_encode_pose(&p, counter, fd, f, 3, &n), 0);
+            assert_int_equal(n, fd ? 1u : 3u);
+            sc_pose_msg d = {0};
+            unsigned mask = 0;
+            for (size_t k = 0; k < n; k++) {
+                assert_true(e2e_ok(&f[k]));
+                assert_int_equal(f[k].data[1] & 0x0Fu, counter);
+                assert_int_equal(!!(f[k].flags & SC_CAN_FLAG_FD), fd);
+                const int part = sc_canproto_decode_pose_part(&f[k], &d);
+                assert_true(part > 0);
+                mask |= (unsigned)part;
+            }
+            assert_int_equal(mask, SC_POSE_PARTS_ALL);
+            /* half a step, plus float rounding of values up to 1638 (2^-13 relative) */
+            for (int i = 0; i < 3; i++) {
+                assert_true(fabsf(d.pos_mm[i] - p.pos_mm[i]) <= 0.025f + 1e-3f);
+            }
+            for (int i = 0; i < 4; i++) {
+                assert_true(fabsf(d.q[i] - p.q[i]) <= 0.5f / 16384.0f + 1e-6f);
+            }
+            assert_int_equal(d.force_valid, p.force_valid);
+            if (p.force_valid) {
+                assert_true(fabsf(d.force_n - p.force_n) <= 0.005f + 1e-4f);
+            }
+            assert_int_equal(d.tracking, p.tracking);
+            /* decode then encode reproduces the frames bit for bit */
+            sc_can_frame g[3];
+            size_t m = 0;
+            assert_int_equal(sc_canproto_encode_pose(&d, counter, fd, g, 3, &m), 0);
+            for (size_t k = 0; k < n; k++) {
+                assert_memory_equal(f[k].data, g[k].data, f[k].len);
+                assert_int_equal(f[k].id, g[k].id);
+            }
+        }
+    }
+}
+
+static void every_raw_value_of_a_16_bit_signal_survives_phys_and_back(void **state)
+{
+    (void)state;
+    const sc_can_msg_info *info = sc_canproto_info(SC_MSG_POSE_POS);
+    const sc_can_msg_info *qi = sc_canproto_info(SC_MSG_POSE_QUAT);
+    for (int32_t raw = -32768; raw <= 32767; raw++) {
+        int64_t back = 0;
+        assert_int_equal(sc_canproto_phys_to_raw(&info->sigs[2],
+                                                 sc_canproto_raw_to_phys(&info->sigs[2], raw),
+                                                 &back),
+                         0);
+        assert_int_equal(back, raw);
+        assert_int_equal(
+            sc_canproto_phys_to_raw(&qi->sigs[2], sc_canproto_raw_to_phys(&qi->sigs[2], raw), &back),
+            0);
+        assert_int_equal(back, raw);
+    }
+}
+
+static void pose_values_outside_the_fields_are_refused(void **state)
+{
+    (void)state;
+    sc_pose_msg p = {.q = {1.0f, 0.0f, 0.0f, 0.0f}};
+    sc_can_frame f[3];
+    size_t n;
+    p.pos_mm[1] = 2000.0f;
+    assert_int_equal(sc_canproto_encode_pose(&p, 0, 0, f, 3, &n), SC_ERR_CAN_SIGNAL);
+    p.pos_mm[1] = NAN;
+    assert_int_equal(sc_canproto_encode_pose(&p, 0, 1, f, 3, &n), SC_ERR_NOT_FINITE);
+    p.pos_mm[1] = 0.0f;
+    p.q[0] = 2.5f;
+    assert_int_equal(sc_canproto_encode_pose(&p, 0, 0, f, 3, &n), SC_ERR_CAN_SIGNAL);
+    p.q[0] = 1.0f;
+    p.force_valid = 1;
+    p.force_n = 655.35f; /* raw 65535 is reserved for "not available" */
+    assert_int_equal(sc_canproto_encode_pose(&p, 0, 0, f, 3, &n), SC_ERR_CAN_SIGNAL);
+    p.force_n = 1.0f;
+    p.tracking = 2;
+    assert_int_equal(sc_canproto_encode_pose(&p, 0, 0, f, 3, &n), SC_ERR_CAN_SIGNAL);
+    p.tracking = 0;
+    assert_int_equal(sc_canproto_encode_pose(&p, 0, 0, f, 2, &n), SC_ERR_NO_SPACE);
+    assert_int_equal(sc_canproto_encode_pose(&p, 0, 0, f, 3, &n), 0);
+}
+
+/* ---- commands ------------------------------------------------------------------------------ */
+
+static void every_command_round_trips(void **state)
+{
+    (void)state;
+    sc_cmd cmds[] = {
+        {.kind = SC_CMD_SELECT_CASE, .case_id = 0},
+        {.kind = SC_CMD_SELECT_CASE, .case_id = 254},
+        {.kind = SC_CMD_SET_METHOD, .method = SC_METHOD_MSDS},
+        {.kind = SC_CMD_SET_METHOD, .method = SC_METHOD_FEM},
+        {.kind = SC_CMD_SET_IMAGING,
+         .imaging = {.depth_mm = 60.0f, .gain_db = -12.5f, .dyn_range_db = 60.0f,
+                     .tgc_db_per_cm = 1.2f, .geometry = SC_SCAN_LINEAR}},
+        {.kind = SC_CMD_SET_IMAGING,
+         .imaging = {.depth_mm = 250.0f, .gain_db = 40.0f, .dyn_range_db = 20.0f,
+                     .tgc_db_per_cm = 10.0f, .geometry = SC_SCAN_CURVILINEAR}},
+        {.kind = SC_CMD_RESET, .reset_target = SC_RESET_TISSUE},
+        {.kind = SC_CMD_RESET, .reset_target = SC_RESET_ALL},
+    };
+    for (size_t i = 0; i < sizeof cmds / sizeof cmds[0]; i++) {
+        sc_can_frame f;
+        assert_int_equal(sc_canproto_encode_cmd(&cmds[i], (uint8_t)i, &f), 0);
+        assert_true(e2e_ok(&f));
+        sc_cmd d;
+        assert_int_equal(sc_canproto_decode_cmd(&f, &d), 0);
+        assert_int_equal(d.kind, cmds[i].kind);
+        assert_int_equal(d.case_id, cmds[i].case_id);
+        assert_int_equal(d.method, cmds[i].method);
+        assert_int_equal(d.reset_target, cmds[i].reset_target);
+        /* tolerance: half a step of each signal (0.05 mm, 0.25 dB, 0.5 dB, 0.05 dB/cm) */
+        assert_true(fabsf(d.imaging.depth_mm - cmds[i].imaging.depth_mm) <= 0.05f);
+        assert_true(fabsf(d.imaging.gain_db - cmds[i].imaging.gain_db) <= 0.25f);
+        assert_true(fabsf(d.imaging.dyn_range_db - cmds[i].imaging.dyn_range_db) <= 0.5f);
+        assert_true(fabsf(d.imaging.tgc_db_per_cm - cmds[i].imaging.tgc_db_per_cm) <= 0.05f);
+        assert_int_equal(d.imaging.geometry, cmds[i].imaging.geometry);
+        sc_can_frame g;
+        assert_int_equal(sc_canproto_encode_cmd(&d, (uint8_t)i, &g), 0);
+        assert_memory_equal(f.data, g.data, 8);
+    }
+}
+
+static void commands_outside_their_ranges_are_refused_both_ways(void **state)
+{
+    (void)state;
+    sc_can_frame f;
+    sc_cmd c = {.kind = SC_CMD_SELECT_CASE, .case_id = 255};
+    assert_int_equal(sc_canproto_encode_cmd(&c, 0, &f), SC_ERR_CAN_SIGNAL);
+    c = (sc_cmd){.kind = SC_CMD_SET_METHOD, .method = 2};
+    assert_int_equal(sc_canproto_encode_cmd(&c, 0, &f), SC_ERR_CAN_SIGNAL);
+    c = (sc_cmd){.kind = SC_CMD_RESET, .reset_target = 0};
+    assert_int_equal(sc_canproto_encode_cmd(&c, 0, &f), SC_ERR_CAN_SIGNAL);
+    c = (sc_cmd){.kind = SC_CMD_SET_IMAGING,
+                 .imaging = {.depth_mm = 5.0f, .gain_db = 0.0f, .dyn_range_db = 60.0f}};
+    assert_int_equal(sc_canproto_encode_cmd(&c, 0, &f), SC_ERR_CAN_SIGNAL);
+    c.imaging.depth_mm = 50.0f;
+    c.imaging.gain_db = NAN;
+    assert_int_equal(sc_canproto_encode_cmd(&c, 0, &f), SC_ERR_NOT_FINITE);
+    c = (sc_cmd){.kind = (sc_cmd_kind)9};
+    assert_int_equal(sc_canproto_encode_cmd(&c, 0, &f), SC_ERR_INVALID_ARG);
+
+    /* raw frames from a foreign sender with out-of-range signals */
+    const sc_can_msg_info *im = sc_canproto_info(SC_MSG_CMD_IMAGING);
+    sc_cmd ok = {.kind = SC_CMD_SET_IMAGING,
+                 .imaging = {.depth_mm = 50.0f, .gain_db = 0.0f, .dyn_range_db = 60.0f}};
+    struct {
+        unsigned sig;
+        int64_t raw;
+    } bad[] = {{2, 99}, {2, 2501}, {3, 81}, {3, -81}, {4, 19}, {4, 101}, {5, 101}, {6, 2}};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        assert_int_equal(sc_canproto_encode_cmd(&ok, 0, &f), 0);
+        sc_canproto_put_raw(f.data, &im->sigs[bad[i].sig], bad[i].raw);
+        sc_cmd d;
+        assert_int_equal(sc_canproto_decode_cmd(&f, &d), SC_ERR_CAN_SIGNAL);
+    }
+    c = (sc_cmd){.kind = SC_CMD_RESET, .reset_target = 1};
+    assert_int_equal(sc_canproto_encode_cmd(&c, 0, &f), 0);
+    f.data[2] = 0;
+    sc_cmd d;
+    assert_int_equal(sc_canproto_decode_cmd(&f, &d), SC_ERR_CAN_SIGNAL);
+    c = (sc_cmd){.kind = SC_CMD_SELECT_CASE, .case_id = 1};
+    assert_int_equal(sc_canproto_encode_cmd(&c, 0, &f), 0);
+    f.data[2] = 255;
+    assert_int_equal(sc_canproto_decode_cmd(&f, &d), SC_ERR_CAN_SIGNAL);
+}
+
+/* ---- status -------------------------------------------------------------------------------- */
+
+static void status_round_trips_and_saturates(void **state)
+{
+    (void)state;
+    sc_e2e_tx tx[3];
+    sc_e2e_tx_init(&tx[0], SC_CANID_STATUS);
+    sc_e2e_tx_init(&tx[1], SC_CANID_TIMING);
+    sc_e2e_tx_init(&tx[2], SC_CANID_DIAG);
+    sc_status_msg s = {.state = 2, .method = 1, .probe_contact = 1, .probe_lifted = 0,
+                       .fault_bits = 0x0A5Au, .deadline_misses = 1234, .case_id = 7,
+                       .worst_frame_us = 15321, .vein_area_ratio = 0.25f,
+                       .artery_area_ratio = SC_AREA_RATIO_NOT_AVAILABLE,
+                       .poses_accepted = 70000, .rejected_e2e = 12,
+                       .rejected_plausibility = 300, .lift_events = 3};
+    sc_can_frame f[3];
+    assert_int_equal(sc_canproto_encode_status(&s, tx, f), 0);
+    sc_status_msg d = {0};
+    for (int i = 0; i < 3; i++) {
+        assert_true(e2e_ok(&f[i]));
+        assert_int_equal(sc_canproto_decode_status_part(&f[i], &d), 0);
+    }
+    assert_int_equal(d.state, 2);
+    assert_int_equal(d.method, 1);
+    assert_int_equal(d.probe_contact, 1);
+    assert_int_equal(d.probe_lifted, 0);
+    assert_int_equal(d.fault_bits, 0x0A5Au);
+    assert_int_equal(d.deadline_misses, 1234);
+    assert_int_equal(d.case_id, 7);
+    assert_int_equal(d.worst_frame_us, 15321);
+    assert_true(fabsf(d.vein_area_ratio - 0.25f) <= 0.0005f);
+    assert_true(d.artery_area_ratio < 0.0f);
+    assert_int_equal(d.poses_accepted, 70000u % 65536u); /* documented: modulo 65536 */
+    assert_int_equal(d.rejected_e2e, 12);
+    assert_int_equal(d.rejected_plausibility, 255); /* saturated to its 8-bit field */
+    assert_int_equal(d.lift_events, 3);
+    /* the sender counters advanced */
+    assert_int_equal(tx[0].counter, 1);
+    s.deadline_misses = 1000000u;
+    s.worst_frame_us = 1000000u;
+    assert_int_equal(sc_canproto_encode_status(&s, tx, f), 0);
+    assert_int_equal(f[0].data[1] & 0x0Fu, 1);
+    for (int i = 0; i < 3; i++) {
+        assert_int_equal(sc_canproto_decode_status_part(&f[i], &d), 0);
+    }
+    assert_int_equal(d.deadline_misses, 65535);
+    assert_int_equal(d.worst_frame_us, 65535);
+    s.state = 4;
+    assert_int_equal(sc_canproto_encode_status(&s, tx, f), SC_ERR_CAN_SIGNAL);
+    s.state = 1;
+    s.vein_area_ratio = INFINITY;
+    assert_int_equal(sc_canproto_encode_status(&s, tx, f), SC_ERR_NOT_FINITE);
+}
+
+/* ---- frame validation ---------------------------------------------------------------------- */
+
+static void frames_with_unknown_id_wrong_length_or_format_are_classified_as_such(void **state)
+{
+    (void)state;
+    sc_can_frame f = {.id = SC_CANID_POSE_POS, .len = 8};
+    sc_msg m;
+    assert_int_equal(sc_canproto_classify(&f, &m), 0);
+    assert_int_equal(m, SC_MSG_POSE_POS);
+    f.len = 7;
+    assert_int_equal(sc_canproto_classify(&f, &m), SC_ERR_CAN_DLC);
+    f.len = 8;
+    f.flags = SC_CAN_FLAG_FD;
+    assert_int_equal(sc_canproto_classify(&f, &m), SC_ERR_CAN_DLC);
+    f.flags = SC_CAN_FLAG_EXT;
+    assert_int_equal(sc_canproto_classify(&f, &m), SC_ERR_CAN_ID);
+    f.flags = SC_CAN_FLAG_RTR;
+    assert_int_equal(sc_canproto_classify(&f, &m), SC_ERR_CAN_ID);
+    f = (sc_can_frame){.id = 0x7FF, .len = 8};
+    assert_int_equal(sc_canproto_classify(&f, &m), SC_ERR_CAN_ID);
+    f = (sc_can_frame){.id = SC_CANID_POSE_FD, .len = 20};
+    assert_int_equal(sc_canproto_classify(&f, &m), SC_ERR_CAN_DLC); /* FD id without FD flag */
+    f.flags = SC_CAN_FLAG_FD;
+    assert_int_equal(sc_canproto_classify(&f, &m), 0);
+    sc_pose_msg p;
+    f = (sc_can_frame){.id = SC_CANID_STATUS, .len = 8};
+    assert_int_equal(sc_canproto_decode_pose_part(&f, &p), SC_ERR_CAN_ID);
+    sc_cmd c;
+    assert_int_equal(sc_canproto_decode_cmd(&f, &c), SC_ERR_CAN_ID);
+    float phys[SC_CANPROTO_MAX_SIGS];
+    assert_int_equal(sc_canproto_decode_phys(&f, &m, phys, 2), SC_ERR_NO_SPACE);
+    assert_int_equal(sc_canproto_decode_phys(&f, &m, phys, SC_CANPROTO_MAX_SIGS), 0);
+    assert_null(sc_canproto_info(SC_MSG_COUNT));
+}
+
+static void signals_of_a_message_do_not_overlap_and_fit_its_length(void **state)
+{
+    (void)state;
+    for (int i = 0; i < (int)SC_MSG_COUNT; i++) {
+        const sc_can_msg_info *m = sc_canproto_info((sc_msg)i);
+        uint8_t used[64] = {0};
+        assert_true(m->sig_count <= SC_CANPROTO_MAX_SIGS);
+        assert_true(sc_can_len_valid(m->len, m->fd ? SC_CAN_FLAG_FD : 0));
+        for (unsigned s = 0; s < m->sig_count; s++) {
+            const sc_can_sig *g = &m->sigs[s];
+            assert_true(g->start_bit + g->bits <= m->len * 8u);
+            for (unsigned b = g->start_bit; b < (unsigned)(g->start_bit + g->bits); b++) {
+                assert_false(used[b / 8u] & (1u << (b % 8u)));
+                used[b / 8u] = (uint8_t)(used[b / 8u] | (1u << (b % 8u)));
+            }
+        }
+        assert_string_equal(m->sigs[0].name, "E2E_CRC");
+        assert_string_equal(m->sigs[1].name, "E2E_Counter");
+        assert_int_equal(m->data_id, m->can_id);
+    }
+}
+
+/* ---- the DBC file ------------------------------------------------------------------------- */
+
+static int near(double a, double b)
+{
+    return fabs(a - b) <= 1e-9 * (fabs(a) + fabs(b) + 1.0);
+}
+
+static void dbc_file_defines_exactly_the_codec_tables(void **state)
+{
+    (void)state;
+    FILE *fp = fopen(SC_SOURCE_DIR "/config/sonocomp.dbc", "r");
+    assert_non_null(fp);
+    char line[1024];
+    const sc_can_msg_info *cur = NULL;
+    unsigned sig_i = 0, msgs = 0, sigs = 0, cycles = 0, dids = 0, touts = 0, fds = 0;
+    while (fgets(line, sizeof line, fp)) {
+        unsigned id, len, start, bits, v;
+        char name[128], order, sign, unit[64];
+        double factor, offset, mn, mx;
+        if (sscanf(line, "BO_ %u %127[^:]: %u", &id, name, &len) == 3) {
+            cur = NULL;
+            for (int i = 0; i < (int)SC_MSG_COUNT; i++) {
+                if (sc_canproto_info((sc_msg)i)->can_id == id) {
+                    cur = sc_canproto_info((sc_msg)i);
+                }
+            }
+            assert_non_null(cur);
+            assert_string_equal(cur->name, name);
+            assert_int_equal(cur->len, len);
+            sig_i = 0;
+            msgs++;
+        } else if (sscanf(line, " SG_ %127s : %u|%u@%c%c (%lf,%lf) [%lf|%lf] \"%63[^\"]\"", name,
+                          &start, &bits, &order, &sign, &factor, &offset, &mn, &mx,
+                          unit) >= 9) {
+            assert_non_null(cur);
+            assert_true(sig_i < cur->sig_count);
+            const sc_can_sig *g = &cur->sigs[sig_i++];
+            if (!strstr(line, "\"\"")) {
+                assert_string_equal(g->unit, unit);
+            } else {
+                assert_string_equal(g->unit, "");
+            }
+            assert_string_equal(g->name, name);
+            assert_int_equal(g->start_bit, start);
+            assert_int_equal(g->bits, bits);
+            assert_int_equal(order, '1'); /* Intel */
+            assert_int_equal(g->is_signed, sign == '-');
+            /* float32 factors: equal to the DBC decimal within float precision */
+            assert_true(fabs(g->factor - factor) <= 1e-7 * fabs(factor));
+            assert_true(near(g->offset, offset));
+            assert_true(fabs(g->min - mn) <= 1e-3 && fabs(g->max - mx) <= 1e-3);
+            sigs++;
+        } else if (sscanf(line, "BA_ \"GenMsgCycleTime\" BO_ %u %u", &id, &v) == 2) {
+            int found = 0;
+            for (int i = 0; i < (int)SC_MSG_COUNT; i++) {
+                if (sc_canproto_info((sc_msg)i)->can_id == id) {
+                    assert_int_equal(sc_canproto_info((sc_msg)i)->cycle_ms, v);
+                    found = 1;
+                }
+            }
+            assert_true(found);
+            cycles++;
+        } else if (sscanf(line, "BA_ \"E2E_DataID\" BO_ %u %u", &id, &v) == 2) {
+            assert_int_equal(id, v); /* data ID = CAN id, as the codec uses */
+            dids++;
+        } else if (sscanf(line, "BA_ \"E2E_TimeoutMs\" BO_ %u %u", &id, &v) == 2) {
+            for (int i = 0; i < (int)SC_MSG_COUNT; i++) {
+                if (sc_canproto_info((sc_msg)i)->can_id == id) {
+                    assert_int_equal(sc_canproto_info((sc_msg)i)->timeout_ms, v);
+                }
+            }
+            touts++;
+        } else if (sscanf(line, "BA_ \"VFrameFormat\" BO_ %u %u", &id, &v) == 2) {
+            assert_int_equal(v, 14); /* StandardCAN_FD */
+            assert_int_equal(id, SC_CANID_POSE_FD);
+            fds++;
+        }
+        if (cur != NULL && strncmp(line, "BO_ ", 4) != 0 && line[0] == '\n') {
+            assert_int_equal(sig_i, cur->sig_count); /* every signal of the message listed */
+            cur = NULL;
+        }
+    }
+    fclose(fp);
+    assert_int_equal(msgs, SC_MSG_COUNT);
+    unsigned total = 0, cyclic = 0, timed = 0;
+    for (int i = 0; i < (int)SC_MSG_COUNT; i++) {
+        total += sc_canproto_info((sc_msg)i)->sig_count;
+        cyclic += sc_canproto_info((sc_msg)i)->cycle_ms != 0u;
+        timed += sc_canproto_info((sc_msg)i)->timeout_ms != 0u;
+    }
+    assert_int_equal(sigs, total);
+    assert_int_equal(cycles, cyclic);
+    assert_int_equal(dids, SC_MSG_COUNT);
+    assert_int_equal(touts, timed);
+    assert_int_equal(fds, 1);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(pose_round_trip_within_half_a_step_classic_and_fd),
+        cmocka_unit_test(every_raw_value_of_a_16_bit_signal_survives_phys_and_back),
+        cmocka_unit_test(pose_values_outside_the_fields_are_refused),
+        cmocka_unit_test(every_command_round_trips),
+        cmocka_unit_test(commands_outside_their_ranges_are_refused_both_ways),
+        cmocka_unit_test(status_round_trips_and_saturates),
+        cmocka_unit_test(frames_with_unknown_id_wrong_length_or_format_are_classified_as_such),
+        cmocka_unit_test(signals_of_a_message_do_not_overlap_and_fit_its_length),
+        cmocka_unit_test(dbc_file_defines_exactly_the_codec_tables),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
