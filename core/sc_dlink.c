@@ -116,15 +116,19 @@ int sc_dlink_encode_begin(uint8_t *buf, size_t cap, const sc_dlink_frame *f,
                                 b->compression_pm != SC_DLINK_COMPRESSION_UNKNOWN)) {
         return SC_ERR_DLINK_FIELD;
     }
-    if (!isfinite(b->depth_mm) || !isfinite(b->width_mm)) {
+    if (!isfinite(b->depth_mm) || !isfinite(b->width_mm) || !isfinite(b->radius_mm)) {
         return SC_ERR_NOT_FINITE;
+    }
+    if (b->radius_mm < 0.0f) {
+        return SC_ERR_DLINK_FIELD;
     }
     write_header(buf, f, SC_DLINK_FRAME_BEGIN, 0u, (uint16_t)SC_DLINK_BEGIN_PAYLOAD);
     uint8_t *p = buf + SC_DLINK_HEADER_SIZE;
     put32(p + 0, f32_bits(b->depth_mm));
     put32(p + 4, f32_bits(b->width_mm));
-    put16(p + 8, b->compression_pm);
-    put16(p + 10, 0u);
+    put32(p + 8, f32_bits(b->radius_mm));
+    put16(p + 12, b->compression_pm);
+    put16(p + 14, 0u);
     return finish(buf, (uint16_t)SC_DLINK_BEGIN_PAYLOAD);
 }
 
@@ -227,8 +231,10 @@ int sc_dlink_decode(const uint8_t *pkt, size_t len, sc_dlink_header *h, const ui
     if (d.type == SC_DLINK_FRAME_BEGIN) {
         float depth = f32_from_bits(get32(pl + 0));
         float width = f32_from_bits(get32(pl + 4));
-        uint16_t comp = get16(pl + 8);
-        if (!isfinite(depth) || !isfinite(width) || get16(pl + 10) != 0u ||
+        float radius = f32_from_bits(get32(pl + 8));
+        uint16_t comp = get16(pl + 12);
+        if (!isfinite(depth) || !isfinite(width) || !isfinite(radius) || radius < 0.0f ||
+            get16(pl + 14) != 0u ||
             (comp > SC_DLINK_COMPRESSION_MAX && comp != SC_DLINK_COMPRESSION_UNKNOWN)) {
             return SC_ERR_DLINK_FIELD;
         }
@@ -246,7 +252,8 @@ void sc_dlink_parse_begin(const uint8_t *payload, sc_dlink_begin *b)
 {
     b->depth_mm = f32_from_bits(get32(payload + 0));
     b->width_mm = f32_from_bits(get32(payload + 4));
-    b->compression_pm = get16(payload + 8);
+    b->radius_mm = f32_from_bits(get32(payload + 8));
+    b->compression_pm = get16(payload + 12);
 }
 
 void sc_dlink_parse_end(const uint8_t *payload, sc_dlink_end *e)

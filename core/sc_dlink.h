@@ -31,7 +31,7 @@
 #define SC_DLINK_MAGIC 0x4C444353u /* bytes 'S' 'C' 'D' 'L' on the wire (little-endian) */
 #define SC_DLINK_VERSION 1u
 #define SC_DLINK_HEADER_SIZE 28u
-#define SC_DLINK_BEGIN_PAYLOAD 12u /* depth_mm f32, width_mm f32, compression u16, rsvd u16 */
+#define SC_DLINK_BEGIN_PAYLOAD 16u /* depth, width, radius f32; compression u16; rsvd u16 */
 #define SC_DLINK_END_PAYLOAD 8u    /* lines_sent u16, lines_dropped u16, reserved u32 */
 /* Largest packet: a line of SC_MAX_SCAN_SAMPLES samples (540 bytes with the default limits,
  * below the 1472-byte UDP payload of a 1500-byte Ethernet MTU, so no IP fragmentation). */
@@ -66,6 +66,7 @@ typedef struct sc_dlink_header {
 typedef struct sc_dlink_begin {
     float depth_mm;           /* imaging depth */
     float width_mm;           /* linear: aperture width; curvilinear: sector angle in degrees */
+    float radius_mm;          /* curvilinear: probe face radius (apex behind the face); linear 0 */
     uint16_t compression_pm;  /* vessel compression measure, permille; or ..._UNKNOWN */
 } sc_dlink_begin;
 
@@ -89,7 +90,8 @@ typedef struct sc_dlink_frame {
  * SC_ERR_NO_SPACE when cap is too small, SC_ERR_DLINK_FIELD when a field is outside the wire
  * limits (line_count or samples 0 or above the SC_MAX_SCAN_* limits, line_index >= line_count,
  * geometry_id > 1, count != samples, compression above 1000 and not unknown, lines_sent +
- * lines_dropped above line_count), SC_ERR_NOT_FINITE for a non-finite depth or width,
+ * lines_dropped above line_count, radius negative), SC_ERR_NOT_FINITE for a non-finite depth,
+ * width or radius,
  * SC_ERR_INVALID_ARG for NULL pointers. O(header + payload), never allocates. */
 int sc_dlink_encode_begin(uint8_t *buf, size_t cap, const sc_dlink_frame *f,
                           const sc_dlink_begin *b);
@@ -109,7 +111,7 @@ int sc_dlink_encode_end(uint8_t *buf, size_t cap, const sc_dlink_frame *f,
 int sc_dlink_decode(const uint8_t *pkt, size_t len, sc_dlink_header *h, const uint8_t **payload);
 
 /* Payload accessors for a packet that sc_dlink_decode accepted with that type (the decoder
- * has checked the payload: finite depth and width, compression <= 1000 or unknown, lines_sent +
+ * has checked the payload: finite depth, width and radius >= 0, compression <= 1000 or unknown, lines_sent +
  * lines_dropped <= line_count, reserved bytes zero). O(1), cannot fail. */
 void sc_dlink_parse_begin(const uint8_t *payload, sc_dlink_begin *b);
 void sc_dlink_parse_end(const uint8_t *payload, sc_dlink_end *e);

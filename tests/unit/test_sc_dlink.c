@@ -39,7 +39,8 @@ static void round_trip_preserves_every_field_of_all_three_packet_types(void **st
     sc_dlink_header h;
     const uint8_t *pl;
 
-    const sc_dlink_begin b = {.depth_mm = 47.5f, .width_mm = 60.25f, .compression_pm = 734u};
+    const sc_dlink_begin b = {
+        .depth_mm = 47.5f, .width_mm = 60.25f, .radius_mm = 40.0f, .compression_pm = 734u};
     int n = sc_dlink_encode_begin(buf, sizeof buf, &k_frame, &b);
     assert_int_equal(n, SC_DLINK_HEADER_SIZE + SC_DLINK_BEGIN_PAYLOAD);
     assert_int_equal(sc_dlink_decode(buf, (size_t)n, &h, &pl), 0);
@@ -54,6 +55,7 @@ static void round_trip_preserves_every_field_of_all_three_packet_types(void **st
     sc_dlink_parse_begin(pl, &b2);
     assert_memory_equal(&b2.depth_mm, &b.depth_mm, sizeof(float)); /* bit-exact */
     assert_memory_equal(&b2.width_mm, &b.width_mm, sizeof(float));
+    assert_memory_equal(&b2.radius_mm, &b.radius_mm, sizeof(float));
     assert_int_equal(b2.compression_pm, 734u);
 
     n = sc_dlink_encode_line(buf, sizeof buf, &k_frame, 127u, samples, 200u);
@@ -202,7 +204,8 @@ static void begin_and_end_payload_fields_are_range_checked(void **state)
     uint8_t pkt[SC_DLINK_MAX_PACKET];
     sc_dlink_header h;
     const uint8_t *pl;
-    const sc_dlink_begin b = {.depth_mm = 40.0f, .width_mm = 38.0f, .compression_pm = 0u};
+    const sc_dlink_begin b = {
+        .depth_mm = 40.0f, .width_mm = 38.0f, .radius_mm = 0.0f, .compression_pm = 0u};
     int n = sc_dlink_encode_begin(pkt, sizeof pkt, &k_frame, &b);
     size_t len = (size_t)n;
     /* depth = NaN (0x7FC00000) */
@@ -212,10 +215,18 @@ static void begin_and_end_payload_fields_are_range_checked(void **state)
     pkt[31] = 0x7F;
     refresh_crc(pkt, len);
     assert_int_equal(sc_dlink_decode(pkt, len, &h, &pl), SC_ERR_DLINK_FIELD);
+    /* radius -1.0f (0xBF800000) */
+    n = sc_dlink_encode_begin(pkt, sizeof pkt, &k_frame, &b);
+    pkt[36] = 0x00;
+    pkt[37] = 0x00;
+    pkt[38] = 0x80;
+    pkt[39] = 0xBF;
+    refresh_crc(pkt, len);
+    assert_int_equal(sc_dlink_decode(pkt, len, &h, &pl), SC_ERR_DLINK_FIELD);
     /* compression 1001 */
     n = sc_dlink_encode_begin(pkt, sizeof pkt, &k_frame, &b);
-    pkt[36] = 0xE9;
-    pkt[37] = 0x03;
+    pkt[40] = 0xE9;
+    pkt[41] = 0x03;
     refresh_crc(pkt, len);
     assert_int_equal(sc_dlink_decode(pkt, len, &h, &pl), SC_ERR_DLINK_FIELD);
     /* a FRAME_BEGIN with a line index */
@@ -251,15 +262,18 @@ static void encoders_refuse_out_of_range_fields_and_small_buffers(void **state)
     assert_int_equal(sc_dlink_encode_line(buf, sizeof buf, &f, 0u, s, 200u), SC_ERR_DLINK_FIELD);
     f = k_frame;
     f.line_count = (uint16_t)(SC_MAX_SCAN_LINES + 1u);
-    const sc_dlink_begin ok_b = {40.0f, 38.0f, SC_DLINK_COMPRESSION_UNKNOWN};
+    const sc_dlink_begin ok_b = {40.0f, 38.0f, 0.0f, SC_DLINK_COMPRESSION_UNKNOWN};
     assert_int_equal(sc_dlink_encode_begin(buf, sizeof buf, &f, &ok_b), SC_ERR_DLINK_FIELD);
     f = k_frame;
-    sc_dlink_begin bad_b = {INFINITY, 38.0f, 0u};
+    sc_dlink_begin bad_b = {INFINITY, 38.0f, 0.0f, 0u};
     assert_int_equal(sc_dlink_encode_begin(buf, sizeof buf, &f, &bad_b), SC_ERR_NOT_FINITE);
     bad_b.depth_mm = 40.0f;
     bad_b.compression_pm = 1001u;
     assert_int_equal(sc_dlink_encode_begin(buf, sizeof buf, &f, &bad_b), SC_ERR_DLINK_FIELD);
-    assert_int_equal(sc_dlink_encode_begin(buf, 39u, &f, &ok_b), SC_ERR_NO_SPACE);
+    bad_b.compression_pm = 0u;
+    bad_b.radius_mm = -1.0f;
+    assert_int_equal(sc_dlink_encode_begin(buf, sizeof buf, &f, &bad_b), SC_ERR_DLINK_FIELD);
+    assert_int_equal(sc_dlink_encode_begin(buf, 43u, &f, &ok_b), SC_ERR_NO_SPACE);
     const sc_dlink_end bad_e = {100u, 29u};
     assert_int_equal(sc_dlink_encode_end(buf, sizeof buf, &f, &bad_e), SC_ERR_DLINK_FIELD);
 }
@@ -275,7 +289,7 @@ typedef struct sender {
 
 static int push_begin(sender *s)
 {
-    const sc_dlink_begin b = {40.0f, 38.0f, 500u};
+    const sc_dlink_begin b = {40.0f, 38.0f, 0.0f, 500u};
     int n = sc_dlink_encode_begin(s->buf, sizeof s->buf, &s->f, &b);
     assert_true(n > 0);
     return sc_dlink_asm_push(&g_asm, s->buf, (size_t)n);
