@@ -153,6 +153,13 @@ _Static_assert((1u << SC_SPRINGS_HASH_BITS) >= 2u * SC_MAX_SPRINGS,
 #ifndef SC_CAN_MAX_FILTERS
 #define SC_CAN_MAX_FILTERS 16u
 #endif
+/* Decoded CAN commands waiting for the engine (sc_tracker); more in one frame are dropped
+ * and counted. */
+#ifndef SC_CAN_CMD_QUEUE_MAX
+#define SC_CAN_CMD_QUEUE_MAX 8u
+#endif
+_Static_assert(SC_CAN_CMD_QUEUE_MAX >= 1u && SC_CAN_CMD_QUEUE_MAX <= 255u,
+               "command queue length must fit uint8_t");
 
 _Static_assert(SC_FRAME_RATE_DEFAULT_HZ >= SC_FRAME_RATE_MIN_HZ &&
                    SC_FRAME_RATE_DEFAULT_HZ <= SC_FRAME_RATE_MAX_HZ,

@@ -1,0 +1,469 @@
+/* sc_tracker.c: CAN receive side (E2E, pose assembly, plausibility, timeout), see sc_tracker.h. */
+#include "sc_tracker.h"
+
+#include <math.h>
+
+#include "sc_err.h"
+
+_Static_assert(SC_MSG_CMD_CASE == 0 && SC_MSG_POSE_FD == 7, "rx message indices 0..7");
+_Static_assert(SC_TRK_RX_MSGS == (unsigned)SC_MSG_POSE_FD + 1u, "rx state per message");
+
+sc_tracker_def sc_tracker_default_def(void)
+{
+    return (sc_tracker_def){
+        .ws_min_mm = {-400.0f, -400.0f, -100.0f},
+        .ws_max_mm = {400.0f, 400.0f, 500.0f},
+        .quat_norm_tol = 0.02f,
+        .max_speed_mm_s = 3000.0f,
+        .max_ang_speed_rad_s = 4.0f * 3.14159265f,
+        .max_force_n = 200.0f,
+        .pose_timeout_ms = 100u,
+        .pose_cycle_ms = 10u,
+        .max_delta_counter = 3u,
+        .accept_fd = 1u,
+    };
+}
+
+int sc_tracker_def_validate(const sc_tracker_def *d)
+{
+    for (unsigned i = 0; i < 3u; i++) {
+        if (!isfinite(d->ws_min_mm[i]) || !isfinite(d->ws_max_mm[i])) {
+            return SC_ERR_NOT_FINITE;
+        }
+        if (!(d->ws_min_mm[i] < d->ws_max_mm[i])) {
+            return SC_ERR_RANGE;
+        }
+    }
+    if (!isfinite(d->quat_norm_tol) || !isfinite(d->max_speed_mm_s) ||
+        !isfinite(d->max_ang_speed_rad_s) || !isfinite(d->max_force_n)) {
+        return SC_ERR_NOT_FINITE;
+    }
+    if (!(d->quat_norm_tol > 0.0f && d->quat_norm_tol < 0.5f) || !(d->max_speed_mm_s > 0.0f) ||
+        !(d->max_ang_speed_rad_s > 0.0f) || !(d->max_force_n > 0.0f)) {
+        return SC_ERR_RANGE;
+    }
+    if (d->pose_cycle_ms == 0u || d->pose_timeout_ms < d->pose_cycle_ms ||
+        d->max_delta_counter < 1u || d->max_delta_counter > SC_E2E_COUNTER_MOD - 2u) {
+        return SC_ERR_RANGE;
+    }
+    return 0;
+}
+
+const char *sc_trk_outcome_name(sc_trk_outcome o)
+{
+    switch (o) {
+    case SC_TRK_POSE_ACCEPTED:
+        return "pose_accepted";
+    case SC_TRK_POSE_PART:
+        return "pose_part";
+    case SC_TRK_COMMAND:
+        return "command";
+    case SC_TRK_NOT_OURS:
+        return "not_ours";
+    case SC_TRK_BAD_LENGTH:
+        return "bad_length";
+    case SC_TRK_FD_DISABLED:
+        return "fd_disabled";
+    case SC_TRK_E2E_WRONG_CRC:
+        return "e2e_wrong_crc";
+    case SC_TRK_E2E_WRONG_SEQUENCE:
+        return "e2e_wrong_sequence";
+    case SC_TRK_E2E_REPEATED:
+        return "e2e_repeated";
+    case SC_TRK_POSE_STALE:
+        return "pose_stale";
+    case SC_TRK_NOT_TRACKING:
+        return "not_tracking";
+    case SC_TRK_REJ_QUAT_NORM:
+        return "rej_quat_norm";
+    case SC_TRK_REJ_WORKSPACE:
+        return "rej_workspace";
+    case SC_TRK_REJ_FORCE:
+        return "rej_force";
+    case SC_TRK_REJ_SPEED:
+        return "rej_speed";
+    case SC_TRK_REJ_ANG_SPEED:
+        return "rej_ang_speed";
+    case SC_TRK_CMD_REJECTED:
+        return "cmd_rejected";
+    case SC_TRK_CMD_QUEUE_FULL:
+        return "cmd_queue_full";
+    case SC_TRK_BUS_ERROR:
+        return "bus_error";
+    case SC_TRK_OUTCOME_COUNT:
+        break;
+    }
+    return "?";
+}
+
+int sc_trk_outcome_is_e2e_reject(sc_trk_outcome o)
+{
+    return o == SC_TRK_E2E_WRONG_CRC || o == SC_TRK_E2E_WRONG_SEQUENCE ||
+           o == SC_TRK_E2E_REPEATED;
+}
+
+int sc_trk_outcome_is_implausible(sc_trk_outcome o)
+{
+    return o == SC_TRK_REJ_QUAT_NORM || o == SC_TRK_REJ_WORKSPACE || o == SC_TRK_REJ_FORCE ||
+           o == SC_TRK_REJ_SPEED || o == SC_TRK_REJ_ANG_SPEED;
+}
+
+static void inc(uint32_t *c)
+{
+    if (*c != UINT32_MAX) {
+        (*c)++;
+    }
+}
+
+int sc_tracker_init(sc_tracker *t, const sc_tracker_def *def)
+{
+    int rc = sc_tracker_def_validate(def);
+    if (rc != 0) {
+        return rc;
+    }
+    *t = (sc_tracker){.def = *def};
+    for (unsigned i = 0; i < SC_TRK_RX_MSGS; i++) {
+        const sc_can_msg_info *info = sc_canproto_info((sc_msg)i);
+        sc_e2e_rx_def rd = sc_e2e_rx_default_def(info->data_id);
+        rd.max_delta_counter = def->max_delta_counter;
+        rd.timeout_ms = info->cycle_ms != 0u ? def->pose_timeout_ms : 0u;
+        rc = sc_e2e_rx_init(&t->rx[i], &rd);
+        if (rc != 0) {
+            return rc;
+        }
+    }
+    sc_e2e_tx_init(&t->tx[0], sc_canproto_info(SC_MSG_STATUS)->data_id);
+    sc_e2e_tx_init(&t->tx[1], sc_canproto_info(SC_MSG_TIMING)->data_id);
+    sc_e2e_tx_init(&t->tx[2], sc_canproto_info(SC_MSG_DIAG)->data_id);
+    return 0;
+}
+
+static sc_trk_outcome e2e_outcome(sc_e2e_status s)
+{
+    switch (s) {
+    case SC_E2E_WRONG_SEQUENCE:
+        return SC_TRK_E2E_WRONG_SEQUENCE;
+    case SC_E2E_REPEATED:
+        return SC_TRK_E2E_REPEATED;
+    case SC_E2E_WRONG_CRC:
+    case SC_E2E_OK:
+    case SC_E2E_INITIAL:
+    case SC_E2E_OK_SOME_LOST:
+    case SC_E2E_NO_NEW_DATA:
+    case SC_E2E_TIMEOUT:
+    case SC_E2E_STATUS_COUNT:
+        break;
+    }
+    return SC_TRK_E2E_WRONG_CRC;
+}
+
+static void lift(sc_tracker *t)
+{
+    if (t->have_pose) {
+        t->have_pose = 0u;
+        inc(&t->n.lift_events);
+    }
+}
+
+/* Plausibility of an assembled sample against def and the last accepted pose. */
+static sc_trk_outcome judge(sc_tracker *t, const sc_pose_msg *m, uint64_t ts_ns)
+{
+    const sc_tracker_def *d = &t->def;
+    if (m->tracking != SC_TRACKING_OK) {
+        return SC_TRK_NOT_TRACKING;
+    }
+    const float n2 = sc_quat_norm2(m->q);
+    const float norm = sqrtf(n2);
+    if (!(fabsf(norm - 1.0f) <= d->quat_norm_tol)) {
+        return SC_TRK_REJ_QUAT_NORM;
+    }
+    for (unsigned i = 0; i < 3u; i++) {
+        if (!(m->pos_mm[i] >= d->ws_min_mm[i] && m->pos_mm[i] <= d->ws_max_mm[i])) {
+            return SC_TRK_REJ_WORKSPACE;
+        }
+    }
+    if (m->force_valid && !(m->force_n <= d->max_force_n)) {
+        return SC_TRK_REJ_FORCE;
+    }
+    if (t->have_pose) {
+        /* dt from receive times, floored at one pose period: frames queued behind each other
+         * arrive together but were sampled a period apart. */
+        const uint64_t cyc_ns = (uint64_t)d->pose_cycle_ms * 1000000u;
+        const uint64_t dt_ns = ts_ns > t->cur.rx_ns && ts_ns - t->cur.rx_ns > cyc_ns
+                                   ? ts_ns - t->cur.rx_ns
+                                   : cyc_ns;
+        const float dt_s = (float)dt_ns * 1e-9f;
+        float d2 = 0.0f;
+        for (unsigned i = 0; i < 3u; i++) {
+            const float dx = m->pos_mm[i] - t->cur.pose.pos_mm[i];
+            d2 += dx * dx;
+        }
+        if (sqrtf(d2) > d->max_speed_mm_s * dt_s) {
+            return SC_TRK_REJ_SPEED;
+        }
+        float dot = 0.0f;
+        for (unsigned i = 0; i < 4u; i++) {
+            dot += m->q[i] * t->cur.pose.q[i];
+        }
+        dot = fabsf(dot) / norm; /* cur.pose.q is unit already */
+        if (dot > 1.0f) {
+            dot = 1.0f;
+        }
+        const float angle_rad = 2.0f * acosf(dot);
+        if (angle_rad > d->max_ang_speed_rad_s * dt_s) {
+            return SC_TRK_REJ_ANG_SPEED;
+        }
+    }
+    return SC_TRK_POSE_ACCEPTED;
+}
+
+static sc_trk_outcome take_sample(sc_tracker *t, const sc_pose_msg *m, uint8_t counter,
+                                  uint64_t ts_ns)
+{
+    if (t->have_last_counter && t->have_pose) {
+        /* A sample at most max_delta_counter behind the last assembled one completed late
+         * (parts reordered across ids): older than the current pose, never used. A larger
+         * distance is a jump forward after losses. */
+        const unsigned delta =
+            (counter + SC_E2E_COUNTER_MOD - t->last_counter) % SC_E2E_COUNTER_MOD;
+        if (delta == 0u || delta >= SC_E2E_COUNTER_MOD - t->def.max_delta_counter) {
+            return SC_TRK_POSE_STALE;
+        }
+    }
+    t->have_last_counter = 1u;
+    t->last_counter = counter;
+    const sc_trk_outcome o = judge(t, m, ts_ns);
+    if (o != SC_TRK_POSE_ACCEPTED) {
+        return o;
+    }
+    const float inv = 1.0f / sqrtf(sc_quat_norm2(m->q));
+    sc_trk_sample s = {.force_n = m->force_n, .force_valid = m->force_valid,
+                       .counter = counter, .rx_ns = ts_ns};
+    for (unsigned i = 0; i < 3u; i++) {
+        s.pose.pos_mm[i] = m->pos_mm[i];
+    }
+    for (unsigned i = 0; i < 4u; i++) {
+        s.pose.q[i] = m->q[i] * inv;
+    }
+    t->cur = s;
+    t->have_pose = 1u;
+    return SC_TRK_POSE_ACCEPTED;
+}
+
+static sc_trk_outcome on_pose_part(sc_tracker *t, const sc_can_frame *f, uint8_t counter,
+                                   uint64_t ts_ns)
+{
+    /* find the slot of this sample, else a free one, else evict the oldest */
+    sc_trk_asm *a = NULL;
+    for (unsigned i = 0; i < SC_TRK_ASM_SLOTS; i++) {
+        if (t->slot[i].used && t->slot[i].counter == counter) {
+            a = &t->slot[i];
+        }
+    }
+    if (a == NULL) {
+        for (unsigned i = 0; i < SC_TRK_ASM_SLOTS && a == NULL; i++) {
+            if (!t->slot[i].used) {
+                a = &t->slot[i];
+            }
+        }
+    }
+    if (a == NULL) {
+        a = &t->slot[0];
+        for (unsigned i = 1; i < SC_TRK_ASM_SLOTS; i++) {
+            if (t->slot[i].seq < a->seq) {
+                a = &t->slot[i];
+            }
+        }
+        inc(&t->n.incomplete);
+        a->used = 0u;
+    }
+    if (!a->used) {
+        *a = (sc_trk_asm){.used = 1u, .counter = counter, .seq = t->slot_seq++};
+    }
+    const int part = sc_canproto_decode_pose_part(f, &a->msg);
+    if (part < 0) {
+        return SC_TRK_BAD_LENGTH; /* unreachable: classified before */
+    }
+    a->mask = (uint8_t)(a->mask | (uint8_t)part);
+    if (ts_ns > a->ts_ns) {
+        a->ts_ns = ts_ns;
+    }
+    if (a->mask != SC_POSE_PARTS_ALL) {
+        return SC_TRK_POSE_PART;
+    }
+    const sc_pose_msg m = a->msg;
+    const uint64_t ts = a->ts_ns;
+    a->used = 0u;
+    /* partial samples older than this one can never complete usefully: drop them */
+    for (unsigned i = 0; i < SC_TRK_ASM_SLOTS; i++) {
+        sc_trk_asm *o = &t->slot[i];
+        const unsigned behind = (counter + SC_E2E_COUNTER_MOD - o->counter) % SC_E2E_COUNTER_MOD;
+        if (o->used && behind >= 1u && behind <= SC_E2E_COUNTER_MOD / 2u) {
+            o->used = 0u;
+            inc(&t->n.incomplete);
+        }
+    }
+    return take_sample(t, &m, counter, ts);
+}
+
+static sc_trk_outcome on_command(sc_tracker *t, const sc_can_frame *f)
+{
+    sc_cmd c;
+    if (sc_canproto_decode_cmd(f, &c) != 0) {
+        return SC_TRK_CMD_REJECTED;
+    }
+    if (t->cmd_count >= SC_CAN_CMD_QUEUE_MAX) {
+        return SC_TRK_CMD_QUEUE_FULL;
+    }
+    t->cmd[(t->cmd_head + t->cmd_count) % SC_CAN_CMD_QUEUE_MAX] = c;
+    t->cmd_count++;
+    return SC_TRK_COMMAND;
+}
+
+static sc_trk_outcome classify_and_handle(sc_tracker *t, const sc_can_frame *f, uint64_t now_ns)
+{
+    if (f->flags & SC_CAN_FLAG_ERR) {
+        t->bus_errors |= f->id;
+        for (unsigned b = 0; b < 6u; b++) {
+            if (f->id & (1u << b)) {
+                inc(&t->n.bus_err_class[b]);
+            }
+        }
+        return SC_TRK_BUS_ERROR;
+    }
+    sc_msg m;
+    const int rc = sc_canproto_classify(f, &m);
+    if (rc == SC_ERR_CAN_ID || (rc == 0 && (unsigned)m >= SC_TRK_RX_MSGS)) {
+        return SC_TRK_NOT_OURS;
+    }
+    if (rc != 0) {
+        return SC_TRK_BAD_LENGTH;
+    }
+    if (m == SC_MSG_POSE_FD && !t->def.accept_fd) {
+        return SC_TRK_FD_DISABLED;
+    }
+    const uint64_t ts_ns = f->ts_ns != 0u ? f->ts_ns : now_ns;
+    sc_e2e_rx *rx = &t->rx[m];
+    const uint32_t lost_before = rx->lost;
+    const sc_e2e_status s = sc_e2e_check(rx, f->data, f->len, ts_ns);
+    t->n.e2e_lost += rx->lost - lost_before;
+    if (!sc_e2e_status_usable(s)) {
+        return e2e_outcome(s);
+    }
+    const uint8_t counter = (uint8_t)(f->data[1] & 0x0Fu);
+    switch (m) {
+    case SC_MSG_CMD_CASE:
+    case SC_MSG_CMD_METHOD:
+    case SC_MSG_CMD_IMAGING:
+    case SC_MSG_CMD_RESET:
+        return on_command(t, f);
+    case SC_MSG_POSE_POS:
+    case SC_MSG_POSE_QUAT:
+    case SC_MSG_POSE_AUX:
+        return on_pose_part(t, f, counter, ts_ns);
+    case SC_MSG_POSE_FD: {
+        sc_pose_msg pm = {0};
+        (void)sc_canproto_decode_pose_part(f, &pm);
+        return take_sample(t, &pm, counter, ts_ns);
+    }
+    case SC_MSG_STATUS:
+    case SC_MSG_TIMING:
+    case SC_MSG_DIAG:
+    case SC_MSG_COUNT:
+        break;
+    }
+    return SC_TRK_NOT_OURS;
+}
+
+sc_trk_outcome sc_tracker_on_frame(sc_tracker *t, const sc_can_frame *f, uint64_t now_ns)
+{
+    inc(&t->n.frames);
+    const sc_trk_outcome o = classify_and_handle(t, f, now_ns);
+    inc(&t->n.outcome[o]);
+    return o;
+}
+
+int sc_tracker_poll(sc_tracker *t, uint64_t now_ns, sc_pose *out, int *contact)
+{
+    for (unsigned i = 0; i < SC_TRK_RX_MSGS; i++) {
+        (void)sc_e2e_poll(&t->rx[i], now_ns);
+    }
+    if (t->have_pose) {
+        const uint64_t timeout_ns = (uint64_t)t->def.pose_timeout_ms * 1000000u;
+        if (now_ns > t->cur.rx_ns && now_ns - t->cur.rx_ns > timeout_ns) {
+            lift(t);
+        }
+    }
+    if (!t->have_pose) {
+        *contact = 0;
+        return SC_ERR_TIMEOUT;
+    }
+    *out = t->cur.pose;
+    *contact = 1;
+    return 0;
+}
+
+const sc_trk_sample *sc_tracker_sample(const sc_tracker *t)
+{
+    return t->have_pose ? &t->cur : NULL;
+}
+
+int sc_tracker_take_command(sc_tracker *t, sc_cmd *out)
+{
+    if (t->cmd_count == 0u) {
+        return SC_ERR_WOULD_BLOCK;
+    }
+    *out = t->cmd[t->cmd_head];
+    t->cmd_head = (uint8_t)((t->cmd_head + 1u) % SC_CAN_CMD_QUEUE_MAX);
+    t->cmd_count--;
+    return 0;
+}
+
+uint32_t sc_tracker_take_bus_errors(sc_tracker *t)
+{
+    const uint32_t e = t->bus_errors;
+    t->bus_errors = 0u;
+    return e;
+}
+
+const sc_trk_counters *sc_tracker_counters(const sc_tracker *t)
+{
+    return &t->n;
+}
+
+uint32_t sc_tracker_rejected_e2e(const sc_tracker *t)
+{
+    uint64_t s = 0;
+    for (unsigned i = 0; i < (unsigned)SC_TRK_OUTCOME_COUNT; i++) {
+        if (sc_trk_outcome_is_e2e_reject((sc_trk_outcome)i)) {
+            s += t->n.outcome[i];
+        }
+    }
+    return s > UINT32_MAX ? UINT32_MAX : (uint32_t)s;
+}
+
+uint32_t sc_tracker_rejected_implausible(const sc_tracker *t)
+{
+    uint64_t s = 0;
+    for (unsigned i = 0; i < (unsigned)SC_TRK_OUTCOME_COUNT; i++) {
+        if (sc_trk_outcome_is_implausible((sc_trk_outcome)i)) {
+            s += t->n.outcome[i];
+        }
+    }
+    return s > UINT32_MAX ? UINT32_MAX : (uint32_t)s;
+}
+
+const sc_e2e_rx *sc_tracker_e2e(const sc_tracker *t, sc_msg m)
+{
+    return (unsigned)m < SC_TRK_RX_MSGS ? &t->rx[m] : NULL;
+}
+
+int sc_tracker_encode_status(sc_tracker *t, sc_status_msg *s, sc_can_frame out[SC_STATUS_FRAMES])
+{
+    s->probe_lifted = (uint8_t)(t->have_pose ? 0u : 1u);
+    s->poses_accepted = t->n.outcome[SC_TRK_POSE_ACCEPTED];
+    s->rejected_e2e = sc_tracker_rejected_e2e(t);
+    s->rejected_plausibility = sc_tracker_rejected_implausible(t);
+    s->lift_events = t->n.lift_events;
+    return sc_canproto_encode_status(s, t->tx, out);
+}
