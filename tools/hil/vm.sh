@@ -7,7 +7,8 @@
 #                                      /payload/test.sh inside; exit with its status
 # Environment: SC_HIL_CACHE (kernel cache, default build/hil-cache), SC_HIL_TIMEOUT_S (300),
 #   SC_HIL_LOG (serial console log, default PAYLOAD_DIR/../vm-console.log),
-#   SC_HIL_QEMU_ARGS (extra qemu arguments, e.g. a monitor socket for screendumps).
+#   SC_HIL_MONITOR (a unix socket path for qemu's monitor, e.g. to take screendumps),
+#   SC_HIL_QEMU_ARGS (extra qemu arguments).
 # The VM runs under TCG (a KVM boot hung here); it powers itself off after the test, and the
 # host side greps the console for the result line, with a timeout.
 set -euo pipefail
@@ -99,13 +100,15 @@ INIT
     chmod +x "$tree/init"
     (cd "$tree" && find . | busybox cpio -o -H newc 2>/dev/null | gzip -1) > "$tree.cpio.gz"
     log=${SC_HIL_LOG:-$(dirname "$payload")/vm-console.log}
+    local monitor=(-monitor none)
+    [ -n "${SC_HIL_MONITOR:-}" ] && monitor=(-monitor "unix:$SC_HIL_MONITOR,server,nowait")
     local display_args=(-display none -vga none)
     [ -f "$payload/want-display" ] && display_args=(-display none -vga std)
     # shellcheck disable=SC2086
     timeout "$timeout_s" qemu-system-x86_64 -accel tcg -m 512 -nographic -no-reboot \
-        "${display_args[@]}" -serial stdio -monitor none \
+        "${display_args[@]}" -serial stdio "${monitor[@]}" \
         -kernel "$cache/vmlinuz" -initrd "$tree.cpio.gz" \
-        -append "console=ttyS0 quiet panic=-1 oops=panic" ${SC_HIL_QEMU_ARGS:-} \
+        -append "console=ttyS0 quiet panic=-1 oops=panic vt.global_cursor_default=0" ${SC_HIL_QEMU_ARGS:-} \
         < /dev/null > "$log" 2>&1 || true
     rm -f "$tree.cpio.gz"
     local rc

@@ -1,0 +1,101 @@
+/* sc_scanconv.c: B-scan scan conversion, see sc_scanconv.h. */
+#include "sc_scanconv.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+int sc_scanconv_init(sc_scanconv *c, uint32_t width, uint32_t height)
+{
+    memset(c, 0, sizeof(*c));
+    c->lut = malloc((size_t)width * height * sizeof(uint32_t));
+    if (!c->lut) {
+        return -1;
+    }
+    c->width = width;
+    c->height = height;
+    return 0;
+}
+
+void sc_scanconv_free(sc_scanconv *c)
+{
+    free(c->lut);
+    memset(c, 0, sizeof(*c));
+}
+
+static int same_geom(const sc_display_frame_info *a, const sc_display_frame_info *b)
+{
+    return a->lines == b->lines && a->samples == b->samples && a->geometry_id == b->geometry_id &&
+           memcmp(&a->depth_mm, &b->depth_mm, sizeof(float)) == 0 &&
+           memcmp(&a->width_mm, &b->width_mm, sizeof(float)) == 0;
+}
+
+static void build_linear(sc_scanconv *c, const sc_display_frame_info *g, uint32_t stride)
+{
+    const double w_mm = g->width_mm > 0.0f ? g->width_mm : 1.0;
+    const double d_mm = g->depth_mm > 0.0f ? g->depth_mm : 1.0;
+    /* mm per pixel: fit the whole image, keep the aspect */
+    const double s = fmax(w_mm / c->width, d_mm / c->height);
+    const double x0 = (c->width - w_mm / s) / 2.0;
+    for (uint32_t y = 0; y < c->height; y++) {
+        for (uint32_t x = 0; x < c->width; x++) {
+            const double xm = (x + 0.5 - x0) * s;
+            const double zm = (y + 0.5) * s;
+            uint32_t v = UINT32_MAX;
+            if (xm >= 0.0 && xm < w_mm && zm < d_mm) {
+                uint32_t l = (uint32_t)(xm / w_mm * g->lines);
+                uint32_t k = (uint32_t)(zm / d_mm * g->samples);
+                if (l < g->lines && k < g->samples) {
+                    v = l * stride + k;
+                }
+            }
+            c->lut[(size_t)y * c->width + x] = v;
+        }
+    }
+}
+
+static void build_sector(sc_scanconv *c, const sc_display_frame_info *g, uint32_t stride)
+{
+    const double d_mm = g->depth_mm > 0.0f ? g->depth_mm : 1.0;
+    const double half = (g->width_mm > 0.0f ? g->width_mm : 60.0) * M_PI / 360.0;
+    const double w_mm = 2.0 * d_mm * sin(half);
+    const double s = fmax(w_mm / c->width, d_mm / c->height);
+    const double cx = c->width / 2.0;
+    for (uint32_t y = 0; y < c->height; y++) {
+        for (uint32_t x = 0; x < c->width; x++) {
+            const double xm = (x + 0.5 - cx) * s;
+            const double zm = (y + 0.5) * s;
+            const double r = sqrt(xm * xm + zm * zm);
+            const double a = atan2(xm, zm);
+            uint32_t v = UINT32_MAX;
+            if (r < d_mm && a >= -half && a < half) {
+                uint32_t l = (uint32_t)((a + half) / (2.0 * half) * g->lines);
+                uint32_t k = (uint32_t)(r / d_mm * g->samples);
+                if (l < g->lines && k < g->samples) {
+                    v = l * stride + k;
+                }
+            }
+            c->lut[(size_t)y * c->width + x] = v;
+        }
+    }
+}
+
+void sc_scanconv_render(sc_scanconv *c, const sc_display_frame_info *info, const uint8_t *image,
+                        uint32_t stride, uint8_t *out)
+{
+    if (!c->valid || c->stride != stride || !same_geom(&c->geom, info)) {
+        if (info->geometry_id == 1u) {
+            build_sector(c, info, stride);
+        } else {
+            build_linear(c, info, stride);
+        }
+        c->geom = *info;
+        c->stride = stride;
+        c->valid = 1;
+    }
+    const size_t n = (size_t)c->width * c->height;
+    for (size_t i = 0; i < n; i++) {
+        const uint32_t v = c->lut[i];
+        out[i] = v == UINT32_MAX ? 0u : image[v];
+    }
+}

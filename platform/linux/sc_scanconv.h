@@ -1,0 +1,37 @@
+/*
+ * sc_scanconv.h: scan conversion of a B-scan (scan lines x samples, line-major) into a raster
+ * a screen or a PNG shows, preserving the image's physical aspect.
+ *
+ * Linear geometry: lines are columns across width_mm, samples are rows down depth_mm.
+ * Curvilinear: lines fan out over a sector of width_mm degrees from a virtual apex at the top
+ * centre; samples run along each line from the apex to depth_mm (the display link carries no
+ * radius of curvature, so the skin-line arc is drawn from the apex; close enough to read the
+ * image, and the same on every sink). Pixels outside the image are 0.
+ * A lookup table maps each output pixel to its source sample once per geometry, so a frame
+ * costs one table walk. The table is allocated by sc_scanconv_init (host code, at start-up).
+ */
+#ifndef SC_SCANCONV_H
+#define SC_SCANCONV_H
+
+#include <stdint.h>
+
+#include "sc_hal_display.h"
+
+typedef struct sc_scanconv {
+    uint32_t width, height;          /* output raster */
+    uint32_t *lut;                   /* width*height source indices, UINT32_MAX = outside */
+    sc_display_frame_info geom;      /* geometry the table was built for */
+    uint32_t stride;
+    int valid;
+} sc_scanconv;
+
+/* Allocates the table for a width x height raster. 0, or -1 when out of memory. */
+int sc_scanconv_init(sc_scanconv *c, uint32_t width, uint32_t height);
+void sc_scanconv_free(sc_scanconv *c);
+
+/* Renders image (line-major, row stride `stride` samples per line) of geometry info into
+ * out (width*height grey bytes, row-major). Rebuilds the table when the geometry changed. */
+void sc_scanconv_render(sc_scanconv *c, const sc_display_frame_info *info, const uint8_t *image,
+                        uint32_t stride, uint8_t *out);
+
+#endif /* SC_SCANCONV_H */
