@@ -58,6 +58,12 @@
 #ifndef SC_PHYS_DT_DEFAULT_S
 #define SC_PHYS_DT_DEFAULT_S 0.01f
 #endif
+/* FEM 3x3 blocks (sc_fem.h): in the 5-tet grid a node of odd i+j+k has at most 18 neighbours
+ * (6 axis + 12 face diagonals) plus itself: 19 blocks; an even node 7; at most (N + 1) / 2
+ * nodes are odd: 19 (N + 1) / 2 + 7 (N + 1) / 2 = 13 (N + 1). */
+#ifndef SC_MAX_FEM_NNZ_BLOCKS
+#define SC_MAX_FEM_NNZ_BLOCKS (13u * (SC_MAX_NODES + 1u))
+#endif
 /* MSDS springs (sc_springs.h, Algorithm 1): the 5-tet grid has one spring per grid edge
  * (3 per node) and one per grid face diagonal (3 per node): at most 6 N. */
 #ifndef SC_MAX_SPRINGS
@@ -76,6 +82,10 @@
 #endif
 #ifndef SC_MAX_SKIN_NODES
 #define SC_MAX_SKIN_NODES (SC_MAX_SKIN_NX * SC_MAX_SKIN_NY)
+#endif
+/* Probe contacts per body (sc_collider.h): at most one per node of the tet mesh or skin. */
+#ifndef SC_MAX_CONTACTS
+#define SC_MAX_CONTACTS (SC_MAX_NODES > SC_MAX_SKIN_NODES ? SC_MAX_NODES : SC_MAX_SKIN_NODES)
 #endif
 _Static_assert((1u << SC_SPRINGS_HASH_BITS) >= 2u * SC_MAX_SPRINGS,
                "spring hash table below twice the spring capacity");
@@ -167,6 +177,8 @@ _Static_assert(SC_FRAME_RATE_DEFAULT_HZ >= SC_FRAME_RATE_MIN_HZ &&
 _Static_assert(SC_MAX_MESH_NX >= 2u && SC_MAX_MESH_NY >= 2u && SC_MAX_MESH_NZ >= 2u,
                "a mesh needs at least 2 nodes per axis");
 _Static_assert(SC_MAX_NODES <= 65535u * 16u, "node indices must fit 32-bit arithmetic");
+_Static_assert(SC_MAX_FEM_NNZ_BLOCKS >= SC_MAX_NODES && SC_MAX_FEM_NNZ_BLOCKS <= 0x7fffffffu,
+               "FEM blocks: at least the diagonal, indices in 31 bits");
 _Static_assert(SC_HEALTH_MISS_DEGRADED <= SC_HEALTH_MISS_WINDOW, "miss threshold above window");
 _Static_assert(SC_HEALTH_MISS_WINDOW <= 64u, "miss window is a 64-bit mask");
 _Static_assert(SC_BSCAN_REGIONS_DEFAULT >= 1u && SC_BSCAN_REGIONS_DEFAULT <= SC_BSCAN_MAX_REGIONS,

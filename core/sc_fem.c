@@ -1,0 +1,643 @@
+/* sc_fem.c: linear / corotated FEM with a fixed block-CSR pattern and fixed-count PCG, see
+ * sc_fem.h.
+ *
+ * Element (linear tet, volume V, rest shape gradients n_a = grad N_a, a = 0..3):
+ *   strain  eps = sym(grad u) = sym(sum_b u_b n_b^T),  stress sigma = lambda tr(eps) I + 2 mu eps
+ *   force   f_a = -V sigma n_a
+ *   block   K_ab = V (lambda n_a n_b^T + mu n_b n_a^T + mu (n_a . n_b) I),  K_ba = K_ab^T
+ * Corotated: F = Ds Dm^-1, R = polar(F), eps = sym(R^T F) - I, f_a = -V R sigma n_a, and the
+ * blocks use g_a = R n_a in place of n_a (that is R K_ab R^T).
+ */
+#include "sc_fem.h"
+
+#include <math.h>
+#include <stddef.h>
+
+#include "sc_assert.h"
+#include "sc_err.h"
+
+/* Ordered vertex pairs of a tet: pairs 0..5 have a < b, pair p + 6 is pair p reversed, so
+ * block p + 6 is the transpose of block p. tet_blk[e][p] is the CSR index of (tet[a], tet[b]). */
+static const uint8_t k_pair_a[12] = {0u, 0u, 0u, 1u, 1u, 2u, 1u, 2u, 3u, 2u, 3u, 3u};
+static const uint8_t k_pair_b[12] = {1u, 2u, 3u, 2u, 3u, 3u, 0u, 0u, 0u, 1u, 1u, 2u};
+
+/* E in Pa -> N/mm^2; density kg/m^3 * mm^3 -> kg (1e-9) -> N s^2/mm (1e-3). */
+#define SC_FEM_PA_TO_NMM2 1.0e-6f
+#define SC_FEM_RHO_VOL_TO_MASS 1.0e-12f
+/* Newton iterations of the polar decomposition at most (quadratic convergence: a stretch of
+ * 3:1 converges to float precision in about 6 scaled iterations). */
+#define SC_FEM_POLAR_MAX_ITER 8u
+/* det F below this: the element is flat or inverted; polar factor undefined: use R = I. */
+#define SC_FEM_DET_MIN 1.0e-3f
+
+sc_fem_def sc_fem_default_def(void)
+{
+    sc_fem_def d;
+    d.rayleigh_beta_s = 0.1f; /* paper Algorithm 1: gamma = 0.1 k per spring */
+    d.rayleigh_alpha_per_s = 0.0f;
+    d.corotated = 0u;
+    return d;
+}
+
+int sc_fem_def_validate(const sc_fem_def *def)
+{
+    if (def == NULL || def->corotated > 1u) {
+        return SC_ERR_INVALID_ARG;
+    }
+    if (!isfinite(def->rayleigh_beta_s) || !isfinite(def->rayleigh_alpha_per_s)) {
+        return SC_ERR_NOT_FINITE;
+    }
+    if (def->rayleigh_beta_s < 0.0f || def->rayleigh_alpha_per_s < 0.0f ||
+        def->rayleigh_beta_s > 100.0f || def->rayleigh_alpha_per_s > 1.0e6f) {
+        return SC_ERR_RANGE;
+    }
+    return SC_OK;
+}
+
+/* ---- small dense helpers ------------------------------------------------------------------ */
+
+static float det9(const float x[9])
+{
+    return x[0] * (x[4] * x[8] - x[5] * x[7]) + x[1] * (x[5] * x[6] - x[3] * x[8]) +
+           x[2] * (x[3] * x[7] - x[4] * x[6]);
+}
+
+/* Rotation of the polar decomposition F = R S by scaled Newton iteration
+ * X <- (g X + X^-T / g) / 2, g = sqrt(|X^-1|_F / |X|_F) (Higham 1986). Returns 0 and R = I when
+ * det F <= SC_FEM_DET_MIN (flat or inverted element: no proper rotation). Bounded cost. */
+static int polar_rotation(const float F[9], float R[9])
+{
+    float x[9];
+    for (uint32_t i = 0; i < 9u; i++) {
+        x[i] = F[i];
+    }
+    if (!(det9(x) > SC_FEM_DET_MIN)) {
+        for (uint32_t i = 0; i < 9u; i++) {
+            R[i] = (i % 4u == 0u) ? 1.0f : 0.0f;
+        }
+        return 0;
+    }
+    for (uint32_t it = 0; it < SC_FEM_POLAR_MAX_ITER; it++) {
+        float c[9];
+        c[0] = x[4] * x[8] - x[5] * x[7];
+        c[1] = x[5] * x[6] - x[3] * x[8];
+        c[2] = x[3] * x[7] - x[4] * x[6];
+        c[3] = x[2] * x[7] - x[1] * x[8];
+        c[4] = x[0] * x[8] - x[2] * x[6];
+        c[5] = x[1] * x[6] - x[0] * x[7];
+        c[6] = x[1] * x[5] - x[2] * x[4];
+        c[7] = x[2] * x[3] - x[0] * x[5];
+        c[8] = x[0] * x[4] - x[1] * x[3];
+        const float det = x[0] * c[0] + x[1] * c[1] + x[2] * c[2];
+        float nx2 = 0.0f, nc2 = 0.0f;
+        for (uint32_t i = 0; i < 9u; i++) {
+            nx2 += x[i] * x[i];
+            nc2 += c[i] * c[i];
+        }
+        /* |X^-1|_F = |C|_F / det (det > 0 is kept by the iteration) */
+        const float g = sqrtf(sqrtf(nc2) / (det * sqrtf(nx2)));
+        const float a = 0.5f * g;
+        const float b = 0.5f / (g * det);
+        float diff2 = 0.0f;
+        for (uint32_t i = 0; i < 9u; i++) {
+            const float nv = a * x[i] + b * c[i];
+            const float d = nv - x[i];
+            diff2 += d * d;
+            x[i] = nv;
+        }
+        if (diff2 < 1.0e-11f) {
+            break;
+        }
+    }
+    for (uint32_t i = 0; i < 9u; i++) {
+        R[i] = x[i];
+    }
+    return 1;
+}
+
+/* Shape gradients of tet e (n[0] = -(n1 + n2 + n3)), 1/mm. */
+static void tet_grads(const float dmi[9], float n[4][3])
+{
+    for (uint32_t d = 0; d < 3u; d++) {
+        n[1][d] = dmi[d];
+        n[2][d] = dmi[3u + d];
+        n[3][d] = dmi[6u + d];
+        n[0][d] = -(n[1][d] + n[2][d] + n[3][d]);
+    }
+}
+
+/* Add the element blocks built from gradients g (rest or rotated) into the matrix. */
+static void add_tet_blocks(sc_fem *f, const uint32_t tet[4], const uint32_t blk_idx[12],
+                           const float g[4][3], float lam_v, float mu_v)
+{
+    for (uint32_t a = 0; a < 4u; a++) {
+        float *B = f->blk[f->diag_blk[tet[a]]];
+        const float dd = mu_v * (g[a][0] * g[a][0] + g[a][1] * g[a][1] + g[a][2] * g[a][2]);
+        const float lm = lam_v + mu_v;
+        for (uint32_t r = 0; r < 3u; r++) {
+            B[4u * r] += lm * g[a][r] * g[a][r] + dd;
+            for (uint32_t c = r + 1u; c < 3u; c++) {
+                const float v = lm * g[a][r] * g[a][c]; /* mirrored: exactly symmetric */
+                B[3u * r + c] += v;
+                B[3u * c + r] += v;
+            }
+        }
+    }
+    for (uint32_t p = 0; p < 6u; p++) {
+        const uint32_t a = k_pair_a[p], b = k_pair_b[p];
+        const float dd = mu_v * (g[a][0] * g[b][0] + g[a][1] * g[b][1] + g[a][2] * g[b][2]);
+        float kab[9];
+        for (uint32_t r = 0; r < 3u; r++) {
+            for (uint32_t c = 0; c < 3u; c++) {
+                kab[3u * r + c] = lam_v * g[a][r] * g[b][c] + mu_v * g[b][r] * g[a][c];
+            }
+            kab[4u * r] += dd;
+        }
+        float *Bab = f->blk[blk_idx[p]];
+        float *Bba = f->blk[blk_idx[p + 6u]];
+        for (uint32_t r = 0; r < 3u; r++) {
+            for (uint32_t c = 0; c < 3u; c++) {
+                Bab[3u * r + c] += kab[3u * r + c];
+                Bba[3u * c + r] += kab[3u * r + c];
+            }
+        }
+    }
+}
+
+static void zero_floats(float *p, uint32_t count)
+{
+    for (uint32_t i = 0; i < count; i++) {
+        p[i] = 0.0f;
+    }
+}
+
+/* Rest stiffness K (R = I). O(T). */
+static void assemble_rest(sc_fem *f, const sc_mesh *m)
+{
+    zero_floats(&f->blk[0][0], 9u * f->nnz_blocks);
+    for (uint32_t e = 0; e < f->tet_count; e++) {
+        float n[4][3];
+        tet_grads(f->dm_inv[e], n);
+        const uint8_t lab = m->tet_label[e];
+        add_tet_blocks(f, m->tet[e], f->tet_blk[e], n, f->lambda_nmm2[lab] * f->vol_mm3[e],
+                       f->mu_nmm2[lab] * f->vol_mm3[e]);
+    }
+    f->matrix_is_rest = 1u;
+}
+
+/* Corotated: warped K into blk and the elastic force -f_int into fel (3N). O(T). */
+static void assemble_corotated(sc_fem *f, const sc_mesh *m, float *restrict fel)
+{
+    zero_floats(&f->blk[0][0], 9u * f->nnz_blocks);
+    zero_floats(fel, 3u * f->node_count);
+    uint32_t degenerate = 0;
+    const float *x3 = f->x3;
+    for (uint32_t e = 0; e < f->tet_count; e++) {
+        const uint32_t *t = m->tet[e];
+        const float *dmi = f->dm_inv[e];
+        const float *p0 = &x3[3u * t[0]];
+        float ds[3][3]; /* ds[k] = x_{k+1} - x_0 (columns of Ds) */
+        for (uint32_t k = 0; k < 3u; k++) {
+            const float *pk = &x3[3u * t[k + 1u]];
+            for (uint32_t d = 0; d < 3u; d++) {
+                ds[k][d] = pk[d] - p0[d];
+            }
+        }
+        float F[9];
+        for (uint32_t r = 0; r < 3u; r++) {
+            for (uint32_t c = 0; c < 3u; c++) {
+                F[3u * r + c] = ds[0][r] * dmi[c] + ds[1][r] * dmi[3u + c] + ds[2][r] * dmi[6u + c];
+            }
+        }
+        float R[9];
+        if (!polar_rotation(F, R)) {
+            degenerate++;
+        }
+        /* S = R^T F, eps = sym(S) - I */
+        float S[9];
+        for (uint32_t r = 0; r < 3u; r++) {
+            for (uint32_t c = 0; c < 3u; c++) {
+                S[3u * r + c] = R[r] * F[c] + R[3u + r] * F[3u + c] + R[6u + r] * F[6u + c];
+            }
+        }
+        const uint8_t lab = m->tet_label[e];
+        const float vol = f->vol_mm3[e];
+        const float lam = f->lambda_nmm2[lab], mu = f->mu_nmm2[lab];
+        const float tr = S[0] + S[4] + S[8] - 3.0f;
+        float sig[9];
+        for (uint32_t r = 0; r < 3u; r++) {
+            for (uint32_t c = 0; c < 3u; c++) {
+                sig[3u * r + c] = mu * (S[3u * r + c] + S[3u * c + r]);
+            }
+            sig[4u * r] += lam * tr - 2.0f * mu;
+        }
+        float n[4][3], g[4][3];
+        tet_grads(dmi, n);
+        for (uint32_t a = 0; a < 4u; a++) {
+            float s[3];
+            for (uint32_t r = 0; r < 3u; r++) {
+                s[r] = sig[3u * r] * n[a][0] + sig[3u * r + 1u] * n[a][1] + sig[3u * r + 2u] * n[a][2];
+            }
+            float *fa = &fel[3u * t[a]];
+            for (uint32_t r = 0; r < 3u; r++) {
+                fa[r] -= vol * (R[3u * r] * s[0] + R[3u * r + 1u] * s[1] + R[3u * r + 2u] * s[2]);
+                g[a][r] = R[3u * r] * n[a][0] + R[3u * r + 1u] * n[a][1] + R[3u * r + 2u] * n[a][2];
+            }
+        }
+        add_tet_blocks(f, t, f->tet_blk[e], g, lam * vol, mu * vol);
+    }
+    f->stats.degenerate_tets = degenerate;
+    f->matrix_is_rest = 0u;
+}
+
+/* q = cm M p + ck K p over the block CSR. O(B). */
+static void matvec(const sc_fem *f, const float *restrict p, float *restrict q, float cm, float ck)
+{
+    const uint32_t nn = f->node_count;
+    const uint32_t *rs = f->row_start;
+    const uint32_t *col = f->col;
+    for (uint32_t i = 0; i < nn; i++) {
+        float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
+        const uint32_t end = rs[i + 1u];
+        for (uint32_t b = rs[i]; b < end; b++) {
+            const float *B = f->blk[b];
+            const float *pc = &p[3u * col[b]];
+            const float px = pc[0], py = pc[1], pz = pc[2];
+            s0 += B[0] * px + B[1] * py + B[2] * pz;
+            s1 += B[3] * px + B[4] * py + B[5] * pz;
+            s2 += B[6] * px + B[7] * py + B[8] * pz;
+        }
+        const float mi = cm * f->mass[i];
+        q[3u * i] = mi * p[3u * i] + ck * s0;
+        q[3u * i + 1u] = mi * p[3u * i + 1u] + ck * s1;
+        q[3u * i + 2u] = mi * p[3u * i + 2u] + ck * s2;
+    }
+}
+
+/* Dot product with 8 partial sums in a fixed order (deterministic, vectorisable). */
+static float dot(const float *restrict a, const float *restrict b, uint32_t count)
+{
+    float s[8] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+    uint32_t i = 0;
+    for (; i + 8u <= count; i += 8u) {
+        for (uint32_t k = 0; k < 8u; k++) {
+            s[k] += a[i + k] * b[i + k];
+        }
+    }
+    for (; i < count; i++) {
+        s[0] += a[i] * b[i];
+    }
+    return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
+}
+
+/* Column code of the 27-stencil: (di + 1) + 3 (dj + 1) + 9 (dk + 1); -1 when not neighbours. */
+static int32_t stencil_code(const sc_mesh *m, uint32_t a, uint32_t b)
+{
+    const int32_t ai = (int32_t)(a % m->nx), aj = (int32_t)((a / m->nx) % m->ny),
+                  ak = (int32_t)(a / (m->nx * m->ny));
+    const int32_t bi = (int32_t)(b % m->nx), bj = (int32_t)((b / m->nx) % m->ny),
+                  bk = (int32_t)(b / (m->nx * m->ny));
+    const int32_t di = bi - ai, dj = bj - aj, dk = bk - ak;
+    if (di < -1 || di > 1 || dj < -1 || dj > 1 || dk < -1 || dk > 1) {
+        return -1;
+    }
+    return (di + 1) + 3 * (dj + 1) + 9 * (dk + 1);
+}
+
+/* CSR index of block (a, b), or UINT32_MAX. O(log 27). */
+static uint32_t find_block(const sc_fem *f, uint32_t a, uint32_t b)
+{
+    uint32_t lo = f->row_start[a], hi = f->row_start[a + 1u];
+    while (lo < hi) {
+        const uint32_t mid = lo + (hi - lo) / 2u;
+        if (f->col[mid] < b) {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    return (lo < f->row_start[a + 1u] && f->col[lo] == b) ? lo : UINT32_MAX;
+}
+
+#ifdef SC_ENABLE_VALIDATE
+/* Expensive invariant: K is symmetric (block (i,j) = block (j,i)^T), exactly. */
+static int matrix_is_symmetric(const sc_fem *f)
+{
+    for (uint32_t i = 0; i < f->node_count; i++) {
+        for (uint32_t b = f->row_start[i]; b < f->row_start[i + 1u]; b++) {
+            const uint32_t t = find_block(f, f->col[b], i);
+            if (t == UINT32_MAX) {
+                return 0;
+            }
+            for (uint32_t r = 0; r < 3u; r++) {
+                for (uint32_t c = 0; c < 3u; c++) {
+                    /* assembled from identical products in the same order: bitwise */
+                    const float u = f->blk[b][3u * r + c], w = f->blk[t][3u * c + r];
+                    if (u < w || u > w) {
+                        return 0;
+                    }
+                }
+            }
+        }
+    }
+    return 1;
+}
+#endif
+
+int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat,
+                const sc_fem_def *def)
+{
+    if (f == NULL || m == NULL || mat == NULL || def == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    int rc = sc_fem_def_validate(def);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    rc = sc_material_table_validate(mat);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    const uint32_t mat_count = mat->count;
+    if (m->node_count == 0u || m->node_count > SC_MAX_NODES || m->tet_count == 0u ||
+        m->tet_count > SC_MAX_TETS || m->nx == 0u || m->ny == 0u ||
+        m->nx * m->ny * m->nz != m->node_count) {
+        return SC_ERR_INVALID_ARG;
+    }
+    for (uint32_t l = 0; l < mat_count; l++) {
+        const sc_material *q = &mat->row[l];
+        const float e = q->e_pa * SC_FEM_PA_TO_NMM2;
+        const float nu = q->poisson;
+        f->lambda_nmm2[l] = e * nu / ((1.0f + nu) * (1.0f - 2.0f * nu));
+        f->mu_nmm2[l] = e / (2.0f * (1.0f + nu));
+    }
+    for (uint32_t l = mat_count; l < SC_MAX_LABELS; l++) {
+        f->lambda_nmm2[l] = 0.0f;
+        f->mu_nmm2[l] = 0.0f;
+    }
+    const uint32_t nn = m->node_count;
+    const uint32_t nt = m->tet_count;
+    for (uint32_t e = 0; e < nt; e++) {
+        if (m->tet_label[e] >= mat_count) {
+            return SC_ERR_CASE_LABEL;
+        }
+        for (uint32_t v = 0; v < 4u; v++) {
+            if (m->tet[e][v] >= nn) {
+                return SC_ERR_INVALID_ARG;
+            }
+        }
+    }
+    f->def = *def;
+    f->node_count = nn;
+    f->tet_count = nt;
+    f->unstable = 0u;
+    f->stats.cg_iterations_run = 0u;
+    f->stats.residual_ratio = 0.0f;
+    f->stats.degenerate_tets = 0u;
+    f->stats.unstable_steps = 0u;
+
+    /* Pattern: a 27-bit stencil mask per node, kept in diag_blk until the rows are built. */
+    for (uint32_t i = 0; i < nn; i++) {
+        f->diag_blk[i] = 1u << 13; /* self */
+        f->node_used[i] = 0u;
+    }
+    for (uint32_t e = 0; e < nt; e++) {
+        const uint32_t *t = m->tet[e];
+        for (uint32_t p = 0; p < 12u; p++) {
+            const int32_t code = stencil_code(m, t[k_pair_a[p]], t[k_pair_b[p]]);
+            if (code < 0 || code == 13) {
+                return SC_ERR_FEM_PATTERN;
+            }
+            f->diag_blk[t[k_pair_a[p]]] |= 1u << (uint32_t)code;
+        }
+        for (uint32_t v = 0; v < 4u; v++) {
+            f->node_used[t[v]] = 1u;
+        }
+    }
+    uint32_t nnz = 0;
+    const int32_t sx = 1, sy = (int32_t)m->nx, sz = (int32_t)(m->nx * m->ny);
+    for (uint32_t i = 0; i < nn; i++) {
+        const uint32_t mask = f->diag_blk[i];
+        f->row_start[i] = nnz;
+        uint32_t prev = 0;
+        for (uint32_t code = 0; code < 27u; code++) {
+            if ((mask & (1u << code)) == 0u) {
+                continue;
+            }
+            if (nnz >= SC_MAX_FEM_NNZ_BLOCKS) {
+                return SC_ERR_FEM_PATTERN;
+            }
+            const int32_t di = (int32_t)(code % 3u) - 1, dj = (int32_t)((code / 3u) % 3u) - 1,
+                          dk = (int32_t)(code / 9u) - 1;
+            const uint32_t c = (uint32_t)((int32_t)i + di * sx + dj * sy + dk * sz);
+            /* stencil order is column order for grid neighbours; checked */
+            if (nnz > f->row_start[i] && c <= prev) {
+                return SC_ERR_FEM_PATTERN;
+            }
+            prev = c;
+            f->col[nnz] = c;
+            if (code == 13u) {
+                f->diag_blk[i] = nnz;
+            }
+            nnz++;
+        }
+    }
+    f->row_start[nn] = nnz;
+    f->nnz_blocks = nnz;
+
+    /* Per-tet rest data, block indices and lumped masses. */
+    for (uint32_t i = 0; i < nn; i++) {
+        f->mass[i] = 0.0f;
+        f->rest3[3u * i] = m->rest_x[i];
+        f->rest3[3u * i + 1u] = m->rest_y[i];
+        f->rest3[3u * i + 2u] = m->rest_z[i];
+    }
+    for (uint32_t e = 0; e < nt; e++) {
+        const uint32_t *t = m->tet[e];
+        float ed[3][3];
+        for (uint32_t k = 0; k < 3u; k++) {
+            ed[k][0] = m->rest_x[t[k + 1u]] - m->rest_x[t[0]];
+            ed[k][1] = m->rest_y[t[k + 1u]] - m->rest_y[t[0]];
+            ed[k][2] = m->rest_z[t[k + 1u]] - m->rest_z[t[0]];
+        }
+        /* rows of Dm^-1 (Dm = [e1 e2 e3]): (e2 x e3, e3 x e1, e1 x e2) / det */
+        float cr[3][3];
+        for (uint32_t k = 0; k < 3u; k++) {
+            const float *u = ed[(k + 1u) % 3u], *w = ed[(k + 2u) % 3u];
+            cr[k][0] = u[1] * w[2] - u[2] * w[1];
+            cr[k][1] = u[2] * w[0] - u[0] * w[2];
+            cr[k][2] = u[0] * w[1] - u[1] * w[0];
+        }
+        const float det = ed[0][0] * cr[0][0] + ed[0][1] * cr[0][1] + ed[0][2] * cr[0][2];
+        if (!(det > 0.0f) || !isfinite(det)) {
+            return SC_ERR_MESH_ORIENTATION;
+        }
+        for (uint32_t k = 0; k < 3u; k++) {
+            for (uint32_t d = 0; d < 3u; d++) {
+                f->dm_inv[e][3u * k + d] = cr[k][d] / det;
+            }
+        }
+        f->vol_mm3[e] = det / 6.0f;
+        for (uint32_t p = 0; p < 12u; p++) {
+            const uint32_t bi = find_block(f, t[k_pair_a[p]], t[k_pair_b[p]]);
+            SC_ASSERT(bi != UINT32_MAX); /* every tet edge is in the pattern by construction */
+            f->tet_blk[e][p] = bi;
+        }
+        const float mq = mat->row[m->tet_label[e]].density_kg_m3 * f->vol_mm3[e] *
+                         SC_FEM_RHO_VOL_TO_MASS * 0.25f;
+        for (uint32_t v = 0; v < 4u; v++) {
+            f->mass[t[v]] += mq;
+        }
+    }
+    assemble_rest(f, m);
+    SC_VALIDATE(matrix_is_symmetric(f));
+    return SC_OK;
+}
+
+void sc_fem_set_corotated(sc_fem *f, int on)
+{
+    SC_ASSERT(f != NULL);
+    f->def.corotated = on ? 1u : 0u;
+}
+
+int sc_fem_status(const sc_fem *f)
+{
+    SC_ASSERT(f != NULL);
+    return f->unstable ? SC_ERR_PHYS_UNSTABLE : SC_OK;
+}
+
+void sc_fem_step(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s, uint32_t cg_iterations)
+{
+    sc_fem_step_kinematic(f, m, n, dt_s, cg_iterations, NULL);
+}
+
+void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
+                           uint32_t cg_iterations, const uint8_t *kinematic)
+{
+    SC_ASSERT(f != NULL && m != NULL && n != NULL);
+    SC_ASSERT(f->node_count == m->node_count && f->tet_count == m->tet_count);
+    SC_ASSERT(isfinite(dt_s) && dt_s > 0.0f);
+    SC_ASSERT(cg_iterations <= SC_PHYS_ITERATIONS_MAX);
+    const uint32_t nn = f->node_count;
+    const uint32_t n3 = 3u * nn;
+    float *restrict x3 = f->x3;
+    float *restrict v3 = f->v3;
+    float *restrict r3 = f->r3;
+    float *restrict z3 = f->z3;
+    float *restrict p3 = f->p3;
+    float *restrict q3 = f->q3;
+    float *restrict inv = f->inv_diag3;
+    const float *restrict rest3 = f->rest3;
+    const float *restrict mass = f->mass;
+
+    /* Gather the shared SoA state; Dirichlet DOFs: fixed (v = 0) and kinematic (v given). */
+    for (uint32_t i = 0; i < nn; i++) {
+        uint8_t con = 0u;
+        if (m->node_fixed[i] != 0u || f->node_used[i] == 0u) {
+            con = 1u;
+        } else if (kinematic != NULL && kinematic[i] != 0u) {
+            con = 2u;
+        }
+        f->constrained[i] = con;
+        x3[3u * i] = n->x[i];
+        x3[3u * i + 1u] = n->y[i];
+        x3[3u * i + 2u] = n->z[i];
+        const float keep = (con == 1u) ? 0.0f : 1.0f;
+        v3[3u * i] = keep * n->vx[i];
+        v3[3u * i + 1u] = keep * n->vy[i];
+        v3[3u * i + 2u] = keep * n->vz[i];
+    }
+
+    const float cm = 1.0f + dt_s * f->def.rayleigh_alpha_per_s;
+    const float ck = dt_s * f->def.rayleigh_beta_s + dt_s * dt_s;
+    const float dta = dt_s * f->def.rayleigh_alpha_per_s;
+
+    /* r0 = b - A v0 with b = M v + dt (f_ext - f_int(x)) and v0 = v (warm start):
+     *   r0 = dt f_ext - dt alpha M v0 - dt f_int(x) - ck K v0. */
+    if (f->def.corotated != 0u) {
+        assemble_corotated(f, m, z3); /* z3 = -f_int */
+        matvec(f, v3, q3, 0.0f, 1.0f);
+        for (uint32_t i = 0; i < nn; i++) {
+            for (uint32_t d = 0; d < 3u; d++) {
+                const uint32_t k = 3u * i + d;
+                const float fe = (d == 0u) ? n->fx[i] : (d == 1u) ? n->fy[i] : n->fz[i];
+                r3[k] = dt_s * (fe + z3[k]) - dta * mass[i] * v3[k] - ck * q3[k];
+            }
+        }
+    } else {
+        if (f->matrix_is_rest == 0u) {
+            assemble_rest(f, m);
+        }
+        f->stats.degenerate_tets = 0u;
+        /* K (x - X) dt + ck K v0 = K (dt (x - X) + ck v0): one mat-vec */
+        for (uint32_t k = 0; k < n3; k++) {
+            p3[k] = dt_s * (x3[k] - rest3[k]) + ck * v3[k];
+        }
+        matvec(f, p3, q3, 0.0f, 1.0f);
+        for (uint32_t i = 0; i < nn; i++) {
+            r3[3u * i] = dt_s * n->fx[i] - dta * mass[i] * v3[3u * i] - q3[3u * i];
+            r3[3u * i + 1u] = dt_s * n->fy[i] - dta * mass[i] * v3[3u * i + 1u] - q3[3u * i + 1u];
+            r3[3u * i + 2u] = dt_s * n->fz[i] - dta * mass[i] * v3[3u * i + 2u] - q3[3u * i + 2u];
+        }
+    }
+
+    /* Jacobi preconditioner, zero on Dirichlet DOFs (projects the CG onto the free DOFs). */
+    for (uint32_t i = 0; i < nn; i++) {
+        const float *D = f->blk[f->diag_blk[i]];
+        for (uint32_t d = 0; d < 3u; d++) {
+            const float a = cm * mass[i] + ck * D[4u * d];
+            inv[3u * i + d] = (f->constrained[i] == 0u && a > 0.0f) ? 1.0f / a : 0.0f;
+        }
+    }
+
+    for (uint32_t k = 0; k < n3; k++) {
+        z3[k] = inv[k] * r3[k];
+        p3[k] = z3[k];
+    }
+    float rz = dot(r3, z3, n3);
+    const float rz0 = rz;
+    uint32_t it = 0;
+    for (; it < cg_iterations; it++) {
+        if (!(rz > 0.0f)) {
+            break; /* exactly converged (or no free DOF) */
+        }
+        matvec(f, p3, q3, cm, ck);
+        const float pq = dot(p3, q3, n3);
+        if (!(pq > 0.0f)) {
+            break;
+        }
+        const float alpha = rz / pq;
+        for (uint32_t k = 0; k < n3; k++) {
+            v3[k] += alpha * p3[k];
+            r3[k] -= alpha * q3[k];
+            z3[k] = inv[k] * r3[k];
+        }
+        const float rz_new = dot(r3, z3, n3);
+        const float beta = rz_new / rz;
+        for (uint32_t k = 0; k < n3; k++) {
+            p3[k] = z3[k] + beta * p3[k];
+        }
+        rz = rz_new;
+    }
+    f->stats.cg_iterations_run = it;
+    f->stats.residual_ratio = (rz0 > 0.0f && rz >= 0.0f) ? sqrtf(rz / rz0) : 0.0f;
+
+    /* Refuse a non-finite solution: the shared state stays as it was. */
+    float vsum = 0.0f;
+    for (uint32_t k = 0; k < n3; k++) {
+        vsum += v3[k] * v3[k];
+    }
+    if (!isfinite(vsum)) {
+        f->unstable = 1u;
+        f->stats.unstable_steps++;
+        return;
+    }
+    for (uint32_t i = 0; i < nn; i++) {
+        n->vx[i] = v3[3u * i];
+        n->vy[i] = v3[3u * i + 1u];
+        n->vz[i] = v3[3u * i + 2u];
+        n->x[i] = x3[3u * i] + dt_s * v3[3u * i];
+        n->y[i] = x3[3u * i + 1u] + dt_s * v3[3u * i + 1u];
+        n->z[i] = x3[3u * i + 2u] + dt_s * v3[3u * i + 2u];
+    }
+}

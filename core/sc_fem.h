@@ -1,0 +1,156 @@
+/*
+ * sc_fem.h: finite-element soft tissue: isotropic linear elasticity with Cauchy strain on the
+ * linear tets of sc_mesh, optionally corotated (stiffness warping), integrated with a linearly
+ * implicit backward Euler step solved by a fixed number of warm-started Jacobi-preconditioned
+ * conjugate-gradient iterations (paper section III / VI: OpenTissue's FEM, 20 CG iterations,
+ * 0.01 s step).
+ *
+ * Model (units: mm, N, s; E in Pa is converted to N/mm^2 = 1e-6 Pa at init):
+ *   M a + C v + f_int(x) = f_ext,   C = alpha M + beta K  (Rayleigh damping)
+ *   linear:     f_int = K (x - X)                          (K: rest stiffness, assembled once)
+ *   corotated:  f_int = sum_e R_e K_e (R_e^T x_e - X_e)     (R_e: polar factor of the element's
+ *               deformation gradient F = Ds Dm^-1, K_e warped to R_e K_e R_e^T every step)
+ * One step of length dt solves for the new velocity v+ (backward Euler linearised at x):
+ *   (M + dt C + dt^2 K) v+ = M v + dt (f_ext - f_int(x)),   x+ = x + dt v+.
+ * M is the lumped mass (density x volume / 4 per tet corner).
+ *
+ * Why this design (the brief asks for an over-damped response comparable to the MSDS):
+ * - The MSDS of the paper (Algorithm 1) gives every spring a damper gamma = 0.1 k: damping
+ *   proportional to stiffness. Rayleigh damping with beta = 0.1 s (default) is the same law in
+ *   FEM form, so every elastic mode relaxes with a time constant of about beta = 0.1 s whatever
+ *   its stiffness (tissue masses are tiny: the modes are over-damped above 2/beta = 20 rad/s,
+ *   and the lowest mode of a 30 mm block of 1 kPa tissue is ~50 rad/s).
+ * - Backward Euler is unconditionally stable, so the step may be the frame period; an
+ *   unconverged CG (fixed count) only slows the relaxation, it cannot blow it up. Warm start:
+ *   the CG starts from the current velocity, which is the solution of the previous frame, so
+ *   convergence accumulates over frames (paper: "quasi-static ... CG").
+ * - Solving for v+ keeps the whole state in sc_nodes (x, v): the FEM has no hidden state
+ *   besides its matrix, so switching MSDS <-> FEM at run time keeps the shape and velocity and
+ *   needs no reallocation; toggling corotation is equally seamless.
+ * - Fixed nodes (mesh node_fixed) and caller-driven kinematic nodes are Dirichlet DOFs: the
+ *   preconditioner is zero on them, which projects the CG onto the free DOFs (their velocity
+ *   stays the prescribed one: 0 for fixed nodes).
+ * - Storage: 3x3 block CSR over nodes (row = node, one block per mesh edge plus the diagonal;
+ *   a node has at most 19 neighbours in the 5-tet grid, 13 on average), full (both
+ *   triangles) so that the mat-vec is one straight pass with no scatter. Vectors inside the
+ *   solver are interleaved xyz float32 so that a block's gather of p is one cache line.
+ *   Per-tet rest data (Dm^-1, volume, 12 block indices) lets the corotated step re-assemble
+ *   the warped matrix in place without any search.
+ *
+ * Memory (float32, uint32; N = SC_MAX_NODES, T = SC_MAX_TETS, B = SC_MAX_FEM_NNZ_BLOCKS):
+ *   blocks 36 B + column 4 B per block       = 40 B  (B = 13 (N + 1): 4.26 MB at 32x16x16)
+ *   per node: rows/diag/mass 12 B + 8 solver vectors of 3 floats 96 B + flags 2 B = 110 B
+ *                                                                      (0.90 MB at 8,192)
+ *   per tet: Dm^-1 + volume 40 B + 12 block indices 48 B = 88 B      (3.07 MB at 34,875)
+ *   total about 8.2 MB at the default limits; sizeof(sc_fem) is printed by the benchmark.
+ *   The MCU build shrinks the limits (all arrays scale with them).
+ *
+ * Thread rules: one writer; an sc_fem is used by one thread. Never allocates, never calls the
+ * OS or stdio. Deterministic: fixed loop orders and fixed iteration counts give bit-identical
+ * results for the same inputs on the same build.
+ */
+#ifndef SC_FEM_H
+#define SC_FEM_H
+
+#include <stdint.h>
+
+#include "sc_config.h"
+#include "sc_material.h"
+#include "sc_mesh.h"
+
+typedef struct sc_fem_def {
+    float rayleigh_beta_s;      /* stiffness-proportional damping, >= 0 (MSDS: gamma = 0.1 k) */
+    float rayleigh_alpha_per_s; /* mass-proportional damping, >= 0 */
+    uint8_t corotated;          /* 1: stiffness warping for large rotations; 0: linear */
+} sc_fem_def;
+
+/* Diagnostics of the last step, for tests, benchmarks and health reporting. */
+typedef struct sc_fem_stats {
+    uint32_t cg_iterations_run;  /* <= the requested count (stops early only on an exact 0) */
+    float residual_ratio;        /* sqrt(r.z) after / before the CG of the last step */
+    uint32_t degenerate_tets;    /* corotated: tets whose F had det <= 0 (linear fallback) */
+    uint32_t unstable_steps;     /* steps refused because the solution was not finite */
+} sc_fem_stats;
+
+typedef struct sc_fem {
+    /* ---- cold: definition and sizes ---- */
+    sc_fem_def def;
+    uint32_t node_count;
+    uint32_t tet_count;
+    uint32_t nnz_blocks;
+    uint8_t matrix_is_rest; /* blocks hold the rest K (linear mode) */
+    uint8_t unstable;       /* a step produced a non-finite solution (sticky until init) */
+    sc_fem_stats stats;
+    float lambda_nmm2[SC_MAX_LABELS]; /* Lame parameters per label, N/mm^2 */
+    float mu_nmm2[SC_MAX_LABELS];
+
+    /* ---- hot: 3x3 block CSR of K (row-major blocks), rows = nodes ---- */
+    SC_ALIGN_HOT float blk[SC_MAX_FEM_NNZ_BLOCKS][9];
+    SC_ALIGN_HOT uint32_t col[SC_MAX_FEM_NNZ_BLOCKS];
+    SC_ALIGN_HOT uint32_t row_start[SC_MAX_NODES + 1u];
+    SC_ALIGN_HOT uint32_t diag_blk[SC_MAX_NODES]; /* index of block (i, i) */
+    SC_ALIGN_HOT float mass[SC_MAX_NODES];        /* lumped mass, N s^2 / mm (= kg * 1e-3) */
+
+    /* ---- hot: solver vectors, interleaved xyz (3 floats per node) ---- */
+    SC_ALIGN_HOT float rest3[3u * SC_MAX_NODES]; /* rest positions, mm */
+    SC_ALIGN_HOT float x3[3u * SC_MAX_NODES];    /* positions at the start of the step, mm */
+    SC_ALIGN_HOT float v3[3u * SC_MAX_NODES];    /* unknown v+, mm/s (warm start: v) */
+    SC_ALIGN_HOT float r3[3u * SC_MAX_NODES];    /* residual, N s */
+    SC_ALIGN_HOT float z3[3u * SC_MAX_NODES];    /* preconditioned residual */
+    SC_ALIGN_HOT float p3[3u * SC_MAX_NODES];    /* search direction */
+    SC_ALIGN_HOT float q3[3u * SC_MAX_NODES];    /* A p */
+    SC_ALIGN_HOT float inv_diag3[3u * SC_MAX_NODES]; /* Jacobi, 0 on Dirichlet DOFs */
+    uint8_t constrained[SC_MAX_NODES]; /* this step: 1 fixed, 2 kinematic, 0 free */
+    uint8_t node_used[SC_MAX_NODES];   /* node belongs to at least one tet */
+
+    /* ---- per tet rest data (corotated re-assembly) ---- */
+    SC_ALIGN_HOT float dm_inv[SC_MAX_TETS][9]; /* rows: grad N1, grad N2, grad N3 (1/mm) */
+    SC_ALIGN_HOT float vol_mm3[SC_MAX_TETS];
+    SC_ALIGN_HOT uint32_t tet_blk[SC_MAX_TETS][12]; /* block (a, b), a != b, see sc_fem.c */
+} sc_fem;
+
+/* Defaults: beta 0.1 s (the MSDS damper ratio of Algorithm 1), alpha 0, linear (paper). */
+sc_fem_def sc_fem_default_def(void);
+
+/* Check a definition: finite, non-negative damping, corotated 0 or 1. O(1).
+ * Errors: SC_ERR_INVALID_ARG (NULL, corotated not 0/1), SC_ERR_NOT_FINITE, SC_ERR_RANGE. */
+int sc_fem_def_validate(const sc_fem_def *def);
+
+/* Build the fixed sparse pattern from the mesh's tets, the per-tet rest data, the lumped
+ * masses and the rest stiffness K, with the material row of each tet's label (E, Poisson,
+ * density; sc_material.h, the same table the MSDS uses). Call at case load (not at frame
+ * time). The mesh (labels, fixed nodes) must stay unchanged while f is used with it.
+ * Cost: O(T) plus O(N * 27) for the pattern, bounded by SC_MAX_TETS / SC_MAX_NODES. Never
+ * allocates. Errors: SC_ERR_INVALID_ARG (NULL, mesh counts above the limits), the
+ * definition's errors (sc_fem_def_validate), SC_ERR_CASE_MATERIAL (table invalid, see
+ * sc_material_table_validate), SC_ERR_CASE_LABEL (a tet label without a table row),
+ * SC_ERR_FEM_PATTERN (a tet edge not between grid neighbours, or more blocks than
+ * SC_MAX_FEM_NNZ_BLOCKS), SC_ERR_MESH_ORIENTATION (a tet with non-positive rest volume). */
+int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat,
+                const sc_fem_def *def);
+
+/* Advance the nodes by dt_s: reads n->x, n->v (warm start) and the external forces n->f*,
+ * writes n->x and n->v. Fixed nodes keep their position with zero velocity. Runs exactly
+ * cg_iterations CG iterations (fewer only if the residual is exactly zero).
+ * Cost: linear: (cg_iterations + 1) block mat-vecs, O(B) each, plus O(N); corotated: plus one
+ * O(T) re-assembly with a polar decomposition per tet (bounded Newton iterations).
+ * Never allocates, cannot fail by contract: a non-finite solution leaves n unchanged, counts
+ * stats.unstable_steps and sets the sticky status read by sc_fem_status().
+ * Preconditions (SC_ASSERT): f initialised with m; dt_s finite and > 0;
+ * cg_iterations <= SC_PHYS_ITERATIONS_MAX. */
+void sc_fem_step(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s, uint32_t cg_iterations);
+
+/* As sc_fem_step, and nodes with kinematic[i] != 0 are driven by the caller: they move with
+ * their current velocity n->v (x += dt v) and act as Dirichlet constraints on the others
+ * (prescribed-displacement indentation; kinematic == NULL is sc_fem_step). Same cost. */
+void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
+                           uint32_t cg_iterations, const uint8_t *kinematic);
+
+/* Switch corotation on or off at run time; takes effect in the next step (switching off
+ * re-assembles the rest K there once, at the cost of a corotated step). O(1). */
+void sc_fem_set_corotated(sc_fem *f, int on);
+
+/* 0, or SC_ERR_PHYS_UNSTABLE once a step produced a non-finite solution. O(1). */
+int sc_fem_status(const sc_fem *f);
+
+#endif /* SC_FEM_H */

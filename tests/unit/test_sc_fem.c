@@ -1,0 +1,726 @@
+/* test_sc_fem.c: FEM soft tissue: pattern, element stiffness, solver, corotation, clinical
+ * behaviour under a prescribed-displacement indentation, determinism. */
+#include "sc_test.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "sc_err.h"
+#include "sc_fem.h"
+#include "sc_labels.h"
+#include "sc_material.h"
+#include "sc_mesh.h"
+
+static sc_mesh g_mesh;
+static sc_nodes g_nodes;
+static sc_fem g_fem;
+static sc_fem g_fem2;
+static sc_nodes g_nodes2;
+static sc_material_table g_mat;
+static uint8_t g_kin[SC_MAX_NODES];
+
+/* Box of the default mesh definition (40 x 20 x 30 mm), nx x ny x nz nodes, all fat, bottom
+ * and sides fixed (sc_material_assign without a label map). */
+static void make_mesh(uint32_t nx, uint32_t ny, uint32_t nz)
+{
+    sc_mesh_def d = sc_mesh_default_def();
+    d.nx = nx;
+    d.ny = ny;
+    d.nz = nz;
+    assert_int_equal(sc_mesh_build(&g_mesh, &d), SC_OK);
+    sc_material_table_default(&g_mat);
+    assert_int_equal(sc_material_assign(&g_mesh, NULL, &g_mat, SC_LABEL_FAT), SC_OK);
+    sc_nodes_reset_to_rest(&g_nodes, &g_mesh);
+}
+
+static void tet_centroid(const sc_mesh *m, uint32_t e, float c[3])
+{
+    c[0] = c[1] = c[2] = 0.0f;
+    for (uint32_t v = 0; v < 4u; v++) {
+        const uint32_t i = m->tet[e][v];
+        c[0] += 0.25f * m->rest_x[i];
+        c[1] += 0.25f * m->rest_y[i];
+        c[2] += 0.25f * m->rest_z[i];
+    }
+}
+
+/* y = K x with the FEM's blocks (interleaved xyz), double accumulation: the test's oracle. */
+static void k_times(const sc_fem *f, const double *x, double *y)
+{
+    for (uint32_t i = 0; i < f->node_count; i++) {
+        double s[3] = {0.0, 0.0, 0.0};
+        for (uint32_t b = f->row_start[i]; b < f->row_start[i + 1u]; b++) {
+            const uint32_t c = f->col[b];
+            for (uint32_t r = 0; r < 3u; r++) {
+                for (uint32_t q = 0; q < 3u; q++) {
+                    s[r] += (double)f->blk[b][3u * r + q] * x[3u * c + q];
+                }
+            }
+        }
+        y[3u * i] = s[0];
+        y[3u * i + 1u] = s[1];
+        y[3u * i + 2u] = s[2];
+    }
+}
+
+/* node on the top (skin) layer, k = 0 */
+static int is_top(const sc_mesh *m, uint32_t i)
+{
+    return i < m->nx * m->ny;
+}
+
+/* bitwise float equality (the values must be exactly unchanged) */
+static int same(float a, float b)
+{
+    return memcmp(&a, &b, sizeof a) == 0;
+}
+
+static double g_u[3u * SC_MAX_NODES], g_ku[3u * SC_MAX_NODES];
+
+/* ---- init and pattern ---------------------------------------------------------------------- */
+
+static void init_rejects_invalid_inputs(void **state)
+{
+    (void)state;
+    make_mesh(5, 4, 3);
+    sc_fem_def def = sc_fem_default_def();
+    assert_int_equal(sc_fem_init(NULL, &g_mesh, &g_mat, &def), SC_ERR_INVALID_ARG);
+    assert_int_equal(sc_fem_init(&g_fem, NULL, &g_mat, &def), SC_ERR_INVALID_ARG);
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, NULL, &def), SC_ERR_INVALID_ARG);
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, NULL), SC_ERR_INVALID_ARG);
+
+    def.rayleigh_beta_s = NAN;
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_ERR_NOT_FINITE);
+    def = sc_fem_default_def();
+    def.rayleigh_alpha_per_s = -1.0f;
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_ERR_RANGE);
+    def = sc_fem_default_def();
+    def.corotated = 2u;
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_ERR_INVALID_ARG);
+    def = sc_fem_default_def();
+
+    sc_material_table bad = g_mat;
+    bad.row[SC_LABEL_VEIN].poisson = 0.5f; /* incompressible: lambda infinite */
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &bad, &def), SC_ERR_CASE_MATERIAL);
+    bad = g_mat;
+    bad.row[SC_LABEL_FAT].e_pa = 0.0f;
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &bad, &def), SC_ERR_CASE_MATERIAL);
+    bad = g_mat;
+    bad.count = 2u; /* fat (2) has no row */
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &bad, &def), SC_ERR_CASE_LABEL);
+
+    /* a tet edge that is not between grid neighbours cannot be in the stencil pattern */
+    const uint32_t keep = g_mesh.tet[0][3];
+    g_mesh.tet[0][3] = g_mesh.node_count - 1u;
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_ERR_FEM_PATTERN);
+    g_mesh.tet[0][3] = keep;
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_OK);
+}
+
+static void pattern_has_diagonal_plus_one_block_per_edge_direction(void **state)
+{
+    (void)state;
+    make_mesh(5, 4, 3);
+    sc_fem_def def = sc_fem_default_def();
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_OK);
+    /* brute-force edge set */
+    static uint8_t adj[60][60];
+    memset(adj, 0, sizeof adj);
+    uint32_t edges = 0;
+    for (uint32_t e = 0; e < g_mesh.tet_count; e++) {
+        for (uint32_t a = 0; a < 4u; a++) {
+            for (uint32_t b = 0; b < 4u; b++) {
+                const uint32_t i = g_mesh.tet[e][a], j = g_mesh.tet[e][b];
+                if (i < j && !adj[i][j]) {
+                    adj[i][j] = adj[j][i] = 1u;
+                    edges++;
+                }
+            }
+        }
+    }
+    assert_int_equal(g_fem.nnz_blocks, g_mesh.node_count + 2u * edges);
+    for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+        uint32_t seen = 0;
+        for (uint32_t b = g_fem.row_start[i]; b < g_fem.row_start[i + 1u]; b++) {
+            const uint32_t c = g_fem.col[b];
+            if (b > g_fem.row_start[i]) {
+                assert_true(c > g_fem.col[b - 1u]); /* sorted, no duplicates */
+            }
+            if (c == i) {
+                assert_int_equal(g_fem.diag_blk[i], b);
+            } else {
+                assert_true(adj[i][c]);
+            }
+            seen++;
+        }
+        assert_true(seen >= 1u && seen <= 19u);
+    }
+    /* the configured bound holds for the largest mesh */
+    make_mesh(SC_MAX_MESH_NX, SC_MAX_MESH_NY, SC_MAX_MESH_NZ);
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_OK);
+    assert_true(g_fem.nnz_blocks <= SC_MAX_FEM_NNZ_BLOCKS);
+    print_message("blocks at %ux%ux%u: %u (limit %u), sizeof(sc_fem) %zu B\n", g_mesh.nx,
+                  g_mesh.ny, g_mesh.nz, g_fem.nnz_blocks, (unsigned)SC_MAX_FEM_NNZ_BLOCKS,
+                  sizeof(sc_fem));
+}
+
+/* ---- element stiffness ------------------------------------------------------------------- */
+
+static double max_abs(const double *v, uint32_t count)
+{
+    double m = 0.0;
+    for (uint32_t i = 0; i < count; i++) {
+        m = fmax(m, fabs(v[i]));
+    }
+    return m;
+}
+
+static void stiffness_is_symmetric_and_annihilates_rigid_motions(void **state)
+{
+    (void)state;
+    make_mesh(6, 5, 4);
+    /* mixed materials: symmetry and rigid-body invariance hold per element */
+    for (uint32_t e = 0; e < g_mesh.tet_count; e++) {
+        g_mesh.tet_label[e] = (uint8_t)(1u + e % 7u);
+    }
+    sc_fem_def def = sc_fem_default_def();
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_OK);
+    const uint32_t n = g_mesh.node_count;
+    double kmax = 0.0;
+    for (uint32_t i = 0; i < n; i++) {
+        for (uint32_t b = g_fem.row_start[i]; b < g_fem.row_start[i + 1u]; b++) {
+            const uint32_t j = g_fem.col[b];
+            uint32_t t = g_fem.row_start[j];
+            while (g_fem.col[t] != i) {
+                t++;
+            }
+            for (uint32_t r = 0; r < 3u; r++) {
+                for (uint32_t c = 0; c < 3u; c++) {
+                    /* assembled from the same products in the same order: exact */
+                    assert_true(memcmp(&g_fem.blk[b][3u * r + c], &g_fem.blk[t][3u * c + r],
+                                       sizeof(float)) == 0);
+                    kmax = fmax(kmax, fabs((double)g_fem.blk[b][3u * r + c]));
+                }
+            }
+        }
+    }
+    /* translations and infinitesimal rotations: K u = 0 up to float rounding of the blocks
+     * (relative 1e-5 of |K| |u|: a block sum of ~19 float terms of size |K|) */
+    const double w[3] = {0.3, -0.2, 0.5};
+    for (uint32_t mode = 0; mode < 4u; mode++) {
+        for (uint32_t i = 0; i < n; i++) {
+            const double X[3] = {g_mesh.rest_x[i], g_mesh.rest_y[i], g_mesh.rest_z[i]};
+            for (uint32_t d = 0; d < 3u; d++) {
+                g_u[3u * i + d] = (mode < 3u) ? (d == mode ? 1.0 : 0.0) : 0.0;
+            }
+            if (mode == 3u) { /* w x X */
+                g_u[3u * i] = w[1] * X[2] - w[2] * X[1];
+                g_u[3u * i + 1u] = w[2] * X[0] - w[0] * X[2];
+                g_u[3u * i + 2u] = w[0] * X[1] - w[1] * X[0];
+            }
+        }
+        k_times(&g_fem, g_u, g_ku);
+        const double bound = 1.0e-5 * kmax * max_abs(g_u, 3u * n) * 19.0;
+        assert_true(max_abs(g_ku, 3u * n) <= bound);
+    }
+    /* and a stretch is not in the kernel (the check above can fail) */
+    for (uint32_t i = 0; i < n; i++) {
+        g_u[3u * i] = 0.01 * g_mesh.rest_x[i];
+        g_u[3u * i + 1u] = 0.0;
+        g_u[3u * i + 2u] = 0.0;
+    }
+    k_times(&g_fem, g_u, g_ku);
+    assert_true(max_abs(g_ku, 3u * n) > 1.0e-3 * kmax * max_abs(g_u, 3u * n));
+}
+
+/* Patch test: for a homogeneous material, K applied to any linear displacement field gives zero
+ * force at interior nodes (linear tets reproduce constant strain), and u . K u is exactly twice
+ * the strain energy of the constant stress over the box: V (lambda tr(eps)^2 + 2 mu eps:eps). */
+static void linear_field_gives_no_interior_force_and_exact_energy(void **state)
+{
+    (void)state;
+    make_mesh(7, 6, 5);
+    sc_fem_def def = sc_fem_default_def();
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_OK);
+    const double G[9] = {0.010, 0.004, -0.002, 0.003, -0.006, 0.001, 0.005, 0.002, -0.012};
+    const uint32_t n = g_mesh.node_count;
+    for (uint32_t i = 0; i < n; i++) {
+        const double X[3] = {g_mesh.rest_x[i], g_mesh.rest_y[i], g_mesh.rest_z[i]};
+        for (uint32_t r = 0; r < 3u; r++) {
+            g_u[3u * i + r] = G[3u * r] * X[0] + G[3u * r + 1u] * X[1] + G[3u * r + 2u] * X[2];
+        }
+    }
+    k_times(&g_fem, g_u, g_ku);
+    const sc_material *fat = &g_mat.row[SC_LABEL_FAT];
+    const double e = fat->e_pa * 1e-6, nu = fat->poisson;
+    const double lam = e * nu / ((1 + nu) * (1 - 2 * nu)), mu = e / (2 * (1 + nu));
+    double eps[9];
+    for (uint32_t r = 0; r < 3u; r++) {
+        for (uint32_t c = 0; c < 3u; c++) {
+            eps[3u * r + c] = 0.5 * (G[3u * r + c] + G[3u * c + r]);
+        }
+    }
+    const double tr = eps[0] + eps[4] + eps[8];
+    double ee = 0.0;
+    for (uint32_t k = 0; k < 9u; k++) {
+        ee += eps[k] * eps[k];
+    }
+    const double energy2 = 40.0 * 20.0 * 30.0 * (lam * tr * tr + 2.0 * mu * ee);
+    double fint = 0.0, fbnd = 0.0, uku = 0.0;
+    for (uint32_t k = 0; k < g_mesh.nz; k++) {
+        for (uint32_t j = 0; j < g_mesh.ny; j++) {
+            for (uint32_t i = 0; i < g_mesh.nx; i++) {
+                const uint32_t id = i + g_mesh.nx * (j + g_mesh.ny * k);
+                const int interior = i > 0 && j > 0 && k > 0 && i + 1u < g_mesh.nx &&
+                                     j + 1u < g_mesh.ny && k + 1u < g_mesh.nz;
+                for (uint32_t d = 0; d < 3u; d++) {
+                    const double v = fabs(g_ku[3u * id + d]);
+                    if (interior) {
+                        fint = fmax(fint, v);
+                    } else {
+                        fbnd = fmax(fbnd, v);
+                    }
+                    uku += g_u[3u * id + d] * g_ku[3u * id + d];
+                }
+            }
+        }
+    }
+    print_message("patch test: interior |f| %.2e N vs boundary %.2e N; u.Ku %.6e vs %.6e\n",
+                  fint, fbnd, uku, energy2);
+    /* float blocks: relative rounding ~1e-7 per term, ~20 terms of boundary-force size */
+    assert_true(fbnd > 0.0);
+    assert_true(fint < 1.0e-5 * fbnd);
+    assert_true(fabs(uku - energy2) < 1.0e-5 * energy2);
+}
+
+/* ---- solver ---------------------------------------------------------------------------------- */
+
+static float max_dev_from_rest_mm(const sc_mesh *m, const sc_nodes *n)
+{
+    float w = 0.0f;
+    for (uint32_t i = 0; i < m->node_count; i++) {
+        w = fmaxf(w, fabsf(n->x[i] - m->rest_x[i]));
+        w = fmaxf(w, fabsf(n->y[i] - m->rest_y[i]));
+        w = fmaxf(w, fabsf(n->z[i] - m->rest_z[i]));
+    }
+    return w;
+}
+
+/* Boundary nodes held on a linear field (kinematic, v = 0), interior started at rest: the
+ * implicit steps converge to the exact linear field inside (the static solution). */
+static void solver_converges_to_the_static_patch_solution(void **state)
+{
+    (void)state;
+    make_mesh(9, 7, 7);
+    for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+        g_mesh.node_fixed[i] = 0u;
+    }
+    sc_fem_def def = sc_fem_default_def();
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_OK);
+    const float G[9] = {0.02f, 0.01f, 0.0f, -0.01f, 0.03f, 0.0f, 0.0f, 0.005f, -0.05f};
+    for (uint32_t k = 0; k < g_mesh.nz; k++) {
+        for (uint32_t j = 0; j < g_mesh.ny; j++) {
+            for (uint32_t i = 0; i < g_mesh.nx; i++) {
+                const uint32_t id = i + g_mesh.nx * (j + g_mesh.ny * k);
+                const int hull = i == 0 || j == 0 || k == 0 || i + 1u == g_mesh.nx ||
+                                 j + 1u == g_mesh.ny || k + 1u == g_mesh.nz;
+                g_kin[id] = hull ? 1u : 0u;
+                if (hull) {
+                    const float X[3] = {g_mesh.rest_x[id], g_mesh.rest_y[id], g_mesh.rest_z[id]};
+                    g_nodes.x[id] += G[0] * X[0] + G[1] * X[1] + G[2] * X[2];
+                    g_nodes.y[id] += G[3] * X[0] + G[4] * X[1] + G[5] * X[2];
+                    g_nodes.z[id] += G[6] * X[0] + G[7] * X[1] + G[8] * X[2];
+                }
+            }
+        }
+    }
+    float err = 0.0f, umax = 0.0f;
+    for (uint32_t frame = 0; frame < 200u; frame++) {
+        sc_fem_step_kinematic(&g_fem, &g_mesh, &g_nodes, 1.0f / 60.0f, 20u, g_kin);
+    }
+    for (uint32_t id = 0; id < g_mesh.node_count; id++) {
+        const float X[3] = {g_mesh.rest_x[id], g_mesh.rest_y[id], g_mesh.rest_z[id]};
+        const float ex = X[0] + G[0] * X[0] + G[1] * X[1] + G[2] * X[2];
+        const float ey = X[1] + G[3] * X[0] + G[4] * X[1] + G[5] * X[2];
+        const float ez = X[2] + G[6] * X[0] + G[7] * X[1] + G[8] * X[2];
+        err = fmaxf(err, fmaxf(fabsf(g_nodes.x[id] - ex),
+                               fmaxf(fabsf(g_nodes.y[id] - ey), fabsf(g_nodes.z[id] - ez))));
+        umax = fmaxf(umax, fabsf(ez - X[2]));
+    }
+    print_message("patch solution: max error %.2e mm of max displacement %.3f mm\n",
+                  (double)err, (double)umax);
+    /* 1e-3 of the displacement: far below a pixel, far above float rounding (1e-6) */
+    assert_true(err < 1.0e-3f * umax);
+    assert_int_equal(sc_fem_status(&g_fem), SC_OK);
+}
+
+/* A displaced state released without forces returns to rest without oscillating: the
+ * tracked displacement never changes sign and shrinks monotonically (over-damped). */
+static void released_displacement_returns_to_rest_over_damped(void **state)
+{
+    (void)state;
+    make_mesh(16, 8, 8);
+    sc_fem_def def = sc_fem_default_def();
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_OK);
+    uint32_t probe = 0;
+    float best = 1e9f;
+    for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+        if (g_mesh.node_fixed[i]) {
+            continue;
+        }
+        const float dx = g_mesh.rest_x[i] - 20.0f, dy = g_mesh.rest_y[i] - 10.0f,
+                    dz = g_mesh.rest_z[i];
+        const float r2 = dx * dx + dy * dy + dz * dz;
+        g_nodes.z[i] += 3.0f * expf(-r2 / 50.0f); /* smooth dent of 3 mm under the top */
+        if (r2 < best) {
+            best = r2;
+            probe = i;
+        }
+    }
+    float prev = g_nodes.z[probe] - g_mesh.rest_z[probe];
+    assert_true(prev > 2.0f);
+    const float start = prev;
+    for (uint32_t frame = 0; frame < 120u; frame++) {
+        sc_fem_step(&g_fem, &g_mesh, &g_nodes, 1.0f / 60.0f, 20u);
+        const float u = g_nodes.z[probe] - g_mesh.rest_z[probe];
+        assert_true(u >= -0.01f * start); /* no overshoot through rest beyond 1% */
+        assert_true(u <= prev + 1e-6f);     /* monotonic decay */
+        prev = u;
+    }
+    const float dev = max_dev_from_rest_mm(&g_mesh, &g_nodes);
+    print_message("released dent: %.3f mm -> max deviation %.2e mm after 2 s\n",
+                  (double)start, (double)dev);
+    assert_true(dev < 0.01f * start);
+}
+
+static void fixed_nodes_never_move_and_forces_push_free_nodes(void **state)
+{
+    (void)state;
+    make_mesh(8, 6, 6);
+    sc_fem_def def = sc_fem_default_def();
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_OK);
+    uint32_t free_top = 0;
+    for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+        g_nodes.fz[i] = 1.0e-3f; /* 1 mN down on every node, fixed ones included */
+        if (!g_mesh.node_fixed[i] && is_top(&g_mesh, i)) {
+            free_top = i;
+        }
+    }
+    for (uint32_t frame = 0; frame < 30u; frame++) {
+        sc_fem_step(&g_fem, &g_mesh, &g_nodes, 0.01f, 20u);
+    }
+    for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+        if (g_mesh.node_fixed[i]) {
+            assert_true(same(g_nodes.x[i], g_mesh.rest_x[i]) &&
+                        same(g_nodes.y[i], g_mesh.rest_y[i]) &&
+                        same(g_nodes.z[i], g_mesh.rest_z[i]));
+            assert_true(same(g_nodes.vx[i], 0.0f) && same(g_nodes.vz[i], 0.0f));
+        }
+    }
+    assert_true(g_nodes.z[free_top] > g_mesh.rest_z[free_top] + 0.01f);
+}
+
+/* Rigid rotation of the whole (unconstrained) block by 40 degrees: the corotated model sees
+ * no strain and produces (almost) no motion, the linear model produces spurious forces. */
+static void corotated_model_is_invariant_under_rigid_rotation(void **state)
+{
+    (void)state;
+    make_mesh(8, 6, 6);
+    for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+        g_mesh.node_fixed[i] = 0u;
+    }
+    const float c = cosf(0.698f), s = sinf(0.698f);
+    float drift[2];
+    for (uint32_t mode = 0; mode < 2u; mode++) {
+        sc_fem_def def = sc_fem_default_def();
+        def.corotated = (uint8_t)(1u - mode);
+        assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_OK);
+        sc_nodes_reset_to_rest(&g_nodes, &g_mesh);
+        for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+            const float x = g_mesh.rest_x[i] - 20.0f, y = g_mesh.rest_y[i] - 10.0f;
+            g_nodes.x[i] = 20.0f + c * x - s * y;
+            g_nodes.y[i] = 10.0f + s * x + c * y;
+            g_nodes2.x[i] = g_nodes.x[i];
+            g_nodes2.y[i] = g_nodes.y[i];
+            g_nodes2.z[i] = g_nodes.z[i];
+        }
+        for (uint32_t frame = 0; frame < 5u; frame++) {
+            sc_fem_step(&g_fem, &g_mesh, &g_nodes, 1.0f / 60.0f, 20u);
+        }
+        float d = 0.0f;
+        for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+            d = fmaxf(d, fabsf(g_nodes.x[i] - g_nodes2.x[i]));
+            d = fmaxf(d, fabsf(g_nodes.y[i] - g_nodes2.y[i]));
+            d = fmaxf(d, fabsf(g_nodes.z[i] - g_nodes2.z[i]));
+        }
+        drift[mode] = d;
+    }
+    print_message("rigid 40 deg rotation, drift after 5 frames: corotated %.2e mm, linear %.3f mm\n",
+                  (double)drift[0], (double)drift[1]);
+    /* corotated: rounding only (positions ~40 mm, float eps 4e-6 mm, amplified by the polar
+     * iteration): 1e-3 mm; linear: the rotation looks like a ~30% strain, mm-scale motion */
+    assert_true(drift[0] < 1.0e-3f);
+    assert_true(drift[1] > 0.5f);
+    assert_int_equal(g_fem.stats.degenerate_tets, 0u);
+}
+
+/* ---- clinical scene ------------------------------------------------------------------------ */
+
+/* Phantom in the default box (x lateral 0..40, y along the vessels 0..20, z depth 0..30 mm):
+ * fat; muscle below 20 mm; a vessel of radius 3 mm at (x 13, z 10) with vessel_a's label and
+ * one at (x 27, z 10) with vessel_b's. Bottom and sides fixed. */
+#define SCENE_VEIN_X_MM 13.0f
+#define SCENE_ART_X_MM 27.0f
+#define SCENE_VESSEL_Z_MM 10.0f
+#define SCENE_VESSEL_R_MM 3.0f
+/* Probe footprint: a linear probe, 36 mm aperture (x 2..38) x 12 mm elevation (y 4..16). */
+#define SCENE_PROBE_X0 2.0f
+#define SCENE_PROBE_X1 38.0f
+#define SCENE_PROBE_Y0 4.0f
+#define SCENE_PROBE_Y1 16.0f
+/* Tets "under the probe": centroid inside the central part of the footprint in y. */
+#define SCENE_MEAS_Y0 7.0f
+#define SCENE_MEAS_Y1 13.0f
+
+static void label_scene(sc_mesh *m, uint8_t label_a, uint8_t label_b)
+{
+    for (uint32_t e = 0; e < m->tet_count; e++) {
+        float c[3];
+        tet_centroid(m, e, c);
+        uint8_t lab = c[2] > 20.0f ? SC_LABEL_MUSCLE : SC_LABEL_FAT;
+        const float za = c[2] - SCENE_VESSEL_Z_MM;
+        const float xa = c[0] - SCENE_VEIN_X_MM, xb = c[0] - SCENE_ART_X_MM;
+        const float r2 = SCENE_VESSEL_R_MM * SCENE_VESSEL_R_MM;
+        if (xa * xa + za * za <= r2) {
+            lab = label_a;
+        } else if (xb * xb + za * za <= r2) {
+            lab = label_b;
+        }
+        m->tet_label[e] = lab;
+    }
+}
+
+/* Sum of the deformed volumes of the tets with label lab under the probe, and of their rest. */
+static void label_volume(const sc_mesh *m, const sc_nodes *n, uint8_t lab, float x0, float x1,
+                         double *vol, double *rest)
+{
+    *vol = 0.0;
+    *rest = 0.0;
+    for (uint32_t e = 0; e < m->tet_count; e++) {
+        float c[3];
+        tet_centroid(m, e, c);
+        if (m->tet_label[e] != lab || c[1] < SCENE_MEAS_Y0 || c[1] > SCENE_MEAS_Y1 ||
+            c[0] < x0 || c[0] > x1) {
+            continue;
+        }
+        *vol += (double)sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[e]);
+        *rest += (double)sc_mesh_tet_volume_mm3(m->rest_x, m->rest_y, m->rest_z, m->tet[e]);
+    }
+}
+
+typedef struct scene_result {
+    double shrink_a; /* relative volume loss of vessel a under the probe */
+    double shrink_b;
+    float dev_after_lift_mm; /* max |x - X| 2 s after the lift */
+    float box_mm;
+} scene_result;
+
+#define SCENE_FRAME_DT_S 0.01f /* the FEM step per frame (SC_PHYS_DT_DEFAULT_S) */
+#define SCENE_PRESS_FRAMES 30u
+#define SCENE_HOLD_FRAMES 30u
+#define SCENE_LIFT_FRAMES 120u /* 2 s at 60 Hz frames */
+
+/* Prescribed-displacement indentation: the top nodes in the footprint are driven 15% of the
+ * box depth down over SCENE_PRESS_FRAMES, held, then released. */
+static scene_result run_scene(sc_fem *f, sc_nodes *n, uint8_t label_a, uint8_t label_b,
+                              int corotated, uint32_t nx, uint32_t ny, uint32_t nz)
+{
+    make_mesh(nx, ny, nz);
+    label_scene(&g_mesh, label_a, label_b);
+    sc_nodes_reset_to_rest(n, &g_mesh);
+    sc_fem_def def = sc_fem_default_def();
+    def.corotated = (uint8_t)corotated;
+    assert_int_equal(sc_fem_init(f, &g_mesh, &g_mat, &def), SC_OK);
+    const float depth_mm = 30.0f;
+    const float press_mm = 0.15f * depth_mm;
+    const float v_press = press_mm / ((float)SCENE_PRESS_FRAMES * SCENE_FRAME_DT_S);
+    for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+        const float x = g_mesh.rest_x[i], y = g_mesh.rest_y[i];
+        g_kin[i] = (is_top(&g_mesh, i) && x >= SCENE_PROBE_X0 && x <= SCENE_PROBE_X1 &&
+                    y >= SCENE_PROBE_Y0 && y <= SCENE_PROBE_Y1)
+                       ? 1u
+                       : 0u;
+    }
+    for (uint32_t frame = 0; frame < SCENE_PRESS_FRAMES + SCENE_HOLD_FRAMES; frame++) {
+        for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+            if (g_kin[i]) {
+                n->vx[i] = 0.0f;
+                n->vy[i] = 0.0f;
+                n->vz[i] = frame < SCENE_PRESS_FRAMES ? v_press : 0.0f;
+            }
+        }
+        sc_fem_step_kinematic(f, &g_mesh, n, SCENE_FRAME_DT_S, SC_PHYS_ITERATIONS_DEFAULT, g_kin);
+    }
+    scene_result res;
+    double v, r;
+    label_volume(&g_mesh, n, label_a, 0.0f, 20.0f, &v, &r);
+    assert_true(r > 0.0);
+    res.shrink_a = 1.0 - v / r;
+    label_volume(&g_mesh, n, label_b, 20.0f, 40.0f, &v, &r);
+    assert_true(r > 0.0);
+    res.shrink_b = 1.0 - v / r;
+    for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+        n->vz[i] = g_kin[i] ? 0.0f : n->vz[i]; /* the probe leaves the skin at rest */
+    }
+    for (uint32_t frame = 0; frame < SCENE_LIFT_FRAMES; frame++) {
+        sc_fem_step(f, &g_mesh, n, SCENE_FRAME_DT_S, SC_PHYS_ITERATIONS_DEFAULT);
+    }
+    res.dev_after_lift_mm = max_dev_from_rest_mm(&g_mesh, n);
+    res.box_mm = 40.0f;
+    assert_int_equal(sc_fem_status(f), SC_OK);
+    return res;
+}
+
+static void check_clinical(int corotated)
+{
+    scene_result a = run_scene(&g_fem, &g_nodes, SC_LABEL_VEIN, SC_LABEL_ARTERY, corotated,
+                               SC_MAX_MESH_NX, SC_MAX_MESH_NY, SC_MAX_MESH_NZ);
+    scene_result b = run_scene(&g_fem, &g_nodes, SC_LABEL_THROMBUS, SC_LABEL_ARTERY, corotated,
+                               SC_MAX_MESH_NX, SC_MAX_MESH_NY, SC_MAX_MESH_NZ);
+    print_message("FEM %s, 15%% indentation: vein -%.0f%%, artery -%.0f%%, thrombosed vein "
+                  "-%.0f%%; 2 s after lift max deviation %.3f / %.3f mm (1%% box = %.2f mm)\n",
+                  corotated ? "corotated" : "linear", 100.0 * a.shrink_a, 100.0 * a.shrink_b,
+                  100.0 * b.shrink_a, (double)a.dev_after_lift_mm, (double)b.dev_after_lift_mm,
+                  (double)(0.01f * a.box_mm));
+    assert_true(a.shrink_a >= 0.60);
+    assert_true(a.shrink_b <= 0.20);
+    assert_true(b.shrink_a <= 0.20);
+    assert_true(a.dev_after_lift_mm <= 0.01f * a.box_mm);
+    assert_true(b.dev_after_lift_mm <= 0.01f * b.box_mm);
+}
+
+static void clinical_vein_collapses_artery_and_thrombus_resist_linear(void **state)
+{
+    (void)state;
+    check_clinical(0);
+}
+
+static void clinical_vein_collapses_artery_and_thrombus_resist_corotated(void **state)
+{
+    (void)state;
+    check_clinical(1);
+}
+
+/* ---- determinism ----------------------------------------------------------------------------- */
+
+static uint64_t hash_nodes(const sc_nodes *n, uint32_t count)
+{
+    uint64_t h = 1469598103934665603ull; /* FNV-1a 64 */
+    const float *arrs[6] = {n->x, n->y, n->z, n->vx, n->vy, n->vz};
+    for (uint32_t a = 0; a < 6u; a++) {
+        const uint8_t *p = (const uint8_t *)arrs[a];
+        for (size_t i = 0; i < (size_t)count * sizeof(float); i++) {
+            h ^= p[i];
+            h *= 1099511628211ull;
+        }
+    }
+    return h;
+}
+
+static void steps_are_bitwise_deterministic(void **state)
+{
+    (void)state;
+    uint64_t h[2][2];
+    for (uint32_t corot = 0; corot < 2u; corot++) {
+        for (uint32_t run = 0; run < 2u; run++) {
+            sc_fem *f = run ? &g_fem2 : &g_fem;
+            sc_nodes *n = run ? &g_nodes2 : &g_nodes;
+            make_mesh(12, 6, 8);
+            label_scene(&g_mesh, SC_LABEL_VEIN, SC_LABEL_ARTERY);
+            sc_nodes_reset_to_rest(n, &g_mesh);
+            sc_fem_def def = sc_fem_default_def();
+            def.corotated = (uint8_t)corot;
+            assert_int_equal(sc_fem_init(f, &g_mesh, &g_mat, &def), SC_OK);
+            for (uint32_t frame = 0; frame < 40u; frame++) {
+                for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+                    const float dx = g_mesh.rest_x[i] - 20.0f, dy = g_mesh.rest_y[i] - 10.0f;
+                    n->fz[i] = (frame < 20u && is_top(&g_mesh, i) && dx * dx + dy * dy < 64.0f)
+                                   ? 2.0e-4f
+                                   : 0.0f;
+                }
+                sc_fem_step(f, &g_mesh, n, 0.01f, 20u);
+            }
+            h[corot][run] = hash_nodes(n, g_mesh.node_count);
+        }
+        assert_true(h[corot][0] == h[corot][1]);
+    }
+    print_message("state hash after 40 frames: linear %016llx corotated %016llx\n",
+                  (unsigned long long)h[0][0], (unsigned long long)h[1][0]);
+}
+
+/* ---- run-time switches -------------------------------------------------------------------- */
+
+/* Corotation switched on and off in the middle of a compression: in the switch frame no node
+ * moves more than 1 mm (a normal frame moves the probe nodes 0.15 mm). */
+static void corotation_switch_mid_compression_does_not_jump(void **state)
+{
+    (void)state;
+    make_mesh(16, 8, 12);
+    label_scene(&g_mesh, SC_LABEL_VEIN, SC_LABEL_ARTERY);
+    sc_fem_def def = sc_fem_default_def();
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_OK);
+    for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+        const float x = g_mesh.rest_x[i], y = g_mesh.rest_y[i];
+        g_kin[i] = (is_top(&g_mesh, i) && x >= SCENE_PROBE_X0 && x <= SCENE_PROBE_X1 &&
+                    y >= SCENE_PROBE_Y0 && y <= SCENE_PROBE_Y1);
+    }
+    float worst = 0.0f;
+    for (uint32_t frame = 0; frame < 40u; frame++) {
+        if (frame == 15u) {
+            sc_fem_set_corotated(&g_fem, 1);
+        }
+        if (frame == 30u) {
+            sc_fem_set_corotated(&g_fem, 0);
+        }
+        for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+            if (g_kin[i]) {
+                g_nodes.vz[i] = 15.0f; /* 0.15 mm per 0.01 s frame */
+            }
+            g_nodes2.x[i] = g_nodes.x[i];
+            g_nodes2.y[i] = g_nodes.y[i];
+            g_nodes2.z[i] = g_nodes.z[i];
+        }
+        sc_fem_step_kinematic(&g_fem, &g_mesh, &g_nodes, 0.01f, 20u, g_kin);
+        float d = 0.0f;
+        for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+            d = fmaxf(d, fabsf(g_nodes.x[i] - g_nodes2.x[i]));
+            d = fmaxf(d, fabsf(g_nodes.y[i] - g_nodes2.y[i]));
+            d = fmaxf(d, fabsf(g_nodes.z[i] - g_nodes2.z[i]));
+        }
+        if (frame == 15u || frame == 30u) {
+            worst = fmaxf(worst, d);
+        }
+    }
+    print_message("largest node move in a corotation switch frame: %.3f mm\n", (double)worst);
+    assert_true(worst <= 1.0f);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(init_rejects_invalid_inputs),
+        cmocka_unit_test(pattern_has_diagonal_plus_one_block_per_edge_direction),
+        cmocka_unit_test(stiffness_is_symmetric_and_annihilates_rigid_motions),
+        cmocka_unit_test(linear_field_gives_no_interior_force_and_exact_energy),
+        cmocka_unit_test(solver_converges_to_the_static_patch_solution),
+        cmocka_unit_test(released_displacement_returns_to_rest_over_damped),
+        cmocka_unit_test(fixed_nodes_never_move_and_forces_push_free_nodes),
+        cmocka_unit_test(corotated_model_is_invariant_under_rigid_rotation),
+        cmocka_unit_test(steps_are_bitwise_deterministic),
+        cmocka_unit_test(corotation_switch_mid_compression_does_not_jump),
+        cmocka_unit_test(clinical_vein_collapses_artery_and_thrombus_resist_linear),
+        cmocka_unit_test(clinical_vein_collapses_artery_and_thrombus_resist_corotated),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
