@@ -385,7 +385,9 @@ static int load_sections(const uint8_t *bytes, size_t size, section_ref sec[SC_C
         sec[s].p = NULL;
         sec[s].size = 0;
     }
-    uint32_t id = sc_crc32_update(SC_CRC32_INIT, bytes, SC_CASE_HEADER_SIZE);
+    /* the id hashes the headers without their own CRC fields: a CRC run over data followed by
+     * its CRC ends in a constant residue, which would make every id equal */
+    uint32_t id = sc_crc32_update(SC_CRC32_INIT, bytes, HDR_CRC);
     uint64_t off = SC_CASE_HEADER_SIZE;
     for (uint32_t i = 0; i < count; i++) {
         if (file_size - off < SC_CASE_SECTION_HEADER_SIZE) {
@@ -395,7 +397,7 @@ static int load_sections(const uint8_t *bytes, size_t size, section_ref sec[SC_C
         if (rd_u32(h + SEC_HCRC) != sc_crc32(h, SEC_HCRC)) {
             return SC_ERR_CASE_CRC;
         }
-        id = sc_crc32_update(id, h, SC_CASE_SECTION_HEADER_SIZE);
+        id = sc_crc32_update(id, h, SEC_HCRC);
         if (rd_u32(h + SEC_FLAGS) != 0u || !all_zero(h + SEC_RESERVED, SEC_HCRC - SEC_RESERVED)) {
             return SC_ERR_CASE_RESERVED;
         }

@@ -95,8 +95,9 @@ typedef struct sc_case {
     sc_xform tracker_to_patient;  /* mannequin registration as stored */
     sc_xform tracker_to_volume;   /* registration with the orientation folded in */
     uint64_t voxel_count;
-    uint32_t case_id;             /* CRC-32 over the file and section headers (which hold the
-                                   * payload CRCs): identifies the case content */
+    uint32_t case_id;             /* CRC-32 over the file and section headers (without their
+                                   * own CRC fields; they hold the payload CRCs): identifies
+                                   * the case content */
 } sc_case;
 
 /* What the writer encodes. volume.voxels and volume.labels must both be non-NULL. */

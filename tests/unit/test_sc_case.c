@@ -159,6 +159,12 @@ static void round_trip_gives_identical_voxels_labels_transforms_and_text(void **
     sc_case c2;
     assert_int_equal(sc_case_load(g_bad, n2, &c2), SC_OK);
     assert_int_equal(c2.case_id, c.case_id);
+    /* one voxel more or less changes the id */
+    g_vox[NVOX / 2u] ^= 1u;
+    n2 = write_def(&d, g_bad);
+    assert_int_equal(sc_case_load(g_bad, n2, &c2), SC_OK);
+    assert_int_not_equal(c2.case_id, c.case_id);
+    g_vox[NVOX / 2u] ^= 1u;
     uint64_t h[SC_MAX_LABELS];
     sc_case_label_histogram(&c, h);
     uint64_t sum = 0;

@@ -1,0 +1,101 @@
+/* sc_storage_linux.c: mmap'd read-only case files, see sc_storage_linux.h. */
+#include "sc_storage_linux.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "sc_err.h"
+
+/* What an empty file maps to: a valid pointer with size 0. */
+static const uint8_t sc_storage_linux_empty[1];
+
+static int storage_open(void *ctx, const char *name, const uint8_t **data, size_t *size)
+{
+    sc_storage_linux *s = (sc_storage_linux *)ctx;
+    if (s == NULL || name == NULL || name[0] == '\0' || data == NULL || size == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    char path[SC_STORAGE_LINUX_PATH_MAX];
+    int n;
+    if (name[0] == '/' || s->base_dir == NULL || s->base_dir[0] == '\0') {
+        n = snprintf(path, sizeof path, "%s", name);
+    } else {
+        n = snprintf(path, sizeof path, "%s/%s", s->base_dir, name);
+    }
+    if (n < 0 || (size_t)n >= sizeof path) {
+        return SC_ERR_NO_SPACE;
+    }
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0) {
+        s->last_errno = errno;
+        return (errno == ENOENT || errno == ENOTDIR) ? SC_ERR_NOT_FOUND : SC_ERR_IO;
+    }
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || st.st_size < 0) {
+        s->last_errno = errno != 0 ? errno : EINVAL;
+        (void)close(fd);
+        return SC_ERR_IO;
+    }
+    if ((uint64_t)st.st_size > (uint64_t)SIZE_MAX) {
+        s->last_errno = EFBIG;
+        (void)close(fd);
+        return SC_ERR_IO;
+    }
+    size_t len = (size_t)st.st_size;
+    if (len == 0u) {
+        (void)close(fd);
+        *data = sc_storage_linux_empty;
+        *size = 0;
+        s->last_errno = 0;
+        s->open_count++;
+        return SC_OK;
+    }
+    void *p = mmap(NULL, len, PROT_READ, MAP_PRIVATE, fd, 0);
+    int map_errno = errno;
+    (void)close(fd); /* the mapping keeps the file */
+    if (p == MAP_FAILED) {
+        s->last_errno = map_errno;
+        return SC_ERR_IO;
+    }
+    *data = (const uint8_t *)p;
+    *size = len;
+    s->last_errno = 0;
+    s->open_count++;
+    return SC_OK;
+}
+
+static void storage_close(void *ctx, const uint8_t *data, size_t size)
+{
+    sc_storage_linux *s = (sc_storage_linux *)ctx;
+    if (data == NULL) {
+        return;
+    }
+    if (size > 0u && data != sc_storage_linux_empty) {
+        (void)munmap((void *)(uintptr_t)data, size);
+    }
+    if (s != NULL && s->open_count > 0u) {
+        s->open_count--;
+    }
+}
+
+static const sc_storage_ops sc_storage_linux_ops = {
+    .open = storage_open,
+    .close = storage_close,
+};
+
+void sc_storage_linux_init(sc_storage_linux *s, const char *base_dir)
+{
+    s->base_dir = base_dir;
+    s->last_errno = 0;
+    s->open_count = 0;
+}
+
+sc_storage_dev sc_storage_linux_dev(sc_storage_linux *s)
+{
+    return (sc_storage_dev){.ops = &sc_storage_linux_ops, .ctx = s};
+}

@@ -1,0 +1,34 @@
+/*
+ * sc_storage_linux.h: hal storage (sc_hal_storage.h) for Linux: a case is a file, opened by
+ * path and mmap'd read-only (PROT_READ, MAP_PRIVATE); the core reads the voxels in place and
+ * never copies them. A relative name is resolved against the storage's base directory (or
+ * the working directory when none is set); an absolute path is used as is.
+ *
+ * open: SC_ERR_NOT_FOUND (no such file), SC_ERR_IO (not readable, not a regular file,
+ * mmap failed; the reason is kept in last_errno), SC_ERR_NO_SPACE (path longer than
+ * SC_STORAGE_LINUX_PATH_MAX), SC_ERR_INVALID_ARG. An empty file opens as size 0 (the case
+ * loader then answers SC_ERR_CASE_TRUNCATED). close: munmap. One storage object per thread.
+ */
+#ifndef SC_STORAGE_LINUX_H
+#define SC_STORAGE_LINUX_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sc_hal_storage.h"
+
+#ifndef SC_STORAGE_LINUX_PATH_MAX
+#define SC_STORAGE_LINUX_PATH_MAX 4096u
+#endif
+
+typedef struct sc_storage_linux {
+    const char *base_dir; /* may be NULL */
+    int last_errno;       /* errno of the last failed open, 0 otherwise */
+    uint32_t open_count;  /* mappings currently open */
+} sc_storage_linux;
+
+/* base_dir may be NULL; the string must outlive the storage. */
+void sc_storage_linux_init(sc_storage_linux *s, const char *base_dir);
+sc_storage_dev sc_storage_linux_dev(sc_storage_linux *s);
+
+#endif /* SC_STORAGE_LINUX_H */

@@ -1,0 +1,510 @@
+/* sc-casebuild: build, inspect and verify sonocomp case files.
+ *
+ *   sc-casebuild phantom <neck-ijv|femoral|femoral-dvt> -o OUT.scase [--seed N] [--spacing MM]
+ *   sc-casebuild import --volume V.{mha,mhd,nrrd,nhdr} [--labels L.{...}] -o OUT.scase
+ *                [--name NAME] [--description TEXT] [--spacing MM] [--window LO:HI]
+ *                [--mesh-nodes NX,NY,NZ] [--mesh-box X0,Y0,Z0,SX,SY,SZ]
+ *   sc-casebuild info CASE.scase
+ *   sc-casebuild verify CASE.scase...
+ *   sc-casebuild slice CASE.scase --axis x|y|z --index N -o OUT.pgm [--labels]
+ *   sc-casebuild isosurface CASE.scase --label L -o OUT.{ply,obj} [--sigma MM] [--iterations N]
+ *
+ * Exit status: 0 success, 1 a case refused / an input unreadable, 2 usage.
+ */
+#include <errno.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sc_case.h"
+#include "sc_caseimport.h"
+#include "sc_err.h"
+#include "sc_isosurface.h"
+#include "sc_labels.h"
+#include "sc_phantom.h"
+#include "sc_storage_linux.h"
+
+static const char *const label_names[] = {
+#define LBL_NAME_(name, value, text) [value] = text,
+    SC_LABEL_LIST(LBL_NAME_)
+#undef LBL_NAME_
+};
+
+static int usage(void)
+{
+    fprintf(stderr,
+            "usage:\n"
+            "  sc-casebuild phantom <neck-ijv|femoral|femoral-dvt> -o OUT.scase [--seed N] "
+            "[--spacing MM]\n"
+            "  sc-casebuild import --volume FILE [--labels FILE] -o OUT.scase [--name NAME]\n"
+            "               [--description TEXT] [--spacing MM] [--window LO:HI]\n"
+            "               [--mesh-nodes NX,NY,NZ] [--mesh-box X0,Y0,Z0,SX,SY,SZ]\n"
+            "               (FILE: .mha, .mhd, .nrrd, .nhdr; raw or compressed)\n"
+            "  sc-casebuild info CASE\n"
+            "  sc-casebuild verify CASE...\n"
+            "  sc-casebuild slice CASE --axis x|y|z --index N -o OUT.pgm [--labels]\n"
+            "  sc-casebuild isosurface CASE --label L -o OUT.ply|OUT.obj [--sigma MM] "
+            "[--iterations N]\n");
+    return 2;
+}
+
+static int write_case_file(const sc_case_def *def, const char *path)
+{
+    size_t need = sc_case_encoded_size(def);
+    if (need == 0u) {
+        fprintf(stderr, "sc-casebuild: case too large to encode\n");
+        return 1;
+    }
+    uint8_t *buf = malloc(need);
+    if (buf == NULL) {
+        fprintf(stderr, "sc-casebuild: out of memory (%zu bytes)\n", need);
+        return 1;
+    }
+    size_t n = 0;
+    int rc = sc_case_write(def, buf, need, &n);
+    if (rc == SC_OK) {
+        /* the writer does not validate semantics: the loader must accept what we ship */
+        sc_case c;
+        rc = sc_case_load(buf, n, &c);
+    }
+    if (rc != SC_OK) {
+        fprintf(stderr, "sc-casebuild: refusing to write an invalid case: %s (%s)\n",
+                sc_err_name(rc), sc_err_str(rc));
+        free(buf);
+        return 1;
+    }
+    char tmp[4096];
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    FILE *f = fopen(tmp, "wb");
+    if (f == NULL || fwrite(buf, 1, n, f) != n || fclose(f) != 0) {
+        fprintf(stderr, "sc-casebuild: cannot write %s: %s\n", tmp, strerror(errno));
+        free(buf);
+        return 1;
+    }
+    free(buf);
+    if (rename(tmp, path) != 0) {
+        fprintf(stderr, "sc-casebuild: cannot rename %s to %s: %s\n", tmp, path,
+                strerror(errno));
+        return 1;
+    }
+    return 0;
+}
+
+/* Map a case through Linux storage and load it; prints the refusal. */
+static int open_case(sc_storage_linux *st, sc_storage_dev *dev, const char *path,
+                     const uint8_t **data, size_t *size, sc_case *c)
+{
+    sc_storage_linux_init(st, NULL);
+    *dev = sc_storage_linux_dev(st);
+    int rc = sc_storage_open(dev, path, data, size);
+    if (rc != SC_OK) {
+        fprintf(stderr, "%s: cannot open: %s (%s)\n", path, sc_err_name(rc),
+                st->last_errno ? strerror(st->last_errno) : sc_err_str(rc));
+        return rc;
+    }
+    rc = sc_case_load(*data, *size, c);
+    if (rc != SC_OK) {
+        fprintf(stderr, "%s: REFUSED: %s (%s)\n", path, sc_err_name(rc), sc_err_str(rc));
+        sc_storage_close(dev, *data, *size);
+    }
+    return rc;
+}
+
+static void print_xform(const char *what, const sc_xform *x)
+{
+    printf("%-22s R [%.4f %.4f %.4f; %.4f %.4f %.4f; %.4f %.4f %.4f] t [%.3f %.3f %.3f] mm\n",
+           what, (double)x->r[0], (double)x->r[1], (double)x->r[2], (double)x->r[3],
+           (double)x->r[4], (double)x->r[5], (double)x->r[6], (double)x->r[7], (double)x->r[8],
+           (double)x->t_mm[0], (double)x->t_mm[1], (double)x->t_mm[2]);
+}
+
+static int cmd_info(int argc, char **argv)
+{
+    if (argc != 1) {
+        return usage();
+    }
+    sc_storage_linux st;
+    sc_storage_dev dev;
+    const uint8_t *data;
+    size_t size;
+    sc_case c;
+    if (open_case(&st, &dev, argv[0], &data, &size, &c) != SC_OK) {
+        return 1;
+    }
+    const sc_volume *v = &c.volume;
+    printf("file                   %s (%zu bytes, format v%u, id %08" PRIx32 ")\n", argv[0], size,
+           SC_CASE_VERSION, c.case_id);
+    printf("name                   %s\n", c.name);
+    printf("description            ");
+    for (const char *p = c.description; *p; p++) {
+        putchar(*p);
+        if (*p == '\n') {
+            printf("                       ");
+        }
+    }
+    putchar('\n');
+    printf("grid                   %u x %u x %u voxels (%" PRIu64 ")\n", v->dim[0], v->dim[1],
+           v->dim[2], c.voxel_count);
+    printf("spacing                %.4g x %.4g x %.4g mm\n", (double)v->spacing_mm[0],
+           (double)v->spacing_mm[1], (double)v->spacing_mm[2]);
+    printf("extent                 x [%.2f, %.2f] y [%.2f, %.2f] z [%.2f, %.2f] mm\n",
+           (double)v->origin_mm[0],
+           (double)(v->origin_mm[0] + v->spacing_mm[0] * (float)(v->dim[0] - 1u)),
+           (double)v->origin_mm[1],
+           (double)(v->origin_mm[1] + v->spacing_mm[1] * (float)(v->dim[1] - 1u)),
+           (double)v->origin_mm[2],
+           (double)(v->origin_mm[2] + v->spacing_mm[2] * (float)(v->dim[2] - 1u)));
+    printf("orientation            [%.4f %.4f %.4f; %.4f %.4f %.4f; %.4f %.4f %.4f]\n",
+           (double)c.orientation[0], (double)c.orientation[1], (double)c.orientation[2],
+           (double)c.orientation[3], (double)c.orientation[4], (double)c.orientation[5],
+           (double)c.orientation[6], (double)c.orientation[7], (double)c.orientation[8]);
+    printf("mesh                   %u x %u x %u nodes, box origin [%.2f %.2f %.2f] size [%.2f "
+           "%.2f %.2f] mm\n",
+           c.mesh.nx, c.mesh.ny, c.mesh.nz, (double)c.mesh.origin_mm[0],
+           (double)c.mesh.origin_mm[1], (double)c.mesh.origin_mm[2], (double)c.mesh.size_mm[0],
+           (double)c.mesh.size_mm[1], (double)c.mesh.size_mm[2]);
+    print_xform("image -> probe", &c.image_to_probe);
+    print_xform("tracker -> patient", &c.tracker_to_patient);
+    print_xform("tracker -> volume", &c.tracker_to_volume);
+    uint64_t hist[SC_MAX_LABELS];
+    sc_case_label_histogram(&c, hist);
+    uint64_t ihist[256] = {0};
+    for (uint64_t i = 0; i < c.voxel_count; i++) {
+        ihist[v->voxels[i]]++;
+    }
+    printf("\nlabel  name       voxels      share   E (Pa)     Poisson  density (kg/m3)\n");
+    for (uint32_t l = 0; l < c.material_count; l++) {
+        const char *nm = l < sizeof label_names / sizeof label_names[0] && label_names[l]
+                             ? label_names[l]
+                             : "-";
+        printf("%5u  %-9s %10" PRIu64 "  %6.2f%%  %-9.4g  %-7.3f  %.0f\n", l, nm, hist[l],
+               100.0 * (double)hist[l] / (double)c.voxel_count, (double)c.materials[l].e_pa,
+               (double)c.materials[l].poisson, (double)c.materials[l].density_kg_m3);
+    }
+    uint64_t acc = 0;
+    int p5 = -1, p50 = -1, p95 = -1;
+    for (int g = 0; g < 256; g++) {
+        acc += ihist[g];
+        if (p5 < 0 && acc * 20u >= c.voxel_count) {
+            p5 = g;
+        }
+        if (p50 < 0 && acc * 2u >= c.voxel_count) {
+            p50 = g;
+        }
+        if (p95 < 0 && acc * 20u >= c.voxel_count * 19u) {
+            p95 = g;
+        }
+    }
+    printf("\nintensity percentiles  p5 %d  p50 %d  p95 %d\n", p5, p50, p95);
+    sc_storage_close(&dev, data, size);
+    return 0;
+}
+
+static int cmd_verify(int argc, char **argv)
+{
+    if (argc < 1) {
+        return usage();
+    }
+    int bad = 0;
+    for (int i = 0; i < argc; i++) {
+        sc_storage_linux st;
+        sc_storage_dev dev;
+        const uint8_t *data;
+        size_t size;
+        sc_case c;
+        if (open_case(&st, &dev, argv[i], &data, &size, &c) != SC_OK) {
+            bad = 1;
+            continue;
+        }
+        printf("%s: OK (%s, %u x %u x %u, id %08" PRIx32 ")\n", argv[i], c.name, c.volume.dim[0],
+               c.volume.dim[1], c.volume.dim[2], c.case_id);
+        sc_storage_close(&dev, data, size);
+    }
+    return bad;
+}
+
+static int cmd_phantom(int argc, char **argv)
+{
+    sc_phantom_def pd = sc_phantom_default_def();
+    const char *out = NULL;
+    if (argc < 1) {
+        return usage();
+    }
+    int kind = sc_phantom_kind_from_name(argv[0]);
+    if (kind < 0) {
+        fprintf(stderr, "sc-casebuild: unknown phantom '%s'\n", argv[0]);
+        return usage();
+    }
+    pd.kind = (sc_phantom_kind)kind;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "-o") == 0 && i + 1 < argc) {
+            out = argv[++i];
+        } else if (strcmp(argv[i], "--seed") == 0 && i + 1 < argc) {
+            pd.seed = strtoull(argv[++i], NULL, 0);
+        } else if (strcmp(argv[i], "--spacing") == 0 && i + 1 < argc) {
+            pd.spacing_mm = strtof(argv[++i], NULL);
+        } else {
+            return usage();
+        }
+    }
+    if (out == NULL) {
+        return usage();
+    }
+    sc_phantom p;
+    int rc = sc_phantom_generate(&pd, &p);
+    if (rc != SC_OK) {
+        fprintf(stderr, "sc-casebuild: phantom: %s\n", sc_err_name(rc));
+        return 1;
+    }
+    rc = write_case_file(&p.def, out);
+    sc_phantom_free(&p);
+    return rc;
+}
+
+static int parse_floats(const char *s, float *v, int n)
+{
+    for (int i = 0; i < n; i++) {
+        char *end;
+        v[i] = strtof(s, &end);
+        if (end == s) {
+            return -1;
+        }
+        s = end;
+        if (i + 1 < n) {
+            if (*s != ',') {
+                return -1;
+            }
+            s++;
+        }
+    }
+    return *s == '\0' ? 0 : -1;
+}
+
+static int cmd_import(int argc, char **argv)
+{
+    sc_import_opts o = sc_import_default_opts();
+    const char *out = NULL;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        const char *val = i + 1 < argc ? argv[i + 1] : NULL;
+        if (val == NULL) {
+            return usage();
+        }
+        i++;
+        if (strcmp(a, "-o") == 0) {
+            out = val;
+        } else if (strcmp(a, "--volume") == 0) {
+            o.volume_path = val;
+        } else if (strcmp(a, "--labels") == 0) {
+            o.labels_path = val;
+        } else if (strcmp(a, "--name") == 0) {
+            o.name = val;
+        } else if (strcmp(a, "--description") == 0) {
+            o.description = val;
+        } else if (strcmp(a, "--spacing") == 0) {
+            o.spacing_mm = strtof(val, NULL);
+        } else if (strcmp(a, "--window") == 0) {
+            float w[2];
+            const char *colon = strchr(val, ':');
+            if (colon == NULL) {
+                return usage();
+            }
+            w[0] = strtof(val, NULL);
+            w[1] = strtof(colon + 1, NULL);
+            o.window_lo = w[0];
+            o.window_hi = w[1];
+            o.has_window = 1;
+        } else if (strcmp(a, "--mesh-nodes") == 0) {
+            float v[3];
+            if (parse_floats(val, v, 3) != 0) {
+                return usage();
+            }
+            o.mesh_nodes[0] = (uint32_t)v[0];
+            o.mesh_nodes[1] = (uint32_t)v[1];
+            o.mesh_nodes[2] = (uint32_t)v[2];
+        } else if (strcmp(a, "--mesh-box") == 0) {
+            if (parse_floats(val, o.mesh_box_mm, 6) != 0) {
+                return usage();
+            }
+            o.has_mesh_box = 1;
+        } else {
+            return usage();
+        }
+    }
+    if (out == NULL || o.volume_path == NULL) {
+        return usage();
+    }
+    sc_import_result r;
+    char err[512];
+    int rc = sc_import_case(&o, &r, err, sizeof err);
+    if (rc != SC_OK) {
+        fprintf(stderr, "sc-casebuild: import: %s: %s\n", sc_err_name(rc), err);
+        return 1;
+    }
+    rc = write_case_file(&r.def, out);
+    sc_import_result_free(&r);
+    return rc;
+}
+
+static int cmd_slice(int argc, char **argv)
+{
+    if (argc < 1) {
+        return usage();
+    }
+    const char *path = argv[0], *out = NULL;
+    int axis = 2, show_labels = 0;
+    long index = -1;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--axis") == 0 && i + 1 < argc) {
+            const char *ax = argv[++i];
+            axis = ax[0] == 'x' ? 0 : ax[0] == 'y' ? 1 : 2;
+        } else if (strcmp(argv[i], "--index") == 0 && i + 1 < argc) {
+            index = strtol(argv[++i], NULL, 10);
+        } else if (strcmp(argv[i], "-o") == 0 && i + 1 < argc) {
+            out = argv[++i];
+        } else if (strcmp(argv[i], "--labels") == 0) {
+            show_labels = 1;
+        } else {
+            return usage();
+        }
+    }
+    if (out == NULL) {
+        return usage();
+    }
+    sc_storage_linux st;
+    sc_storage_dev dev;
+    const uint8_t *data;
+    size_t size;
+    sc_case c;
+    if (open_case(&st, &dev, path, &data, &size, &c) != SC_OK) {
+        return 1;
+    }
+    const uint32_t *d = c.volume.dim;
+    if (index < 0) {
+        index = (long)(d[axis] / 2u);
+    }
+    if ((unsigned long)index >= d[axis]) {
+        fprintf(stderr, "sc-casebuild: index outside the grid\n");
+        sc_storage_close(&dev, data, size);
+        return 1;
+    }
+    /* image rows run along z (depth down) for x and y cuts, along y for a z cut */
+    uint32_t w = axis == 0 ? d[1] : d[0];
+    uint32_t h = axis == 2 ? d[1] : d[2];
+    FILE *f = fopen(out, "wb");
+    if (f == NULL) {
+        fprintf(stderr, "sc-casebuild: cannot write %s\n", out);
+        sc_storage_close(&dev, data, size);
+        return 1;
+    }
+    fprintf(f, "P5\n%u %u\n255\n", w, h);
+    const uint8_t *src = show_labels ? c.volume.labels : c.volume.voxels;
+    for (uint32_t r = 0; r < h; r++) {
+        for (uint32_t q = 0; q < w; q++) {
+            size_t i, j, k;
+            if (axis == 0) {
+                i = (size_t)index, j = q, k = r;
+            } else if (axis == 1) {
+                i = q, j = (size_t)index, k = r;
+            } else {
+                i = q, j = r, k = (size_t)index;
+            }
+            uint8_t g = src[i + d[0] * (j + (size_t)d[1] * k)];
+            if (show_labels) {
+                g = (uint8_t)(g * 28u);
+            }
+            fputc(g, f);
+        }
+    }
+    fclose(f);
+    sc_storage_close(&dev, data, size);
+    return 0;
+}
+
+static int cmd_isosurface(int argc, char **argv)
+{
+    if (argc < 1) {
+        return usage();
+    }
+    const char *path = argv[0], *out = NULL;
+    sc_iso_opts o = sc_iso_default_opts();
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--label") == 0 && i + 1 < argc) {
+            const char *l = argv[++i];
+            o.label = -1;
+            for (unsigned k = 0; k < sizeof label_names / sizeof label_names[0]; k++) {
+                if (label_names[k] && strcmp(label_names[k], l) == 0) {
+                    o.label = (int)k;
+                }
+            }
+            if (o.label < 0) {
+                o.label = (int)strtol(l, NULL, 10);
+            }
+        } else if (strcmp(argv[i], "--sigma") == 0 && i + 1 < argc) {
+            o.sigma_mm = strtof(argv[++i], NULL);
+        } else if (strcmp(argv[i], "--iterations") == 0 && i + 1 < argc) {
+            o.iterations = (uint32_t)strtoul(argv[++i], NULL, 10);
+        } else if (strcmp(argv[i], "-o") == 0 && i + 1 < argc) {
+            out = argv[++i];
+        } else {
+            return usage();
+        }
+    }
+    if (out == NULL) {
+        return usage();
+    }
+    sc_storage_linux st;
+    sc_storage_dev dev;
+    const uint8_t *data;
+    size_t size;
+    sc_case c;
+    if (open_case(&st, &dev, path, &data, &size, &c) != SC_OK) {
+        return 1;
+    }
+    sc_iso_mesh m;
+    int rc = sc_iso_extract(&c.volume, &o, &m);
+    if (rc == SC_OK) {
+        size_t len = strlen(out);
+        int obj = len > 4u && strcmp(out + len - 4u, ".obj") == 0;
+        rc = obj ? sc_iso_write_obj(&m, out) : sc_iso_write_ply(&m, out);
+        if (rc == SC_OK) {
+            printf("%s: label %d: %zu vertices, %zu triangles\n", out, o.label, m.vertex_count,
+                   m.triangle_count);
+        }
+        sc_iso_mesh_free(&m);
+    }
+    sc_storage_close(&dev, data, size);
+    if (rc != SC_OK) {
+        fprintf(stderr, "sc-casebuild: isosurface: %s\n", sc_err_name(rc));
+        return 1;
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        return usage();
+    }
+    const char *cmd = argv[1];
+    if (strcmp(cmd, "phantom") == 0) {
+        return cmd_phantom(argc - 2, argv + 2);
+    }
+    if (strcmp(cmd, "import") == 0) {
+        return cmd_import(argc - 2, argv + 2);
+    }
+    if (strcmp(cmd, "info") == 0) {
+        return cmd_info(argc - 2, argv + 2);
+    }
+    if (strcmp(cmd, "verify") == 0) {
+        return cmd_verify(argc - 2, argv + 2);
+    }
+    if (strcmp(cmd, "slice") == 0) {
+        return cmd_slice(argc - 2, argv + 2);
+    }
+    if (strcmp(cmd, "isosurface") == 0) {
+        return cmd_isosurface(argc - 2, argv + 2);
+    }
+    return usage();
+}

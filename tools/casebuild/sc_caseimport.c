@@ -1,0 +1,1062 @@
+/* sc_caseimport.c: MetaImage and NRRD readers, resampling to a case, see sc_caseimport.h. */
+#include "sc_caseimport.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <zlib.h>
+
+#include "sc_err.h"
+#include "sc_labels.h"
+#include "sc_materials.h"
+
+static int fail(char *err, size_t errlen, int rc, const char *fmt, ...)
+{
+    if (err != NULL && errlen > 0u) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err, errlen, fmt, ap);
+        va_end(ap);
+    }
+    return rc;
+}
+
+/* ---- file helpers ----------------------------------------------------------------------- */
+static int read_file(const char *path, uint8_t **data, size_t *size, char *err, size_t errlen)
+{
+    FILE *f = fopen(path, "rb");
+    if (f == NULL) {
+        return fail(err, errlen, errno == ENOENT ? SC_ERR_NOT_FOUND : SC_ERR_IO, "%s: %s", path,
+                    strerror(errno));
+    }
+    if (fseek(f, 0, SEEK_END) != 0) {
+        fclose(f);
+        return fail(err, errlen, SC_ERR_IO, "%s: cannot seek", path);
+    }
+    long len = ftell(f);
+    if (len < 0 || fseek(f, 0, SEEK_SET) != 0) {
+        fclose(f);
+        return fail(err, errlen, SC_ERR_IO, "%s: cannot size", path);
+    }
+    uint8_t *buf = malloc((size_t)len + 1u);
+    if (buf == NULL) {
+        fclose(f);
+        return fail(err, errlen, SC_ERR_NO_SPACE, "%s: out of memory", path);
+    }
+    if (fread(buf, 1, (size_t)len, f) != (size_t)len) {
+        free(buf);
+        fclose(f);
+        return fail(err, errlen, SC_ERR_IO, "%s: short read", path);
+    }
+    fclose(f);
+    buf[len] = 0;
+    *data = buf;
+    *size = (size_t)len;
+    return SC_OK;
+}
+
+/* path of a data file named in a header: relative to the header's directory */
+static void sibling_path(char *out, size_t n, const char *header_path, const char *name)
+{
+    const char *slash = strrchr(header_path, '/');
+    if (name[0] == '/' || slash == NULL) {
+        snprintf(out, n, "%s", name);
+    } else {
+        snprintf(out, n, "%.*s/%s", (int)(slash - header_path), header_path, name);
+    }
+}
+
+static size_t elem_size(sc_elem_type t)
+{
+    switch (t) {
+    case SC_ELEM_U8:
+    case SC_ELEM_I8:
+        return 1;
+    case SC_ELEM_U16:
+    case SC_ELEM_I16:
+        return 2;
+    case SC_ELEM_U32:
+    case SC_ELEM_I32:
+    case SC_ELEM_F32:
+        return 4;
+    case SC_ELEM_F64:
+    default:
+        return 8;
+    }
+}
+
+/* Decode n elements of binary data (either byte order) into doubles. */
+static void decode_binary(const uint8_t *src, size_t n, sc_elem_type t, int big_endian,
+                          double *dst)
+{
+    const size_t es = elem_size(t);
+    uint8_t b[8];
+    for (size_t i = 0; i < n; i++) {
+        const uint8_t *p = src + i * es;
+        for (size_t k = 0; k < es; k++) {
+            b[k] = big_endian ? p[es - 1u - k] : p[k]; /* b is little-endian */
+        }
+        uint64_t u = 0;
+        for (size_t k = es; k-- > 0;) {
+            u = (u << 8) | b[k];
+        }
+        switch (t) {
+        case SC_ELEM_U8:
+            dst[i] = (double)(uint8_t)u;
+            break;
+        case SC_ELEM_I8:
+            dst[i] = (double)(int8_t)(uint8_t)u;
+            break;
+        case SC_ELEM_U16:
+            dst[i] = (double)(uint16_t)u;
+            break;
+        case SC_ELEM_I16:
+            dst[i] = (double)(int16_t)(uint16_t)u;
+            break;
+        case SC_ELEM_U32:
+            dst[i] = (double)(uint32_t)u;
+            break;
+        case SC_ELEM_I32:
+            dst[i] = (double)(int32_t)(uint32_t)u;
+            break;
+        case SC_ELEM_F32: {
+            uint32_t w = (uint32_t)u;
+            float f;
+            memcpy(&f, &w, sizeof f);
+            dst[i] = (double)f;
+            break;
+        }
+        case SC_ELEM_F64:
+        default: {
+            double d;
+            memcpy(&d, &u, sizeof d);
+            dst[i] = d;
+            break;
+        }
+        }
+    }
+}
+
+/* Inflate a zlib or gzip stream (auto-detected) into exactly want bytes. */
+static int inflate_exact(const uint8_t *src, size_t srclen, uint8_t *dst, size_t want, char *err,
+                         size_t errlen)
+{
+    z_stream zs;
+    memset(&zs, 0, sizeof zs);
+    if (inflateInit2(&zs, 15 + 32) != Z_OK) {
+        return fail(err, errlen, SC_ERR_IO, "zlib init failed");
+    }
+    zs.next_in = (Bytef *)(uintptr_t)src;
+    zs.next_out = dst;
+    size_t in_left = srclen, out_left = want;
+    int zr = Z_OK;
+    while (out_left > 0u && zr != Z_STREAM_END) {
+        uInt in_chunk = in_left > 0x40000000u ? 0x40000000u : (uInt)in_left;
+        uInt out_chunk = out_left > 0x40000000u ? 0x40000000u : (uInt)out_left;
+        zs.avail_in = in_chunk;
+        zs.avail_out = out_chunk;
+        zr = inflate(&zs, Z_NO_FLUSH);
+        in_left -= in_chunk - zs.avail_in;
+        out_left -= out_chunk - zs.avail_out;
+        if (zr == Z_STREAM_END && out_left > 0u && in_left > 0u) {
+            /* concatenated gzip members (e.g. from pigz): continue */
+            if (inflateReset(&zs) != Z_OK) {
+                break;
+            }
+            zr = Z_OK;
+            continue;
+        }
+        if (zr != Z_OK && zr != Z_STREAM_END) {
+            break;
+        }
+        if (in_chunk == 0u && zr != Z_STREAM_END) {
+            break;
+        }
+    }
+    inflateEnd(&zs);
+    if (out_left != 0u) {
+        return fail(err, errlen, SC_ERR_PARSE,
+                    "compressed data inflates to %zu of %zu bytes (zlib %d)", want - out_left,
+                    want, zr);
+    }
+    return SC_OK;
+}
+
+static int set_dims(sc_image *img, const long long d[3], int nd, char *err, size_t errlen)
+{
+    for (int a = 0; a < 3; a++) {
+        long long v = a < nd ? d[a] : 1;
+        if (v < 1 || v > (long long)SC_MAX_VOLUME_DIM) {
+            return fail(err, errlen, SC_ERR_CASE_DIMS, "dimension %d = %lld outside 1..%u", a, v,
+                        SC_MAX_VOLUME_DIM);
+        }
+        img->dim[a] = (uint32_t)v;
+    }
+    uint64_t n = (uint64_t)img->dim[0] * img->dim[1] * img->dim[2];
+    if (n > SC_MAX_VOLUME_VOXELS) {
+        return fail(err, errlen, SC_ERR_CASE_DIMS, "%llu voxels above the limit %u",
+                    (unsigned long long)n, SC_MAX_VOLUME_VOXELS);
+    }
+    return SC_OK;
+}
+
+static void image_init(sc_image *img)
+{
+    memset(img, 0, sizeof *img);
+    for (int a = 0; a < 3; a++) {
+        img->spacing[a] = 1.0;
+        img->dir[a * 3 + a] = 1.0;
+    }
+}
+
+static size_t image_count(const sc_image *img)
+{
+    return (size_t)img->dim[0] * img->dim[1] * img->dim[2];
+}
+
+static char *trim(char *s)
+{
+    while (*s && isspace((unsigned char)*s)) {
+        s++;
+    }
+    char *e = s + strlen(s);
+    while (e > s && isspace((unsigned char)e[-1])) {
+        *--e = 0;
+    }
+    return s;
+}
+
+/* parse up to max doubles separated by spaces, commas or parentheses; returns the count */
+static int parse_numbers(const char *s, double *v, int max)
+{
+    int n = 0;
+    while (*s && n < max) {
+        while (*s && (isspace((unsigned char)*s) || *s == ',' || *s == '(' || *s == ')')) {
+            s++;
+        }
+        if (!*s) {
+            break;
+        }
+        char *end;
+        double d = strtod(s, &end);
+        if (end == s) {
+            return -1;
+        }
+        v[n++] = d;
+        s = end;
+    }
+    while (*s && (isspace((unsigned char)*s) || *s == ',' || *s == '(' || *s == ')')) {
+        s++;
+    }
+    return *s ? -1 : n;
+}
+
+/* ---- MetaImage ---------------------------------------------------------------------------- */
+static int met_type(const char *s, sc_elem_type *t)
+{
+    static const struct {
+        const char *name;
+        sc_elem_type t;
+    } m[] = {{"MET_UCHAR", SC_ELEM_U8},  {"MET_CHAR", SC_ELEM_I8},   {"MET_USHORT", SC_ELEM_U16},
+             {"MET_SHORT", SC_ELEM_I16}, {"MET_UINT", SC_ELEM_U32},  {"MET_INT", SC_ELEM_I32},
+             {"MET_FLOAT", SC_ELEM_F32}, {"MET_DOUBLE", SC_ELEM_F64}};
+    for (size_t i = 0; i < sizeof m / sizeof m[0]; i++) {
+        if (strcasecmp(s, m[i].name) == 0) {
+            *t = m[i].t;
+            return 0;
+        }
+    }
+    return -1;
+}
+
+static int is_true(const char *s)
+{
+    return strcasecmp(s, "true") == 0 || strcmp(s, "1") == 0;
+}
+
+static int read_metaimage(const char *path, sc_image *img, char *err, size_t errlen)
+{
+    uint8_t *file;
+    size_t fsize;
+    int rc = read_file(path, &file, &fsize, err, errlen);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    int ndims = 0, have_type = 0, compressed = 0, big = 0, channels = 1, have_spacing = 0;
+    long long dsz[3] = {1, 1, 1};
+    long long header_size = 0, comp_size = -1;
+    char datafile[1024] = "";
+    size_t pos = 0, data_off = 0;
+    int found_data = 0;
+    while (pos < fsize && !found_data) {
+        size_t eol = pos;
+        while (eol < fsize && file[eol] != '\n') {
+            eol++;
+        }
+        size_t len = eol - pos;
+        char line[2048];
+        if (len >= sizeof line) {
+            free(file);
+            return fail(err, errlen, SC_ERR_PARSE, "%s: header line too long", path);
+        }
+        memcpy(line, file + pos, len);
+        line[len] = 0;
+        pos = eol < fsize ? eol + 1u : eol;
+        char *eq = strchr(line, '=');
+        if (eq == NULL) {
+            if (trim(line)[0] == 0) {
+                continue;
+            }
+            free(file);
+            return fail(err, errlen, SC_ERR_PARSE, "%s: not a MetaImage header line: %s", path,
+                        line);
+        }
+        *eq = 0;
+        char *key = trim(line), *val = trim(eq + 1);
+        double v[9];
+        if (strcasecmp(key, "NDims") == 0) {
+            ndims = atoi(val);
+        } else if (strcasecmp(key, "DimSize") == 0) {
+            int n = parse_numbers(val, v, 3);
+            if (n < 1) {
+                free(file);
+                return fail(err, errlen, SC_ERR_PARSE, "%s: bad DimSize", path);
+            }
+            for (int a = 0; a < n; a++) {
+                dsz[a] = (long long)v[a];
+            }
+        } else if (strcasecmp(key, "ElementSpacing") == 0 ||
+                   (strcasecmp(key, "ElementSize") == 0 && !have_spacing)) {
+            /* ElementSpacing wins over ElementSize (voxel extent) when both are given */
+            have_spacing = strcasecmp(key, "ElementSpacing") == 0;
+            int n = parse_numbers(val, v, 3);
+            for (int a = 0; a < n; a++) {
+                img->spacing[a] = v[a];
+            }
+        } else if (strcasecmp(key, "Offset") == 0 || strcasecmp(key, "Origin") == 0 ||
+                   strcasecmp(key, "Position") == 0) {
+            int n = parse_numbers(val, v, 3);
+            for (int a = 0; a < n; a++) {
+                img->origin[a] = v[a];
+            }
+        } else if (strcasecmp(key, "TransformMatrix") == 0 || strcasecmp(key, "Rotation") == 0 ||
+                   strcasecmp(key, "Orientation") == 0) {
+            /* MetaIO stores the matrix column by column: the first 3 values are the
+             * direction of the first axis */
+            int n = parse_numbers(val, v, 9);
+            if (n == 9) {
+                for (int a = 0; a < 3; a++) {
+                    for (int r = 0; r < 3; r++) {
+                        img->dir[r * 3 + a] = v[a * 3 + r];
+                    }
+                }
+            } else if (n == 4 && ndims == 2) {
+                img->dir[0] = v[0];
+                img->dir[3] = v[1];
+                img->dir[1] = v[2];
+                img->dir[4] = v[3];
+            }
+        } else if (strcasecmp(key, "ElementType") == 0) {
+            if (met_type(val, &img->type) != 0) {
+                free(file);
+                return fail(err, errlen, SC_ERR_NOT_SUPPORTED, "%s: element type %s", path, val);
+            }
+            have_type = 1;
+        } else if (strcasecmp(key, "ElementNumberOfChannels") == 0) {
+            channels = atoi(val);
+        } else if (strcasecmp(key, "BinaryDataByteOrderMSB") == 0 ||
+                   strcasecmp(key, "ElementByteOrderMSB") == 0) {
+            big = is_true(val);
+        } else if (strcasecmp(key, "CompressedData") == 0) {
+            compressed = is_true(val);
+        } else if (strcasecmp(key, "CompressedDataSize") == 0) {
+            comp_size = atoll(val);
+        } else if (strcasecmp(key, "HeaderSize") == 0) {
+            header_size = atoll(val);
+        } else if (strcasecmp(key, "BinaryData") == 0) {
+            if (!is_true(val)) {
+                free(file);
+                return fail(err, errlen, SC_ERR_NOT_SUPPORTED, "%s: ASCII MetaImage data", path);
+            }
+        } else if (strcasecmp(key, "ElementDataFile") == 0) {
+            snprintf(datafile, sizeof datafile, "%s", val);
+            data_off = pos;
+            found_data = 1;
+        } /* other keys (ObjectType, AnatomicalOrientation, patient fields...): ignored */
+    }
+    if (!found_data || !have_type || (ndims != 2 && ndims != 3)) {
+        free(file);
+        return fail(err, errlen, SC_ERR_PARSE,
+                    "%s: MetaImage needs NDims 2 or 3, ElementType, ElementDataFile", path);
+    }
+    if (channels != 1) {
+        free(file);
+        return fail(err, errlen, SC_ERR_NOT_SUPPORTED, "%s: %d channels (1 supported)", path,
+                    channels);
+    }
+    rc = set_dims(img, dsz, ndims, err, errlen);
+    if (rc != SC_OK) {
+        free(file);
+        return rc;
+    }
+    const size_t n = image_count(img), raw_bytes = n * elem_size(img->type);
+    const uint8_t *src;
+    size_t srclen;
+    uint8_t *other = NULL;
+    if (strcasecmp(datafile, "LOCAL") == 0) {
+        src = file + data_off;
+        srclen = fsize - data_off;
+    } else if (strcasecmp(datafile, "LIST") == 0 || strchr(datafile, '%') != NULL) {
+        free(file);
+        return fail(err, errlen, SC_ERR_NOT_SUPPORTED, "%s: slice-list data files", path);
+    } else {
+        char dp[2048];
+        sibling_path(dp, sizeof dp, path, datafile);
+        size_t olen;
+        rc = read_file(dp, &other, &olen, err, errlen);
+        if (rc != SC_OK) {
+            free(file);
+            return rc;
+        }
+        src = other;
+        srclen = olen;
+        if (!compressed) {
+            if (header_size == -1) {
+                header_size = olen >= raw_bytes ? (long long)(olen - raw_bytes) : 0;
+            }
+            if (header_size < 0 || (size_t)header_size > olen) {
+                free(file);
+                free(other);
+                return fail(err, errlen, SC_ERR_PARSE, "%s: HeaderSize beyond the data", path);
+            }
+            src += header_size;
+            srclen -= (size_t)header_size;
+        }
+    }
+    img->data = malloc(n * sizeof(double));
+    uint8_t *raw = compressed ? malloc(raw_bytes) : NULL;
+    if (img->data == NULL || (compressed && raw == NULL)) {
+        free(file);
+        free(other);
+        free(raw);
+        free(img->data);
+        img->data = NULL;
+        return fail(err, errlen, SC_ERR_NO_SPACE, "out of memory");
+    }
+    if (compressed) {
+        size_t clen = comp_size > 0 && (size_t)comp_size <= srclen ? (size_t)comp_size : srclen;
+        rc = inflate_exact(src, clen, raw, raw_bytes, err, errlen);
+        src = raw;
+        srclen = raw_bytes;
+    } else if (srclen < raw_bytes) {
+        rc = fail(err, errlen, SC_ERR_PARSE, "%s: %zu data bytes, %zu expected", path, srclen,
+                  raw_bytes);
+    }
+    if (rc == SC_OK) {
+        decode_binary(src, n, img->type, big, img->data);
+    } else {
+        free(img->data);
+        img->data = NULL;
+    }
+    free(raw);
+    free(other);
+    free(file);
+    return rc;
+}
+
+/* ---- NRRD --------------------------------------------------------------------------------- */
+static int nrrd_type(const char *s, sc_elem_type *t)
+{
+    static const struct {
+        const char *name;
+        sc_elem_type t;
+    } m[] = {{"signed char", SC_ELEM_I8},
+             {"int8", SC_ELEM_I8},
+             {"int8_t", SC_ELEM_I8},
+             {"uchar", SC_ELEM_U8},
+             {"unsigned char", SC_ELEM_U8},
+             {"uint8", SC_ELEM_U8},
+             {"uint8_t", SC_ELEM_U8},
+             {"short", SC_ELEM_I16},
+             {"short int", SC_ELEM_I16},
+             {"signed short", SC_ELEM_I16},
+             {"signed short int", SC_ELEM_I16},
+             {"int16", SC_ELEM_I16},
+             {"int16_t", SC_ELEM_I16},
+             {"ushort", SC_ELEM_U16},
+             {"unsigned short", SC_ELEM_U16},
+             {"unsigned short int", SC_ELEM_U16},
+             {"uint16", SC_ELEM_U16},
+             {"uint16_t", SC_ELEM_U16},
+             {"int", SC_ELEM_I32},
+             {"signed int", SC_ELEM_I32},
+             {"int32", SC_ELEM_I32},
+             {"int32_t", SC_ELEM_I32},
+             {"uint", SC_ELEM_U32},
+             {"unsigned int", SC_ELEM_U32},
+             {"uint32", SC_ELEM_U32},
+             {"uint32_t", SC_ELEM_U32},
+             {"float", SC_ELEM_F32},
+             {"double", SC_ELEM_F64}};
+    for (size_t i = 0; i < sizeof m / sizeof m[0]; i++) {
+        if (strcasecmp(s, m[i].name) == 0) {
+            *t = m[i].t;
+            return 0;
+        }
+    }
+    return -1;
+}
+
+enum { ENC_RAW, ENC_GZIP, ENC_ASCII };
+
+static int read_nrrd(const char *path, sc_image *img, char *err, size_t errlen)
+{
+    uint8_t *file;
+    size_t fsize;
+    int rc = read_file(path, &file, &fsize, err, errlen);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    if (fsize < 8u || memcmp(file, "NRRD000", 7) != 0) {
+        free(file);
+        return fail(err, errlen, SC_ERR_PARSE, "%s: no NRRD magic", path);
+    }
+    int ndims = 0, have_type = 0, enc = ENC_RAW, big = 0, have_dirs = 0;
+    long long dsz[3] = {1, 1, 1};
+    long long byte_skip = 0, line_skip = 0;
+    char datafile[1024] = "";
+    size_t pos = 0;
+    int first = 1, header_done = 0;
+    while (pos < fsize) {
+        size_t eol = pos;
+        while (eol < fsize && file[eol] != '\n') {
+            eol++;
+        }
+        size_t len = eol - pos;
+        char line[2048];
+        if (len >= sizeof line) {
+            free(file);
+            return fail(err, errlen, SC_ERR_PARSE, "%s: header line too long", path);
+        }
+        memcpy(line, file + pos, len);
+        line[len] = 0;
+        pos = eol < fsize ? eol + 1u : eol;
+        if (len > 0u && line[len - 1u] == '\r') {
+            line[len - 1u] = 0;
+        }
+        if (first) {
+            first = 0;
+            continue;
+        }
+        if (line[0] == 0) {
+            header_done = 1;
+            break; /* blank line: data follows (attached) */
+        }
+        if (line[0] == '#' || strstr(line, ":=") != NULL) {
+            continue; /* comment or key/value pair: ignored by design */
+        }
+        char *colon = strstr(line, ": ");
+        if (colon == NULL) {
+            free(file);
+            return fail(err, errlen, SC_ERR_PARSE, "%s: bad NRRD field line: %s", path, line);
+        }
+        *colon = 0;
+        char *key = trim(line), *val = trim(colon + 2);
+        double v[9];
+        if (strcasecmp(key, "type") == 0) {
+            if (nrrd_type(val, &img->type) != 0) {
+                free(file);
+                return fail(err, errlen, SC_ERR_NOT_SUPPORTED, "%s: type %s", path, val);
+            }
+            have_type = 1;
+        } else if (strcasecmp(key, "dimension") == 0) {
+            ndims = atoi(val);
+        } else if (strcasecmp(key, "sizes") == 0) {
+            int n = parse_numbers(val, v, 3);
+            if (n < 1) {
+                free(file);
+                return fail(err, errlen, SC_ERR_PARSE, "%s: bad sizes", path);
+            }
+            for (int a = 0; a < n; a++) {
+                dsz[a] = (long long)v[a];
+            }
+        } else if (strcasecmp(key, "spacings") == 0 && !have_dirs) {
+            int n = parse_numbers(val, v, 3);
+            for (int a = 0; a < n; a++) {
+                img->spacing[a] = v[a];
+            }
+        } else if (strcasecmp(key, "space directions") == 0) {
+            if (strstr(val, "none") != NULL) {
+                free(file);
+                return fail(err, errlen, SC_ERR_NOT_SUPPORTED,
+                            "%s: non-spatial axes (multi-component data)", path);
+            }
+            int n = parse_numbers(val, v, 9);
+            if (n != 9) {
+                free(file);
+                return fail(err, errlen, SC_ERR_PARSE, "%s: space directions need 3 vectors",
+                            path);
+            }
+            for (int a = 0; a < 3; a++) {
+                double nrm = sqrt(v[a * 3] * v[a * 3] + v[a * 3 + 1] * v[a * 3 + 1] +
+                                  v[a * 3 + 2] * v[a * 3 + 2]);
+                img->spacing[a] = nrm;
+                for (int r = 0; r < 3; r++) {
+                    img->dir[r * 3 + a] = nrm > 0.0 ? v[a * 3 + r] / nrm : 0.0;
+                }
+            }
+            have_dirs = 1;
+        } else if (strcasecmp(key, "space origin") == 0) {
+            int n = parse_numbers(val, v, 3);
+            for (int a = 0; a < n; a++) {
+                img->origin[a] = v[a];
+            }
+        } else if (strcasecmp(key, "encoding") == 0) {
+            if (strcasecmp(val, "raw") == 0) {
+                enc = ENC_RAW;
+            } else if (strcasecmp(val, "gzip") == 0 || strcasecmp(val, "gz") == 0) {
+                enc = ENC_GZIP;
+            } else if (strcasecmp(val, "ascii") == 0 || strcasecmp(val, "text") == 0 ||
+                       strcasecmp(val, "txt") == 0) {
+                enc = ENC_ASCII;
+            } else {
+                free(file);
+                return fail(err, errlen, SC_ERR_NOT_SUPPORTED, "%s: encoding %s", path, val);
+            }
+        } else if (strcasecmp(key, "endian") == 0) {
+            big = strcasecmp(val, "big") == 0;
+        } else if (strcasecmp(key, "byte skip") == 0 || strcasecmp(key, "byteskip") == 0) {
+            byte_skip = atoll(val);
+        } else if (strcasecmp(key, "line skip") == 0 || strcasecmp(key, "lineskip") == 0) {
+            line_skip = atoll(val);
+        } else if (strcasecmp(key, "data file") == 0 || strcasecmp(key, "datafile") == 0) {
+            if (strncasecmp(val, "LIST", 4) == 0 || strchr(val, ' ') != NULL) {
+                free(file);
+                return fail(err, errlen, SC_ERR_NOT_SUPPORTED, "%s: multi-file data", path);
+            }
+            snprintf(datafile, sizeof datafile, "%s", val);
+        } /* space, kinds, centerings, units, content...: geometry already covered */
+    }
+    if (!have_type || (ndims != 2 && ndims != 3)) {
+        free(file);
+        return fail(err, errlen, SC_ERR_PARSE, "%s: NRRD needs type and dimension 2 or 3",
+                    path);
+    }
+    rc = set_dims(img, dsz, ndims, err, errlen);
+    if (rc != SC_OK) {
+        free(file);
+        return rc;
+    }
+    const uint8_t *src;
+    size_t srclen;
+    uint8_t *other = NULL;
+    if (datafile[0] != 0) {
+        char dp[2048];
+        sibling_path(dp, sizeof dp, path, datafile);
+        rc = read_file(dp, &other, &srclen, err, errlen);
+        if (rc != SC_OK) {
+            free(file);
+            return rc;
+        }
+        src = other;
+    } else {
+        if (!header_done) {
+            free(file);
+            return fail(err, errlen, SC_ERR_PARSE, "%s: no data after the header", path);
+        }
+        src = file + pos;
+        srclen = fsize - pos;
+    }
+    for (long long l = 0; l < line_skip; l++) {
+        const uint8_t *nl = memchr(src, '\n', srclen);
+        if (nl == NULL) {
+            srclen = 0;
+            break;
+        }
+        srclen -= (size_t)(nl + 1 - src);
+        src = nl + 1;
+    }
+    const size_t n = image_count(img), raw_bytes = n * elem_size(img->type);
+    if (enc == ENC_RAW) {
+        if (byte_skip == -1) {
+            byte_skip = srclen >= raw_bytes ? (long long)(srclen - raw_bytes) : 0;
+        }
+    }
+    if (byte_skip < 0 || (size_t)byte_skip > srclen) {
+        free(file);
+        free(other);
+        return fail(err, errlen, SC_ERR_PARSE, "%s: byte skip beyond the data", path);
+    }
+    if (enc != ENC_GZIP) {
+        src += byte_skip;
+        srclen -= (size_t)byte_skip;
+    }
+    img->data = malloc(n * sizeof(double));
+    uint8_t *raw = enc == ENC_GZIP ? malloc(raw_bytes) : NULL;
+    if (img->data == NULL || (enc == ENC_GZIP && raw == NULL)) {
+        free(file);
+        free(other);
+        free(raw);
+        free(img->data);
+        img->data = NULL;
+        return fail(err, errlen, SC_ERR_NO_SPACE, "out of memory");
+    }
+    if (enc == ENC_GZIP) {
+        /* byte skip applies to the decompressed data (NRRD spec) */
+        size_t skip = (size_t)byte_skip;
+        uint8_t *tmp = malloc(raw_bytes + skip);
+        rc = tmp == NULL ? SC_ERR_NO_SPACE
+                         : inflate_exact(src, srclen, tmp, raw_bytes + skip, err, errlen);
+        if (rc == SC_OK) {
+            memcpy(raw, tmp + skip, raw_bytes);
+            decode_binary(raw, n, img->type, big, img->data);
+        }
+        free(tmp);
+    } else if (enc == ENC_RAW) {
+        if (srclen < raw_bytes) {
+            rc = fail(err, errlen, SC_ERR_PARSE, "%s: %zu data bytes, %zu expected", path, srclen,
+                      raw_bytes);
+        } else {
+            decode_binary(src, n, img->type, big, img->data);
+        }
+    } else {
+        /* ascii: whitespace-separated numbers; src may not be NUL-terminated (detached) */
+        char *txt = malloc(srclen + 1u);
+        if (txt == NULL) {
+            rc = SC_ERR_NO_SPACE;
+        } else {
+            memcpy(txt, src, srclen);
+            txt[srclen] = 0;
+            char *p = txt;
+            for (size_t i = 0; i < n && rc == SC_OK; i++) {
+                char *end;
+                img->data[i] = strtod(p, &end);
+                if (end == p) {
+                    rc = fail(err, errlen, SC_ERR_PARSE, "%s: %zu ascii values, %zu expected",
+                              path, i, n);
+                }
+                p = end;
+                while (*p == ',' || isspace((unsigned char)*p)) {
+                    p++;
+                }
+            }
+            free(txt);
+        }
+    }
+    if (rc != SC_OK) {
+        free(img->data);
+        img->data = NULL;
+    }
+    free(raw);
+    free(other);
+    free(file);
+    return rc;
+}
+
+static int ends_with(const char *s, const char *suffix)
+{
+    size_t a = strlen(s), b = strlen(suffix);
+    return a >= b && strcasecmp(s + a - b, suffix) == 0;
+}
+
+int sc_image_read(const char *path, sc_image *img, char *err, size_t errlen)
+{
+    if (path == NULL || img == NULL) {
+        return fail(err, errlen, SC_ERR_INVALID_ARG, "no path");
+    }
+    image_init(img);
+    int rc;
+    if (ends_with(path, ".mha") || ends_with(path, ".mhd")) {
+        rc = read_metaimage(path, img, err, errlen);
+    } else if (ends_with(path, ".nrrd") || ends_with(path, ".nhdr")) {
+        rc = read_nrrd(path, img, err, errlen);
+    } else {
+        return fail(err, errlen, SC_ERR_NOT_SUPPORTED,
+                    "%s: unknown format (.mha .mhd .nrrd .nhdr; DICOM not built in)", path);
+    }
+    if (rc != SC_OK) {
+        return rc;
+    }
+    for (int a = 0; a < 3; a++) {
+        if (!isfinite(img->spacing[a]) || !(img->spacing[a] > 0.0) || !isfinite(img->origin[a])) {
+            sc_image_free(img);
+            return fail(err, errlen, SC_ERR_CASE_SPACING, "%s: spacing/origin not finite > 0",
+                        path);
+        }
+    }
+    /* direction cosines must be a rotation (orthonormal, det +1) */
+    const double *d = img->dir;
+    for (int a = 0; a < 3; a++) {
+        for (int b = 0; b < 3; b++) {
+            double dot = d[a] * d[b] + d[3 + a] * d[3 + b] + d[6 + a] * d[6 + b];
+            if (fabs(dot - (a == b ? 1.0 : 0.0)) > 1e-4) {
+                sc_image_free(img);
+                return fail(err, errlen, SC_ERR_CASE_TRANSFORM,
+                            "%s: direction cosines not orthonormal", path);
+            }
+        }
+    }
+    double det = d[0] * (d[4] * d[8] - d[5] * d[7]) - d[1] * (d[3] * d[8] - d[5] * d[6]) +
+                 d[2] * (d[3] * d[7] - d[4] * d[6]);
+    if (det < 0.0) {
+        sc_image_free(img);
+        return fail(err, errlen, SC_ERR_CASE_TRANSFORM,
+                    "%s: left-handed grid (det -1): flip an axis before import", path);
+    }
+    return SC_OK;
+}
+
+void sc_image_free(sc_image *img)
+{
+    if (img != NULL) {
+        free(img->data);
+        img->data = NULL;
+    }
+}
+
+/* ---- import into a case ----------------------------------------------------------------- */
+sc_import_opts sc_import_default_opts(void)
+{
+    sc_import_opts o;
+    memset(&o, 0, sizeof o);
+    o.mesh_nodes[0] = 24u;
+    o.mesh_nodes[1] = 12u;
+    o.mesh_nodes[2] = 12u;
+    return o;
+}
+
+void sc_import_result_free(sc_import_result *r)
+{
+    if (r != NULL) {
+        free(r->voxels);
+        free(r->labels);
+        r->voxels = NULL;
+        r->labels = NULL;
+    }
+}
+
+/* world point -> continuous source index */
+static void world_to_index(const sc_image *img, const double p[3], double idx[3])
+{
+    double q[3] = {p[0] - img->origin[0], p[1] - img->origin[1], p[2] - img->origin[2]};
+    for (int a = 0; a < 3; a++) {
+        double s = img->dir[a] * q[0] + img->dir[3 + a] * q[1] + img->dir[6 + a] * q[2];
+        idx[a] = s / img->spacing[a];
+    }
+}
+
+static double sample_linear(const sc_image *img, const double idx[3])
+{
+    double f[3];
+    long i0[3];
+    for (int a = 0; a < 3; a++) {
+        double c = idx[a];
+        double hi = (double)(img->dim[a] - 1u);
+        c = c < 0.0 ? 0.0 : (c > hi ? hi : c);
+        i0[a] = (long)floor(c);
+        if (i0[a] >= (long)img->dim[a] - 1) {
+            i0[a] = (long)img->dim[a] - 1;
+            f[a] = 0.0;
+        } else {
+            f[a] = c - (double)i0[a];
+        }
+    }
+    double acc = 0.0;
+    for (int c = 0; c < 8; c++) {
+        long ii[3];
+        double w = 1.0;
+        for (int a = 0; a < 3; a++) {
+            int up = (c >> a) & 1;
+            ii[a] = i0[a] + (up && f[a] > 0.0 ? 1 : 0);
+            w *= up ? f[a] : 1.0 - f[a];
+        }
+        if (w > 0.0) {
+            acc += w * img->data[(size_t)ii[0] +
+                                 img->dim[0] * ((size_t)ii[1] + (size_t)img->dim[1] * ii[2])];
+        }
+    }
+    return acc;
+}
+
+static int sample_nearest(const sc_image *img, const double idx[3], double *v)
+{
+    long ii[3];
+    for (int a = 0; a < 3; a++) {
+        ii[a] = lround(idx[a]);
+        if (ii[a] < 0 || ii[a] >= (long)img->dim[a]) {
+            return 0;
+        }
+    }
+    *v = img->data[(size_t)ii[0] + img->dim[0] * ((size_t)ii[1] + (size_t)img->dim[1] * ii[2])];
+    return 1;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+int sc_import_case(const sc_import_opts *o, sc_import_result *r, char *err, size_t errlen)
+{
+    if (o == NULL || r == NULL || o->volume_path == NULL) {
+        return fail(err, errlen, SC_ERR_INVALID_ARG, "no volume");
+    }
+    memset(r, 0, sizeof *r);
+    sc_image vol, lab;
+    int rc = sc_image_read(o->volume_path, &vol, err, errlen);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    int have_lab = 0;
+    if (o->labels_path != NULL) {
+        rc = sc_image_read(o->labels_path, &lab, err, errlen);
+        if (rc != SC_OK) {
+            sc_image_free(&vol);
+            return rc;
+        }
+        have_lab = 1;
+    }
+    /* the case grid: the volume's orientation and extent, source or requested spacing */
+    uint32_t dim[3];
+    double sp[3];
+    for (int a = 0; a < 3; a++) {
+        sp[a] = o->spacing_mm > 0.0f ? (double)o->spacing_mm : vol.spacing[a];
+        double ext = vol.spacing[a] * (double)(vol.dim[a] - 1u);
+        dim[a] = (uint32_t)floor(ext / sp[a] + 1e-6) + 1u;
+    }
+    long long dl[3] = {dim[0], dim[1], dim[2]};
+    sc_image tmp;
+    rc = set_dims(&tmp, dl, 3, err, errlen);
+    if (rc != SC_OK) {
+        goto out;
+    }
+    const size_t n = (size_t)dim[0] * dim[1] * dim[2];
+    r->voxels = malloc(n);
+    r->labels = malloc(n);
+    if (r->voxels == NULL || r->labels == NULL) {
+        rc = fail(err, errlen, SC_ERR_NO_SPACE, "out of memory");
+        goto out;
+    }
+    /* intensity window */
+    double lo = 0.0, hi = 255.0;
+    if (o->has_window) {
+        lo = (double)o->window_lo;
+        hi = (double)o->window_hi;
+    } else if (vol.type != SC_ELEM_U8) {
+        size_t vn = image_count(&vol), step = vn / 65536u + 1u, m = 0;
+        double *smp = malloc((vn / step + 1u) * sizeof(double));
+        if (smp == NULL) {
+            rc = fail(err, errlen, SC_ERR_NO_SPACE, "out of memory");
+            goto out;
+        }
+        for (size_t i = 0; i < vn; i += step) {
+            smp[m++] = vol.data[i];
+        }
+        qsort(smp, m, sizeof(double), cmp_double);
+        lo = smp[(m - 1u) / 1000u];
+        hi = smp[(m - 1u) - (m - 1u) / 1000u];
+        free(smp);
+    }
+    if (!(hi > lo)) {
+        hi = lo + 1.0;
+    }
+    size_t outside_labels = 0;
+    for (uint32_t k = 0; k < dim[2]; k++) {
+        for (uint32_t j = 0; j < dim[1]; j++) {
+            for (uint32_t i = 0; i < dim[0]; i++) {
+                size_t idx = i + (size_t)dim[0] * (j + (size_t)dim[1] * k);
+                /* world point: origin + D * (i, j, k) * sp */
+                double g[3] = {(double)i * sp[0], (double)j * sp[1], (double)k * sp[2]};
+                double p[3];
+                for (int rr = 0; rr < 3; rr++) {
+                    p[rr] = vol.origin[rr] + vol.dir[rr * 3] * g[0] + vol.dir[rr * 3 + 1] * g[1] +
+                            vol.dir[rr * 3 + 2] * g[2];
+                }
+                double si[3];
+                world_to_index(&vol, p, si);
+                double v = sample_linear(&vol, si);
+                double t = (v - lo) / (hi - lo) * 255.0;
+                t = t < 0.0 ? 0.0 : (t > 255.0 ? 255.0 : t);
+                r->voxels[idx] = (uint8_t)lrint(t);
+                uint8_t l = SC_LABEL_MUSCLE;
+                if (have_lab) {
+                    double li[3], lv = 0.0;
+                    world_to_index(&lab, p, li);
+                    if (!sample_nearest(&lab, li, &lv)) {
+                        lv = SC_LABEL_OUTSIDE; /* label map smaller than the volume */
+                        outside_labels++;
+                    }
+                    if (!(lv >= 0.0 && lv <= 255.0) || lv > floor(lv)) {
+                        rc = fail(err, errlen, SC_ERR_CASE_LABEL,
+                                  "label value %g is not an integer 0..255", lv);
+                        goto out;
+                    }
+                    l = (uint8_t)lv;
+                }
+                r->labels[idx] = l;
+            }
+        }
+    }
+    (void)outside_labels;
+    /* the case definition */
+    sc_case_def *d = &r->def;
+    *d = sc_case_default_def();
+    snprintf(r->name, sizeof r->name, "%s", o->name ? o->name : "imported");
+    if (o->description != NULL) {
+        snprintf(r->description, sizeof r->description, "%s", o->description);
+    } else {
+        snprintf(r->description, sizeof r->description,
+                 "Imported volume (voxels and geometry only), %u x %u x %u, %.3g x %.3g x %.3g mm%s.",
+                 dim[0], dim[1], dim[2], sp[0], sp[1], sp[2],
+                 have_lab ? ", with label map" : ", no label map (soft tissue)");
+    }
+    d->name = r->name;
+    d->description = r->description;
+    /* volume frame = grid axes: v = D^T (world); case origin = D^T world origin */
+    for (int a = 0; a < 3; a++) {
+        d->volume.dim[a] = dim[a];
+        d->volume.spacing_mm[a] = (float)sp[a];
+        d->volume.origin_mm[a] = (float)(vol.dir[a] * vol.origin[0] + vol.dir[3 + a] * vol.origin[1] +
+                                         vol.dir[6 + a] * vol.origin[2]);
+    }
+    for (int i = 0; i < 9; i++) {
+        d->orientation[i] = (float)vol.dir[i];
+    }
+    d->volume.voxels = r->voxels;
+    d->volume.labels = r->labels;
+    static const sc_case_material mats[] = {
+#define IM_MAT_(label, e, nu, rho) {(e), (nu), (rho)},
+        SC_MATERIAL_LIST(IM_MAT_)
+#undef IM_MAT_
+    };
+    d->material_count = (uint32_t)(sizeof mats / sizeof mats[0]);
+    memcpy(d->materials, mats, sizeof mats);
+    d->mesh.nx = o->mesh_nodes[0];
+    d->mesh.ny = o->mesh_nodes[1];
+    d->mesh.nz = o->mesh_nodes[2];
+    for (int a = 0; a < 3; a++) {
+        if (o->has_mesh_box) {
+            d->mesh.origin_mm[a] = o->mesh_box_mm[a];
+            d->mesh.size_mm[a] = o->mesh_box_mm[3 + a];
+        } else {
+            d->mesh.origin_mm[a] = d->volume.origin_mm[a];
+            d->mesh.size_mm[a] = (float)(sp[a] * (double)(dim[a] - 1u));
+        }
+    }
+    rc = SC_OK;
+out:
+    sc_image_free(&vol);
+    if (have_lab) {
+        sc_image_free(&lab);
+    }
+    if (rc != SC_OK) {
+        sc_import_result_free(r);
+    }
+    return rc;
+}

@@ -1,0 +1,79 @@
+/*
+ * sc_caseimport.h: volume and label-map import for the case builder (host tool library,
+ * allocates with malloc).
+ *
+ * Readers: MetaImage (.mha with the data inline, .mhd + a raw data file; raw or zlib/gzip
+ * compressed: CompressedData = True) and NRRD (.nrrd attached, .nhdr + detached data file;
+ * encodings raw, gzip, ascii; endian little or big). Element types: 8/16/32-bit signed and
+ * unsigned integers, float32, float64. 2D images load as a one-slice volume. Only voxels and
+ * geometry are kept (dimensions, spacing, origin, direction cosines); every other header
+ * field, including any patient metadata, is ignored and never reaches a case file.
+ *
+ * Geometry: world point of voxel (i, j, k) = origin + D * (i*sx, j*sy, k*sz) where D's columns
+ * are the directions of the grid axes (MetaImage TransformMatrix, NRRD space directions).
+ */
+#ifndef SC_CASEIMPORT_H
+#define SC_CASEIMPORT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sc_case.h"
+
+typedef enum sc_elem_type {
+    SC_ELEM_U8,
+    SC_ELEM_I8,
+    SC_ELEM_U16,
+    SC_ELEM_I16,
+    SC_ELEM_U32,
+    SC_ELEM_I32,
+    SC_ELEM_F32,
+    SC_ELEM_F64
+} sc_elem_type;
+
+typedef struct sc_image {
+    uint32_t dim[3];
+    double spacing[3];
+    double origin[3];
+    double dir[9]; /* row-major; column a = direction of grid axis a */
+    sc_elem_type type; /* element type of the file */
+    double *data;      /* dim[0]*dim[1]*dim[2] values, x fastest (malloc'd) */
+} sc_image;
+
+/* Read a MetaImage or NRRD file (by extension; .mha .mhd .nrrd .nhdr). On error returns a
+ * negative sc_err (SC_ERR_NOT_FOUND, SC_ERR_IO, SC_ERR_PARSE, SC_ERR_NOT_SUPPORTED,
+ * SC_ERR_NO_SPACE, SC_ERR_CASE_DIMS) and a message in err. */
+int sc_image_read(const char *path, sc_image *img, char *err, size_t errlen);
+void sc_image_free(sc_image *img);
+
+typedef struct sc_import_opts {
+    const char *volume_path;
+    const char *labels_path;  /* NULL: every voxel inside the body becomes SC_LABEL_MUSCLE */
+    const char *name;         /* default "imported" (never the file name: it may identify) */
+    const char *description;  /* default: "Imported volume" and the grid */
+    float spacing_mm;         /* > 0: resample to this isotropic spacing; 0: keep the source's */
+    int has_window;
+    float window_lo, window_hi; /* intensity window mapped to 0..255; default: 8-bit data as
+                                 * is, other types their 0.1 .. 99.9 percentiles */
+    uint32_t mesh_nodes[3];   /* default 24 x 12 x 12 */
+    int has_mesh_box;
+    float mesh_box_mm[6];     /* origin xyz, size xyz in the volume frame; default: the volume */
+} sc_import_opts;
+
+typedef struct sc_import_result {
+    sc_case_def def; /* ready for sc_case_write() */
+    uint8_t *voxels;
+    uint8_t *labels;
+    char name[SC_CASE_NAME_LEN];
+    char description[SC_CASE_DESCRIPTION_LEN];
+} sc_import_result;
+
+sc_import_opts sc_import_default_opts(void);
+
+/* Read, resample to the case grid (trilinear for intensities, nearest for labels, through
+ * world coordinates so the label map may have its own grid), window to 8 bits, and fill a
+ * case definition with the default material table. O(case voxels). */
+int sc_import_case(const sc_import_opts *o, sc_import_result *r, char *err, size_t errlen);
+void sc_import_result_free(sc_import_result *r);
+
+#endif /* SC_CASEIMPORT_H */
