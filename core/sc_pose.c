@@ -110,3 +110,46 @@ int sc_xform_is_rigid(const sc_xform *x, float tol)
                 x->r[2] * (x->r[3] * x->r[7] - x->r[4] * x->r[6]);
     return fabsf(det - 1.0f) <= tol;
 }
+
+sc_pose sc_pose_from_xform(const sc_xform *x)
+{
+    /* Shepperd's method: pick the largest of w, x, y, z to divide by (stable everywhere) */
+    const float *m = x->r;
+    const float tr = m[0] + m[4] + m[8];
+    float q[4];
+    if (tr > 0.0f) {
+        const float s = sqrtf(tr + 1.0f) * 2.0f;
+        q[0] = 0.25f * s;
+        q[1] = (m[7] - m[5]) / s;
+        q[2] = (m[2] - m[6]) / s;
+        q[3] = (m[3] - m[1]) / s;
+    } else if (m[0] > m[4] && m[0] > m[8]) {
+        const float s = sqrtf(1.0f + m[0] - m[4] - m[8]) * 2.0f;
+        q[0] = (m[7] - m[5]) / s;
+        q[1] = 0.25f * s;
+        q[2] = (m[1] + m[3]) / s;
+        q[3] = (m[2] + m[6]) / s;
+    } else if (m[4] > m[8]) {
+        const float s = sqrtf(1.0f + m[4] - m[0] - m[8]) * 2.0f;
+        q[0] = (m[2] - m[6]) / s;
+        q[1] = (m[1] + m[3]) / s;
+        q[2] = 0.25f * s;
+        q[3] = (m[5] + m[7]) / s;
+    } else {
+        const float s = sqrtf(1.0f + m[8] - m[0] - m[4]) * 2.0f;
+        q[0] = (m[3] - m[1]) / s;
+        q[1] = (m[2] + m[6]) / s;
+        q[2] = (m[5] + m[7]) / s;
+        q[3] = 0.25f * s;
+    }
+    const float n = sqrtf(sc_quat_norm2(q));
+    const float sign = q[0] < 0.0f ? -1.0f : 1.0f;
+    sc_pose p;
+    for (int i = 0; i < 4; i++) {
+        p.q[i] = sign * q[i] / n;
+    }
+    for (int i = 0; i < 3; i++) {
+        p.pos_mm[i] = x->t_mm[i];
+    }
+    return p;
+}

@@ -28,6 +28,8 @@ sc_xform sc_xform_compose(const sc_xform *b, const sc_xform *a);
 sc_xform sc_xform_inverse(const sc_xform *a);
 void sc_xform_apply(const sc_xform *x, const float p[3], float out[3]);
 void sc_xform_rotate(const sc_xform *x, const float v[3], float out[3]);
+/* The pose (position, unit quaternion with w >= 0) of a rigid transform. O(1). */
+sc_pose sc_pose_from_xform(const sc_xform *x);
 /* Quaternion norm squared; a pose is plausible only near 1. */
 float sc_quat_norm2(const float q[4]);
 /* 1 when every element is finite and R is orthonormal within tol (rigid, det +1). */
