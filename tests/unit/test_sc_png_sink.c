@@ -1,0 +1,139 @@
+/* test_sc_png_sink.c: the PNG display sink writes one file per frame (scan-converted raster of
+ * the configured size), never blocks the caller (a frame arriving while the writer is busy is
+ * skipped and counted), and refuses lines out of protocol. */
+#include "sc_test.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "sc_err.h"
+#include "sc_png_sink.h"
+
+static void send_frame(sc_display_dev *d, uint32_t no, uint16_t lines, int skip_line)
+{
+    const sc_display_frame_info info = {no, lines, 64u, 0u, 0u, 40.0f, 38.0f};
+    uint8_t s[64];
+    assert_int_equal(sc_display_frame_begin(d, &info), 0);
+    for (uint16_t l = 0; l < lines; l++) {
+        if ((int)l == skip_line) {
+            continue;
+        }
+        memset(s, (int)(l * 3u), sizeof s);
+        assert_int_equal(sc_display_line(d, no, l, s, 64u), 0);
+    }
+    (void)sc_display_frame_end(d, no);
+}
+
+static uint64_t wait_written(sc_png_sink *s, uint64_t n)
+{
+    sc_png_sink_stats st;
+    for (int i = 0; i < 5000; i++) {
+        sc_png_sink_get_stats(s, &st);
+        if (st.frames_written + st.write_errors >= n) {
+            break;
+        }
+        usleep(1000);
+    }
+    return st.frames_written;
+}
+
+static void each_frame_becomes_one_png_of_the_configured_size(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/sc_png_sink_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    sc_png_sink *s = NULL;
+    const sc_png_sink_def def = {.dir = dir, .width_px = 200u, .height_px = 150u};
+    assert_int_equal(sc_png_sink_open(&s, &def), 0);
+    sc_display_dev d = sc_png_sink_dev(s);
+    for (uint32_t f = 1; f <= 3u; f++) {
+        send_frame(&d, f, 32u, f == 2u ? 5 : -1);
+        assert_int_equal(wait_written(s, f), f);
+    }
+    sc_png_sink_stats st;
+    sc_png_sink_get_stats(s, &st);
+    assert_int_equal(st.frames, 3u);
+    assert_int_equal(st.frames_incomplete, 1u);
+    assert_int_equal(st.frames_busy, 0u);
+    sc_png_sink_close(s);
+    for (uint32_t f = 1; f <= 3u; f++) {
+        char path[128];
+        snprintf(path, sizeof path, "%s/frame_%06u.png", dir, f);
+        struct stat sb;
+        assert_int_equal(stat(path, &sb), 0);
+        /* grey 200 x 150 stored: 150 rows of 201 bytes plus headers */
+        assert_true(sb.st_size > 150 * 201 && sb.st_size < 150 * 201 + 200);
+        unsigned char hdr[24];
+        FILE *fp = fopen(path, "rb");
+        assert_non_null(fp);
+        assert_int_equal(fread(hdr, 1, 24, fp), 24);
+        fclose(fp);
+        assert_int_equal((hdr[16] << 24) | (hdr[17] << 16) | (hdr[18] << 8) | hdr[19], 200);
+        assert_int_equal((hdr[20] << 24) | (hdr[21] << 16) | (hdr[22] << 8) | hdr[23], 150);
+        remove(path);
+    }
+    rmdir(dir);
+}
+
+static void frames_while_the_writer_is_busy_are_skipped_not_waited_for(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/sc_png_sink_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    sc_png_sink *s = NULL;
+    const sc_png_sink_def def = {.dir = dir, .width_px = 1024u, .height_px = 1024u};
+    assert_int_equal(sc_png_sink_open(&s, &def), 0);
+    sc_display_dev d = sc_png_sink_dev(s);
+    for (uint32_t f = 0; f < 200u; f++) {
+        send_frame(&d, f, 16u, -1);
+    }
+    sc_png_sink_close(s); /* finishes the pending file */
+    /* every frame was either written or skipped; with 200 back-to-back frames of 1 MiB files
+     * the writer cannot have kept up with all of them */
+    char cmd[160];
+    snprintf(cmd, sizeof cmd, "ls %s | wc -l", dir);
+    FILE *p = popen(cmd, "r");
+    int files = 0;
+    assert_int_equal(fscanf(p, "%d", &files), 1);
+    pclose(p);
+    assert_true(files >= 1 && files < 200);
+    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+    assert_int_equal(system(cmd), 0);
+}
+
+static void protocol_violations_are_refused(void **state)
+{
+    (void)state;
+    assert_int_equal(sc_png_sink_open(&(sc_png_sink *){NULL},
+                                      &(sc_png_sink_def){.dir = "/nonexistent-dir"}),
+                     SC_ERR_NOT_FOUND);
+    sc_png_sink *s = NULL;
+    assert_int_equal(sc_png_sink_open(&s, &(sc_png_sink_def){.dir = "/tmp", .max_frames = 1u}), 0);
+    sc_display_dev d = sc_png_sink_dev(s);
+    uint8_t smp[8] = {0};
+    assert_int_equal(sc_display_line(&d, 1u, 0u, smp, 8u), SC_ERR_STATE);
+    const sc_display_frame_info bad = {1u, 0u, 8u, 0u, 0u, 40.0f, 38.0f};
+    assert_int_equal(sc_display_frame_begin(&d, &bad), SC_ERR_RANGE);
+    const sc_display_frame_info ok = {1u, 4u, 8u, 0u, 0u, 40.0f, 38.0f};
+    assert_int_equal(sc_display_frame_begin(&d, &ok), 0);
+    assert_int_equal(sc_display_line(&d, 1u, 4u, smp, 8u), SC_ERR_STATE);
+    assert_int_equal(sc_display_line(&d, 1u, 0u, smp, 7u), SC_ERR_STATE);
+    assert_int_equal(sc_display_frame_end(&d, 2u), SC_ERR_STATE);
+    sc_png_sink_stats st;
+    sc_png_sink_get_stats(s, &st);
+    assert_int_equal(st.protocol_errors, 5u);
+    sc_png_sink_close(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(each_frame_becomes_one_png_of_the_configured_size),
+        cmocka_unit_test(frames_while_the_writer_is_busy_are_skipped_not_waited_for),
+        cmocka_unit_test(protocol_violations_are_refused),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
