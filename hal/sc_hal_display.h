@@ -22,6 +22,8 @@ typedef struct sc_display_frame_info {
     uint16_t flags;       /* SC_DISPLAY_FLAG_* */
     float depth_mm;       /* imaging depth */
     float width_mm;       /* linear: aperture width; curvilinear: sector angle in degrees */
+    float radius_mm;      /* curvilinear: probe face radius (apex radius_mm behind the face,
+                           * samples from radius_mm to radius_mm + depth_mm); linear: 0 */
 } sc_display_frame_info;
 
 enum {

@@ -27,6 +27,7 @@ static int same_geom(const sc_display_frame_info *a, const sc_display_frame_info
 {
     return a->lines == b->lines && a->samples == b->samples && a->geometry_id == b->geometry_id &&
            memcmp(&a->depth_mm, &b->depth_mm, sizeof(float)) == 0 &&
+           memcmp(&a->radius_mm, &b->radius_mm, sizeof(float)) == 0 &&
            memcmp(&a->width_mm, &b->width_mm, sizeof(float)) == 0;
 }
 
@@ -57,20 +58,25 @@ static void build_linear(sc_scanconv *c, const sc_display_frame_info *g, uint32_
 static void build_sector(sc_scanconv *c, const sc_display_frame_info *g, uint32_t stride)
 {
     const double d_mm = g->depth_mm > 0.0f ? g->depth_mm : 1.0;
+    const double r0 = g->radius_mm > 0.0f ? g->radius_mm : 0.0;
+    const double r1 = r0 + d_mm;
     const double half = (g->width_mm > 0.0f ? g->width_mm : 60.0) * M_PI / 360.0;
-    const double w_mm = 2.0 * d_mm * sin(half);
-    const double s = fmax(w_mm / c->width, d_mm / c->height);
+    /* bounding box of the fan (apex at the origin, beam along +z) */
+    const double w_mm = 2.0 * r1 * sin(half);
+    const double z0 = r0 * cos(half);
+    const double h_mm = r1 - z0;
+    const double s = fmax(w_mm / c->width, h_mm / c->height);
     const double cx = c->width / 2.0;
     for (uint32_t y = 0; y < c->height; y++) {
         for (uint32_t x = 0; x < c->width; x++) {
             const double xm = (x + 0.5 - cx) * s;
-            const double zm = (y + 0.5) * s;
+            const double zm = z0 + (y + 0.5) * s;
             const double r = sqrt(xm * xm + zm * zm);
             const double a = atan2(xm, zm);
             uint32_t v = UINT32_MAX;
-            if (r < d_mm && a >= -half && a < half) {
+            if (r >= r0 && r < r1 && a >= -half && a < half) {
                 uint32_t l = (uint32_t)((a + half) / (2.0 * half) * g->lines);
-                uint32_t k = (uint32_t)(r / d_mm * g->samples);
+                uint32_t k = (uint32_t)((r - r0) / d_mm * g->samples);
                 if (l < g->lines && k < g->samples) {
                     v = l * stride + k;
                 }

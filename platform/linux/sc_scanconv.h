@@ -3,10 +3,9 @@
  * a screen or a PNG shows, preserving the image's physical aspect.
  *
  * Linear geometry: lines are columns across width_mm, samples are rows down depth_mm.
- * Curvilinear: lines fan out over a sector of width_mm degrees from a virtual apex at the top
- * centre; samples run along each line from the apex to depth_mm (the display link carries no
- * radius of curvature, so the skin-line arc is drawn from the apex; close enough to read the
- * image, and the same on every sink). Pixels outside the image are 0.
+ * Curvilinear: lines fan out over a sector of width_mm degrees from the apex, radius_mm behind
+ * the probe face; samples run along each line from radius_mm to radius_mm + depth_mm, so the
+ * probe face is the arc at the top of the raster. Pixels outside the image are 0.
  * A lookup table maps each output pixel to its source sample once per geometry, so a frame
  * costs one table walk. The table is allocated by sc_scanconv_init (host code, at start-up).
  */
