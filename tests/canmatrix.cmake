@@ -7,6 +7,11 @@ foreach(_t test_sc_candump test_sc_socketcan)
     target_compile_definitions(${_t} PRIVATE _GNU_SOURCE)
   endif()
 endforeach()
+#    The tracker emulator's generator (tools/tracker_emu) against the tracker.
+if(TARGET test_sc_trkemu AND TARGET sc_trkemu)
+  target_link_libraries(test_sc_trkemu PRIVATE sc_trkemu)
+  target_compile_definitions(test_sc_trkemu PRIVATE _GNU_SOURCE)
+endif()
 
 # 2. An independent reader of config/sonocomp.dbc: Debian's python3-canmatrix loads the DBC and
 #    decodes frames that the core codec encoded (tests/can/sc_canproto_dump prints them with the

@@ -1,0 +1,295 @@
+/* sc-tracker-emu: sends scripted probe motions as the tracker would, over SocketCAN or into a
+ * candump -l log file that the host runner replays, with faults injected on command.
+ *
+ *   sc-tracker-emu --script press|sweep|rock|lift | --csv FILE
+ *                  [--rate-hz 100] [--duration-s 10] [--fd]
+ *                  [--point X,Y,Z] [--depth-mm 10] [--hover-mm 30] [--length-mm 60]
+ *                  [--period-s 4] [--angle-deg 15] [--no-force]
+ *                  [--fault KIND[:PERIOD[:START_S]]]...  KIND: bad-crc counter-jump repeat
+ *                                                        silence implausible
+ *                  [--silence-ms 300]
+ *                  (--iface vcan0 | --log FILE|- [--log-iface vcan0] [--t0 1700000000])
+ * Summary (samples, frames, injected faults) on stderr; exit 0, 2 on a usage error, 1 on an
+ * I/O error. */
+#include <errno.h>
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "sc_candump.h"
+#include "sc_err.h"
+#include "sc_socketcan.h"
+#include "sc_trkemu.h"
+
+#define MAX_ROWS 100000u
+
+static sc_emu_row rows[MAX_ROWS];
+
+static void usage(void)
+{
+    fprintf(stderr,
+            "usage: sc-tracker-emu --script press|sweep|rock|lift | --csv FILE\n"
+            "       [--rate-hz HZ] [--duration-s S] [--fd] [--point X,Y,Z] [--depth-mm MM]\n"
+            "       [--hover-mm MM] [--length-mm MM] [--period-s S] [--angle-deg DEG]\n"
+            "       [--no-force] [--fault KIND[:PERIOD[:START_S]]]... [--silence-ms MS]\n"
+            "       (--iface IFNAME | --log FILE|- [--log-iface IFNAME] [--t0 SECONDS])\n"
+            "faults: bad-crc counter-jump repeat silence implausible\n");
+}
+
+static int parse_double(const char *s, double *out)
+{
+    char *end;
+    errno = 0;
+    const double v = strtod(s, &end);
+    if (end == s || *end != '\0' || errno != 0) {
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+static int parse_fault(char *arg, sc_emu_fault *f)
+{
+    char *kind = strtok(arg, ":");
+    char *period = strtok(NULL, ":");
+    char *start = strtok(NULL, ":");
+    if (kind == NULL || sc_emu_fault_from_name(kind, &f->kind) != 0) {
+        return -1;
+    }
+    double v = 100.0;
+    if (period && (parse_double(period, &v) != 0 || v < 1.0 || v > 1e9)) {
+        return -1;
+    }
+    f->period = (uint32_t)v;
+    f->start_s = 0.0;
+    if (start && parse_double(start, &f->start_s) != 0) {
+        return -1;
+    }
+    return 0;
+}
+
+static void sleep_until(const struct timespec *t0, uint64_t t_ns)
+{
+    struct timespec t = *t0;
+    t.tv_sec += (time_t)(t_ns / 1000000000u);
+    t.tv_nsec += (long)(t_ns % 1000000000u);
+    if (t.tv_nsec >= 1000000000L) {
+        t.tv_sec++;
+        t.tv_nsec -= 1000000000L;
+    }
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &t, NULL) == EINTR) {
+    }
+}
+
+int main(int argc, char **argv)
+{
+    sc_emu_def def = sc_emu_default_def();
+    const char *iface = NULL, *log_path = NULL, *log_iface = "vcan0", *csv = NULL;
+    double t0_s = 1700000000.0;
+    int have_script = 0;
+    static const struct option opts[] = {
+        {"script", required_argument, 0, 's'}, {"csv", required_argument, 0, 'c'},
+        {"rate-hz", required_argument, 0, 'r'}, {"duration-s", required_argument, 0, 'd'},
+        {"fd", no_argument, 0, 'F'}, {"point", required_argument, 0, 'p'},
+        {"depth-mm", required_argument, 0, 'D'}, {"hover-mm", required_argument, 0, 'H'},
+        {"length-mm", required_argument, 0, 'L'}, {"period-s", required_argument, 0, 'T'},
+        {"angle-deg", required_argument, 0, 'A'}, {"no-force", no_argument, 0, 'n'},
+        {"fault", required_argument, 0, 'f'}, {"silence-ms", required_argument, 0, 'S'},
+        {"iface", required_argument, 0, 'i'}, {"log", required_argument, 0, 'l'},
+        {"log-iface", required_argument, 0, 'I'}, {"t0", required_argument, 0, 't'},
+        {"help", no_argument, 0, 'h'}, {0, 0, 0, 0},
+    };
+    int c;
+    double v;
+    while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
+        int bad = 0;
+        switch (c) {
+        case 's':
+            bad = sc_emu_script_from_name(optarg, &def.script) != 0 || def.script == SC_EMU_CSV;
+            have_script = 1;
+            break;
+        case 'c':
+            csv = optarg;
+            def.script = SC_EMU_CSV;
+            have_script = 1;
+            break;
+        case 'r':
+            bad = parse_double(optarg, &def.rate_hz) != 0;
+            break;
+        case 'd':
+            bad = parse_double(optarg, &def.duration_s) != 0;
+            break;
+        case 'F':
+            def.fd = 1;
+            break;
+        case 'p':
+            bad = sscanf(optarg, "%f,%f,%f", &def.point_mm[0], &def.point_mm[1],
+                         &def.point_mm[2]) != 3;
+            break;
+        case 'D':
+            bad = parse_double(optarg, &v) != 0;
+            def.depth_mm = (float)v;
+            break;
+        case 'H':
+            bad = parse_double(optarg, &v) != 0;
+            def.hover_mm = (float)v;
+            break;
+        case 'L':
+            bad = parse_double(optarg, &v) != 0;
+            def.length_mm = (float)v;
+            break;
+        case 'T':
+            bad = parse_double(optarg, &def.period_s) != 0;
+            break;
+        case 'A':
+            bad = parse_double(optarg, &v) != 0;
+            def.angle_deg = (float)v;
+            break;
+        case 'n':
+            def.force_valid = 0;
+            break;
+        case 'f':
+            bad = def.n_faults >= SC_EMU_MAX_FAULTS ||
+                  parse_fault(optarg, &def.faults[def.n_faults++]) != 0;
+            break;
+        case 'S':
+            bad = parse_double(optarg, &def.silence_ms) != 0 || def.silence_ms < 0.0;
+            break;
+        case 'i':
+            iface = optarg;
+            break;
+        case 'l':
+            log_path = optarg;
+            break;
+        case 'I':
+            log_iface = optarg;
+            break;
+        case 't':
+            bad = parse_double(optarg, &t0_s) != 0 || t0_s < 0.0;
+            break;
+        case 'h':
+            usage();
+            return 0;
+        default:
+            bad = 1;
+            break;
+        }
+        if (bad) {
+            fprintf(stderr, "sc-tracker-emu: bad option value: %s\n", optarg ? optarg : "?");
+            usage();
+            return 2;
+        }
+    }
+    if (!have_script || (iface == NULL) == (log_path == NULL) || optind != argc) {
+        usage();
+        return 2;
+    }
+    if (csv) {
+        FILE *fp = fopen(csv, "r");
+        if (fp == NULL) {
+            fprintf(stderr, "sc-tracker-emu: %s: %s\n", csv, strerror(errno));
+            return 1;
+        }
+        size_t bad_line = 0;
+        const int rc = sc_emu_load_csv(fp, rows, MAX_ROWS, &def.n_rows, &bad_line);
+        fclose(fp);
+        if (rc != 0) {
+            fprintf(stderr, "sc-tracker-emu: %s:%zu: %s (want t_s,x,y,z,qw,qx,qy,qz[,force_n] "
+                            "with increasing t_s)\n",
+                    csv, bad_line, sc_err_str(rc));
+            return 2;
+        }
+        def.rows = rows;
+    }
+    sc_emu emu;
+    if (sc_emu_init(&emu, &def) != 0) {
+        fprintf(stderr, "sc-tracker-emu: invalid settings (rate, duration, period)\n");
+        return 2;
+    }
+
+    sc_socketcan node;
+    sc_can_dev dev = {0};
+    FILE *log = NULL;
+    if (iface) {
+        const int rc = sc_socketcan_open(&node, sc_socketcan_sys_posix(), NULL, iface);
+        if (rc != 0) {
+            fprintf(stderr, "sc-tracker-emu: cannot open CAN interface %s: %s (%s)\n", iface,
+                    sc_err_str(rc), strerror(errno));
+            return 1;
+        }
+        if (def.fd && !node.fd_capable) {
+            fprintf(stderr, "sc-tracker-emu: %s is not CAN FD (MTU 72 needed)\n", iface);
+            return 1;
+        }
+        dev = sc_socketcan_dev(&node);
+    } else {
+        log = strcmp(log_path, "-") == 0 ? stdout : fopen(log_path, "w");
+        if (log == NULL) {
+            fprintf(stderr, "sc-tracker-emu: %s: %s\n", log_path, strerror(errno));
+            return 1;
+        }
+    }
+
+    struct timespec start;
+    clock_gettime(CLOCK_MONOTONIC, &start);
+    const uint64_t t0_us = (uint64_t)llround(t0_s * 1e6);
+    uint64_t tx_failed = 0;
+    sc_can_frame fr[SC_EMU_MAX_FRAMES];
+    uint64_t t_ns;
+    int n;
+    while ((n = sc_emu_next(&emu, fr, SC_EMU_MAX_FRAMES, &t_ns)) >= 0) {
+        if (iface) {
+            sleep_until(&start, t_ns);
+        }
+        for (int k = 0; k < n; k++) {
+            if (iface) {
+                int rc = sc_can_send(&dev, &fr[k]);
+                for (int retry = 0; rc == SC_ERR_WOULD_BLOCK && retry < 20; retry++) {
+                    const struct timespec ws = {0, 200000};
+                    nanosleep(&ws, NULL);
+                    rc = sc_can_send(&dev, &fr[k]);
+                }
+                tx_failed += rc != 0;
+            } else {
+                /* frames of one sample 100 us apart, as back-to-back frames on a busy bus */
+                sc_candump_rec rec;
+                memset(&rec, 0, sizeof rec);
+                snprintf(rec.iface, sizeof rec.iface, "%s", log_iface);
+                rec.ts_us = t0_us + t_ns / 1000u + (uint64_t)k * 100u;
+                rec.frame = fr[k];
+                rec.frame.ts_ns = rec.ts_us * 1000u;
+                if (sc_candump_write(log, &rec) != 0) {
+                    fprintf(stderr, "sc-tracker-emu: cannot write the log\n");
+                    return 1;
+                }
+            }
+        }
+    }
+    if (n != SC_ERR_NOT_FOUND) {
+        fprintf(stderr, "sc-tracker-emu: cannot encode a pose: %s\n", sc_err_str(n));
+        return 1;
+    }
+    if (log && log != stdout) {
+        if (fclose(log) != 0) {
+            fprintf(stderr, "sc-tracker-emu: cannot write the log\n");
+            return 1;
+        }
+    }
+    if (iface) {
+        sc_socketcan_close(&node);
+    }
+    fprintf(stderr, "sc-tracker-emu: script %s, %.1f Hz, %s: samples_sent=%llu "
+                    "samples_silent=%llu frames=%llu tx_failed=%llu",
+            sc_emu_script_name(def.script), def.rate_hz, def.fd ? "fd" : "classic",
+            (unsigned long long)emu.samples_sent, (unsigned long long)emu.samples_silent,
+            (unsigned long long)emu.frames_sent, (unsigned long long)tx_failed);
+    for (int k = 0; k < (int)SC_EMU_F_COUNT; k++) {
+        fprintf(stderr, " %s=%llu", sc_emu_fault_name((sc_emu_fault_kind)k),
+                (unsigned long long)emu.injected[k]);
+    }
+    fprintf(stderr, "\n");
+    return tx_failed ? 1 : 0;
+}

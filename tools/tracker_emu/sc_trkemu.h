@@ -1,0 +1,123 @@
+/*
+ * sc_trkemu.h: the tracker emulator's generator (host code, used by sc-tracker-emu and by
+ * tests that feed the host simulator's bus in-process).
+ *
+ * Scripted probe motions in the tracker frame, sampled at rate_hz, encoded with the core codec
+ * (sc_canproto: 3 classic frames or 1 FD frame per sample, one E2E counter per sample), with
+ * faults injected on command. The probe frame follows sc_pose.h (x along the aperture, y
+ * elevation, z along the beam); base_q orients it (default beam pointing down, -Z).
+ *
+ * Scripts (skin contact point P, hover height H, press depth D along -Z):
+ *   press  hover 0.5 s, descend to P - D in 1 s, hold 1 s, rise in 1 s, hover 0.5 s; repeat
+ *   sweep  at depth D, x moves P.x -L/2 .. +L/2 and back, triangular, period T (across the neck)
+ *   rock   at depth D, tilt about the probe's y axis by A sin(2 pi t / T)
+ *   lift   descend 1 s, hold 1 s, rise in 0.5 s, then silence (nothing sent) to the end
+ *   csv    rows "t_s,x_mm,y_mm,z_mm,qw,qx,qy,qz[,force_n]", linear interpolation, nlerp
+ * Contact force (when force_valid): force_n_per_mm * penetration below P.z, else 0.
+ *
+ * Faults, each every `period` samples from start_s on (0 = off); counted in injected[]:
+ *   bad-crc       one payload bit of one frame of the sample flipped after protection
+ *   counter-jump  the counter skips 5 ahead (beyond the receiver's max delta of 3)
+ *   repeat        the sample is sent twice with the same counter
+ *   silence       nothing sent for silence_ms (longer than the 100 ms timeout by default)
+ *   implausible   cycles: quaternion norm 1.5, position outside the workspace, a 100 mm jump
+ */
+#ifndef SC_TRKEMU_H
+#define SC_TRKEMU_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "sc_canproto.h"
+
+typedef enum sc_emu_script {
+    SC_EMU_PRESS = 0,
+    SC_EMU_SWEEP,
+    SC_EMU_ROCK,
+    SC_EMU_LIFT,
+    SC_EMU_CSV,
+    SC_EMU_SCRIPT_COUNT
+} sc_emu_script;
+
+typedef enum sc_emu_fault_kind {
+    SC_EMU_F_BAD_CRC = 0,
+    SC_EMU_F_COUNTER_JUMP,
+    SC_EMU_F_REPEAT,
+    SC_EMU_F_SILENCE,
+    SC_EMU_F_IMPLAUSIBLE,
+    SC_EMU_F_COUNT
+} sc_emu_fault_kind;
+
+typedef struct sc_emu_fault {
+    sc_emu_fault_kind kind;
+    uint32_t period; /* every period-th sample; 0 = off */
+    double start_s;
+} sc_emu_fault;
+
+typedef struct sc_emu_row {
+    double t_s;
+    float pos_mm[3];
+    float q[4];
+    float force_n; /* < 0: not given */
+} sc_emu_row;
+
+#define SC_EMU_MAX_FAULTS 8u
+#define SC_EMU_MAX_FRAMES 8u /* frames one sample may produce (repeat doubles them) */
+
+typedef struct sc_emu_def {
+    sc_emu_script script;
+    double rate_hz;
+    double duration_s;
+    int fd;
+    float point_mm[3];
+    float hover_mm;
+    float depth_mm;
+    float length_mm;
+    double period_s;
+    float angle_deg;
+    float base_q[4];
+    float force_n_per_mm;
+    int force_valid;
+    double silence_ms;
+    sc_emu_fault faults[SC_EMU_MAX_FAULTS];
+    size_t n_faults;
+    const sc_emu_row *rows; /* csv script */
+    size_t n_rows;
+} sc_emu_def;
+
+/* Defaults: press at (0, 0, 0), hover 30 mm, depth 10 mm, sweep 60 mm, period 4 s, rock 15
+ * degrees, 100 Hz, 10 s, classic frames, beam down (q = 0, 1, 0, 0), 0.5 N/mm, silence 300 ms. */
+sc_emu_def sc_emu_default_def(void);
+
+typedef struct sc_emu {
+    sc_emu_def def;
+    uint64_t sample;   /* next sample index */
+    uint8_t counter;   /* next E2E counter */
+    uint64_t silent_until_ns;
+    uint32_t implausible_variant;
+    uint64_t injected[SC_EMU_F_COUNT];
+    uint64_t samples_sent;
+    uint64_t frames_sent;
+    uint64_t samples_silent; /* samples not sent (silence, lift) */
+} sc_emu;
+
+/* 0, or SC_ERR_INVALID_ARG / SC_ERR_RANGE for a bad definition (rate, duration, csv rows). */
+int sc_emu_init(sc_emu *e, const sc_emu_def *def);
+/* The scripted pose at t_s (no faults). */
+sc_pose_msg sc_emu_pose_at(const sc_emu_def *def, double t_s);
+/* Frames of the next sample (0 when silent) into out[cap >= SC_EMU_MAX_FRAMES]; *t_ns the
+ * sample time from the start. Returns the frame count, or SC_ERR_NOT_FOUND past the duration. */
+int sc_emu_next(sc_emu *e, sc_can_frame *out, size_t cap, uint64_t *t_ns);
+
+/* Loads csv rows (comma separated, '#' comments and a header line allowed, times strictly
+ * increasing). 0, or SC_ERR_PARSE with *bad_line set, SC_ERR_NO_SPACE above cap. */
+int sc_emu_load_csv(FILE *fp, sc_emu_row *rows, size_t cap, size_t *n, size_t *bad_line);
+
+const char *sc_emu_script_name(sc_emu_script s);
+const char *sc_emu_fault_name(sc_emu_fault_kind k);
+/* By name ("press", "bad-crc", ...): 0 or SC_ERR_NOT_FOUND. */
+int sc_emu_script_from_name(const char *name, sc_emu_script *out);
+int sc_emu_fault_from_name(const char *name, sc_emu_fault_kind *out);
+
+#endif /* SC_TRKEMU_H */
