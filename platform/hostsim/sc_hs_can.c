@@ -89,6 +89,23 @@ static void broadcast(sc_hs_can_bus *bus, uint32_t from, const sc_can_frame *f)
     }
 }
 
+int sc_hs_can_inject(sc_hs_can_bus *bus, uint32_t node, const sc_can_frame *frame)
+{
+    if (node >= bus->node_count) {
+        return SC_ERR_INVALID_ARG;
+    }
+    sc_hs_can_node *n = &bus->nodes[node];
+    if (n->count >= SC_HS_CAN_QUEUE) {
+        n->rx_overruns++;
+        return SC_ERR_NO_SPACE;
+    }
+    sc_hs_can_slot *s = &n->queue[(n->head + n->count) % SC_HS_CAN_QUEUE];
+    s->frame = *frame;
+    s->deliver_at_ns = 0;
+    n->count++;
+    return SC_OK;
+}
+
 void sc_hs_can_flush(sc_hs_can_bus *bus)
 {
     if (bus->held_valid) {

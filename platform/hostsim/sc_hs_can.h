@@ -85,6 +85,10 @@ sc_can_dev sc_hs_can_dev(sc_hs_can_bus *bus, uint32_t node);
 void sc_hs_can_set_faults(sc_hs_can_bus *bus, const sc_hs_can_faults *faults);
 /* Enter or leave bus-off. Entering sends a bus-off error frame to every node. */
 void sc_hs_can_set_bus_off(sc_hs_can_bus *bus, int bus_off);
+/* Put a frame straight into one node's receive queue, bypassing faults and filters, with the
+ * given time stamp; it is delivered at once. For replaying a recording. SC_ERR_NO_SPACE when
+ * the queue is full (counted as an overrun). */
+int sc_hs_can_inject(sc_hs_can_bus *bus, uint32_t node, const sc_can_frame *frame);
 /* Deliver a frame held back for reordering (call at the end of a test's traffic). */
 void sc_hs_can_flush(sc_hs_can_bus *bus);
 

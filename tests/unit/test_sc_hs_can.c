@@ -6,6 +6,7 @@
 
 #include "sc_err.h"
 #include "sc_hs_can.h"
+#include "sc_hs_can_tap.h"
 #include "sc_hs_clock.h"
 
 static sc_hs_clock clk;
@@ -178,6 +179,53 @@ static void invalid_lengths_are_refused(void **state)
     assert_int_equal(sc_can_send(&a, &f), SC_OK);
 }
 
+static uint32_t tapped;
+static uint64_t tapped_ts;
+
+static void on_tap(void *user, const sc_can_frame *f)
+{
+    (void)user;
+    tapped++;
+    tapped_ts = f->ts_ns;
+}
+
+static void tap_stamps_receive_time_and_reports_each_frame(void **state)
+{
+    (void)state;
+    sc_hs_can_tap tap;
+    tapped = 0;
+    sc_hs_can_tap_init(&tap, b, &clk_dev, on_tap, NULL);
+    sc_can_dev t = sc_hs_can_tap_dev(&tap);
+    sc_can_frame f = mk(0x100, 3), r;
+    sc_can_send(&a, &f); /* stamped 0 by the bus */
+    sc_hs_clock_advance_ns(&clk, 123456u);
+    assert_int_equal(sc_can_recv(&t, &r), SC_OK);
+    assert_int_equal(r.ts_ns, 123456u); /* the tap's stamp: time of reception */
+    assert_int_equal(tapped, 1);
+    assert_int_equal(tapped_ts, 123456u);
+    assert_int_equal(sc_can_recv(&t, &r), SC_ERR_WOULD_BLOCK);
+    assert_int_equal(tapped, 1);
+    /* sends pass through */
+    assert_int_equal(sc_can_send(&t, &f), SC_OK);
+    assert_int_equal(sc_can_recv(&a, &r), SC_OK);
+}
+
+static void inject_bypasses_faults_and_is_bounded(void **state)
+{
+    (void)state;
+    sc_hs_can_faults flt = {.drop_ppm = 1000000u};
+    sc_hs_can_set_faults(&bus, &flt);
+    sc_can_frame f = mk(0x100, 9), r;
+    assert_int_equal(sc_hs_can_inject(&bus, 1, &f), SC_OK);
+    assert_int_equal(sc_can_recv(&b, &r), SC_OK);
+    assert_int_equal(r.data[0], 9);
+    for (uint32_t i = 0; i < SC_HS_CAN_QUEUE; i++) {
+        assert_int_equal(sc_hs_can_inject(&bus, 1, &f), SC_OK);
+    }
+    assert_int_equal(sc_hs_can_inject(&bus, 1, &f), SC_ERR_NO_SPACE);
+    assert_int_equal(sc_hs_can_inject(&bus, 7, &f), SC_ERR_INVALID_ARG);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -188,6 +236,8 @@ int main(void)
         cmocka_unit_test_setup(delay_holds_frames_until_virtual_time_passes, setup),
         cmocka_unit_test_setup(bus_off_refuses_sends_and_reports_error_frames, setup),
         cmocka_unit_test_setup(invalid_lengths_are_refused, setup),
+        cmocka_unit_test_setup(tap_stamps_receive_time_and_reports_each_frame, setup),
+        cmocka_unit_test_setup(inject_bypasses_faults_and_is_bounded, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
