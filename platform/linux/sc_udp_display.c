@@ -92,7 +92,7 @@ static int udp_frame_begin(void *ctx, const sc_display_frame_info *info)
     u->frame_sent = 0;
     u->frame_dropped = 0;
     const sc_dlink_begin b = {info->depth_mm, info->width_mm,
-                              info->geometry_id == 1u ? u->radius_mm : 0.0f, u->compression_pm};
+                              info->geometry_id == 1u ? info->radius_mm : 0.0f, u->compression_pm};
     int len = sc_dlink_encode_begin(u->pkt, sizeof u->pkt, &u->frame, &b);
     if (len < 0) {
         u->protocol_errors++;
@@ -179,9 +179,8 @@ sc_display_dev sc_udp_display_dev(sc_udp_display *u)
     return d;
 }
 
-void sc_udp_display_set_extra(sc_udp_display *u, float radius_mm, uint16_t compression_pm)
+void sc_udp_display_set_compression(sc_udp_display *u, uint16_t compression_pm)
 {
-    u->radius_mm = radius_mm;
     u->compression_pm = compression_pm;
 }
 

@@ -41,7 +41,6 @@ typedef struct sc_udp_display {
     sc_dlink_frame frame;
     uint16_t frame_sent;
     uint16_t frame_dropped;
-    float radius_mm;         /* carried in FRAME_BEGIN (curvilinear) */
     uint16_t compression_pm; /* carried in FRAME_BEGIN */
     uint32_t inject_drop_permille;
     uint32_t rng;
@@ -60,8 +59,9 @@ sc_udp_display_def sc_udp_display_default_def(void);
  * SC_ERR_IO (socket error; errno in last_errno), SC_ERR_RANGE (drop permille above 1000). */
 int sc_udp_display_open(sc_udp_display *u, const sc_udp_display_def *def);
 sc_display_dev sc_udp_display_dev(sc_udp_display *u);
-/* Values for the next FRAME_BEGIN that hal frame info does not carry. */
-void sc_udp_display_set_extra(sc_udp_display *u, float radius_mm, uint16_t compression_pm);
+/* The vessels' compression measure (permille, or SC_DLINK_COMPRESSION_UNKNOWN) for the next
+ * FRAME_BEGINs: hal frame info does not carry it. */
+void sc_udp_display_set_compression(sc_udp_display *u, uint16_t compression_pm);
 void sc_udp_display_close(sc_udp_display *u);
 
 #endif /* SC_UDP_DISPLAY_H */

@@ -55,7 +55,7 @@ static uint32_t drain(int fd)
 
 static void send_frame(sc_display_dev *dev, uint32_t frame_no, uint16_t lines, uint16_t samples)
 {
-    const sc_display_frame_info info = {frame_no, lines, samples, 0u, 1u, 40.0f, 38.0f};
+    const sc_display_frame_info info = {frame_no, lines, samples, 0u, 1u, 40.0f, 38.0f, 0.0f};
     uint8_t s[SC_MAX_SCAN_SAMPLES];
     (void)sc_display_frame_begin(dev, &info);
     for (uint16_t l = 0; l < lines; l++) {
@@ -163,7 +163,7 @@ static void calls_out_of_order_are_refused_and_counted(void **state)
     uint8_t s[16] = {0};
     assert_int_equal(sc_display_line(&dev, 1u, 0u, s, 16u), SC_ERR_STATE);
     assert_int_equal(sc_display_frame_end(&dev, 1u), SC_ERR_STATE);
-    const sc_display_frame_info info = {1u, 4u, 16u, 0u, 0u, 40.0f, 38.0f};
+    const sc_display_frame_info info = {1u, 4u, 16u, 0u, 0u, 40.0f, 38.0f, 0.0f};
     assert_int_equal(sc_display_frame_begin(&dev, &info), 0);
     assert_int_equal(sc_display_line(&dev, 1u, 4u, s, 16u), SC_ERR_DLINK_FIELD);
     assert_int_equal(sc_display_line(&dev, 1u, 0u, s, 15u), SC_ERR_DLINK_FIELD);
