@@ -299,9 +299,33 @@ int sc_iso_extract(const sc_volume *vol, const sc_iso_opts *o, sc_iso_mesh *out)
                             break;
                         }
                     }
-                    for (int m = 1; m + 1 < len; m++) {
-                        uint32_t tri[3] = {(uint32_t)gv[loop[0]], (uint32_t)gv[loop[m]],
-                                           (uint32_t)gv[loop[m + 1]]};
+                    /* the face walk winds the loop clockwise seen from outside the label:
+                     * emit reversed. Loops of 4+ vertices get a centre vertex so that the
+                     * only edges shared between cubes are the face segments (a fan's
+                     * chords could meet another cube's chords on an ambiguous face) */
+                    if (len == 3) {
+                        uint32_t tri[3] = {(uint32_t)gv[loop[0]], (uint32_t)gv[loop[2]],
+                                           (uint32_t)gv[loop[1]]};
+                        if (gb_push(&tris, tri) != 0) {
+                            rc = SC_ERR_NO_SPACE;
+                        }
+                        continue;
+                    }
+                    float cen[3] = {0.0f, 0.0f, 0.0f};
+                    for (int m = 0; m < len; m++) {
+                        const float *q = (const float *)verts.p + (size_t)gv[loop[m]] * 3u;
+                        cen[0] += q[0] / (float)len;
+                        cen[1] += q[1] / (float)len;
+                        cen[2] += q[2] / (float)len;
+                    }
+                    if (gb_push(&verts, cen) != 0) {
+                        rc = SC_ERR_NO_SPACE;
+                        break;
+                    }
+                    uint32_t cv = (uint32_t)(verts.n - 1u);
+                    for (int m = 0; m < len; m++) {
+                        uint32_t tri[3] = {cv, (uint32_t)gv[loop[(m + 1) % len]],
+                                           (uint32_t)gv[loop[m]]};
                         if (gb_push(&tris, tri) != 0) {
                             rc = SC_ERR_NO_SPACE;
                             break;

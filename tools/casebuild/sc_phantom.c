@@ -61,8 +61,10 @@ static void scene_init(scene *s, sc_phantom_kind kind)
     } else {
         /* groin: CFV medial (10-12 mm), CFA lateral (8-9 mm), femoral nerve lateral to it */
         int dvt = kind == SC_PHANTOM_FEMORAL_DVT;
-        s->v[0] = (sc_phantom_vessel){SC_LABEL_VEIN, -5.5f, 18.0f, dvt ? 6.5f : 6.0f,
-                                      dvt ? 6.0f : 5.0f, 0.4f, -0.02f, dvt};
+        /* the thrombosed vein is distended (rounder, larger, bulging medially) */
+        s->v[0] = (sc_phantom_vessel){SC_LABEL_VEIN,      dvt ? -6.5f : -5.5f, 18.0f,
+                                      dvt ? 6.5f : 6.0f,  dvt ? 6.0f : 5.0f,   0.4f,
+                                      -0.02f,             dvt};
         s->v[1] = (sc_phantom_vessel){SC_LABEL_ARTERY, 5.5f, 17.0f, 4.2f, 4.2f, 1.0f, -0.015f, 0};
         s->nerve_x = 13.0f;
         s->nerve_z = 16.0f;

@@ -1,0 +1,13 @@
+# Tests of the case builder libraries (tools/casebuild) and the Linux case storage: each
+# tests/casebuild/test_*.c is one cmocka executable and one ctest test, label "casebuild".
+file(GLOB _casebuild_tests CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/casebuild/test_*.c)
+foreach(_src ${_casebuild_tests})
+  get_filename_component(_name ${_src} NAME_WE)
+  add_executable(${_name} ${_src})
+  target_compile_options(${_name} PRIVATE ${SC_WARN} -Wno-missing-prototypes)
+  target_compile_definitions(${_name} PRIVATE _GNU_SOURCE SC_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+                                              SC_BINARY_DIR="${PROJECT_BINARY_DIR}")
+  target_link_libraries(${_name} PRIVATE sc_phantom sc_caseimport sc_linux sc_test_support)
+  add_test(NAME ${_name} COMMAND ${_name})
+  set_tests_properties(${_name} PROPERTIES LABELS casebuild TIMEOUT 600)
+endforeach()

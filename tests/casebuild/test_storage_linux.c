@@ -1,0 +1,161 @@
+/* test_storage_linux.c: the Linux hal storage maps case files read-only, names missing and
+ * unreadable files, and a corrupt file on disk is refused by the loader through it. */
+#include "sc_test.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "sc_case.h"
+#include "sc_err.h"
+#include "sc_labels.h"
+#include "sc_storage_linux.h"
+
+static char g_dir[128];
+
+static void write_file(const char *name, const uint8_t *data, size_t n)
+{
+    char p[256];
+    snprintf(p, sizeof p, "%s/%s", g_dir, name);
+    FILE *f = fopen(p, "wb");
+    assert_non_null(f);
+    if (n) {
+        assert_int_equal(fwrite(data, 1, n, f), n);
+    }
+    assert_int_equal(fclose(f), 0);
+}
+
+static size_t make_case(uint8_t **out)
+{
+    static uint8_t vox[8 * 8 * 8], lab[8 * 8 * 8];
+    for (size_t i = 0; i < sizeof vox; i++) {
+        vox[i] = (uint8_t)i;
+        lab[i] = (uint8_t)(i % SC_LABEL_COUNT);
+    }
+    sc_case_def d = sc_case_default_def();
+    d.name = "tiny";
+    for (int a = 0; a < 3; a++) {
+        d.volume.dim[a] = 8;
+        d.volume.spacing_mm[a] = 1.0f;
+    }
+    d.volume.voxels = vox;
+    d.volume.labels = lab;
+    d.material_count = SC_LABEL_COUNT;
+    for (uint32_t m = 0; m < SC_LABEL_COUNT; m++) {
+        d.materials[m] = (sc_case_material){1e4f, 0.45f, 1000.0f};
+    }
+    d.mesh.nx = d.mesh.ny = d.mesh.nz = 4;
+    for (int a = 0; a < 3; a++) {
+        d.mesh.origin_mm[a] = 0.0f;
+        d.mesh.size_mm[a] = 7.0f;
+    }
+    size_t need = sc_case_encoded_size(&d), n = 0;
+    *out = malloc(need);
+    assert_int_equal(sc_case_write(&d, *out, need, &n), SC_OK);
+    return n;
+}
+
+static void mapped_case_loads_and_points_into_the_mapping(void **state)
+{
+    (void)state;
+    uint8_t *bytes;
+    size_t n = make_case(&bytes);
+    write_file("tiny.scase", bytes, n);
+    sc_storage_linux st;
+    sc_storage_linux_init(&st, g_dir);
+    sc_storage_dev dev = sc_storage_linux_dev(&st);
+    const uint8_t *data = NULL;
+    size_t size = 0;
+    assert_int_equal(sc_storage_open(&dev, "tiny.scase", &data, &size), SC_OK);
+    assert_int_equal(size, n);
+    assert_int_equal(st.open_count, 1);
+    assert_memory_equal(data, bytes, n);
+    sc_case c;
+    assert_int_equal(sc_case_load(data, size, &c), SC_OK);
+    assert_true(c.volume.voxels >= data && c.volume.voxels < data + size);
+    assert_string_equal(c.name, "tiny");
+    sc_storage_close(&dev, data, size);
+    assert_int_equal(st.open_count, 0);
+    /* an absolute path ignores the base directory */
+    char p[256];
+    snprintf(p, sizeof p, "%s/tiny.scase", g_dir);
+    sc_storage_linux_init(&st, "/nonexistent");
+    assert_int_equal(sc_storage_open(&dev, p, &data, &size), SC_OK);
+    sc_storage_close(&dev, data, size);
+    free(bytes);
+}
+
+static void missing_unreadable_and_empty_files_are_named(void **state)
+{
+    (void)state;
+    sc_storage_linux st;
+    sc_storage_linux_init(&st, g_dir);
+    sc_storage_dev dev = sc_storage_linux_dev(&st);
+    const uint8_t *data = NULL;
+    size_t size = 0;
+    assert_int_equal(sc_storage_open(&dev, "nope.scase", &data, &size), SC_ERR_NOT_FOUND);
+    assert_true(st.last_errno != 0);
+    /* a directory is not a case */
+    char p[256];
+    snprintf(p, sizeof p, "%s/adir", g_dir);
+    assert_int_equal(mkdir(p, 0700), 0);
+    assert_int_equal(sc_storage_open(&dev, "adir", &data, &size), SC_ERR_IO);
+    /* an empty file maps as size 0 and the loader calls it truncated */
+    write_file("empty.scase", NULL, 0);
+    assert_int_equal(sc_storage_open(&dev, "empty.scase", &data, &size), SC_OK);
+    assert_int_equal(size, 0);
+    sc_case c;
+    assert_int_equal(sc_case_load(data, size, &c), SC_ERR_CASE_TRUNCATED);
+    sc_storage_close(&dev, data, size);
+    assert_int_equal(sc_storage_open(&dev, "", &data, &size), SC_ERR_INVALID_ARG);
+}
+
+static void corrupt_file_on_disk_is_refused_through_storage(void **state)
+{
+    (void)state;
+    uint8_t *bytes;
+    size_t n = make_case(&bytes);
+    bytes[n - 100u] ^= 0x10u; /* a bit in the XFRM payload: bytes n-128 .. n-33 */
+    write_file("bad.scase", bytes, n);
+    write_file("cut.scase", bytes, n / 2u);
+    sc_storage_linux st;
+    sc_storage_linux_init(&st, g_dir);
+    sc_storage_dev dev = sc_storage_linux_dev(&st);
+    const uint8_t *data;
+    size_t size;
+    sc_case c;
+    assert_int_equal(sc_storage_open(&dev, "bad.scase", &data, &size), SC_OK);
+    assert_int_equal(sc_case_load(data, size, &c), SC_ERR_CASE_CRC);
+    sc_storage_close(&dev, data, size);
+    assert_int_equal(sc_storage_open(&dev, "cut.scase", &data, &size), SC_OK);
+    assert_int_equal(sc_case_load(data, size, &c), SC_ERR_CASE_TRUNCATED);
+    sc_storage_close(&dev, data, size);
+    free(bytes);
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    snprintf(g_dir, sizeof g_dir, "/tmp/sc_storage_XXXXXX");
+    return mkdtemp(g_dir) == NULL ? -1 : 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    char cmd[200];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_dir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(mapped_case_loads_and_points_into_the_mapping),
+        cmocka_unit_test(missing_unreadable_and_empty_files_are_named),
+        cmocka_unit_test(corrupt_file_on_disk_is_refused_through_storage),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
