@@ -342,7 +342,9 @@ static sc_trk_outcome classify_and_handle(sc_tracker *t, const sc_can_frame *f, 
     if (m == SC_MSG_POSE_FD && !t->def.accept_fd) {
         return SC_TRK_FD_DISABLED;
     }
-    const uint64_t ts_ns = f->ts_ns != 0u ? f->ts_ns : now_ns;
+    /* receive times at microsecond resolution, the candump log's: a replayed log then gives
+     * every time-dependent decision (speed, timeout) exactly as the live run did */
+    const uint64_t ts_ns = (f->ts_ns != 0u ? f->ts_ns : now_ns) / 1000u * 1000u;
     sc_e2e_rx *rx = &t->rx[m];
     const uint32_t lost_before = rx->lost;
     const sc_e2e_status s = sc_e2e_check(rx, f->data, f->len, ts_ns);

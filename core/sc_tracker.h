@@ -18,7 +18,9 @@
  *    takes from;
  *  - records controller error frames (SC_CAN_ERRF_* classes) for the health state;
  *  - encodes the engine's status frames with its own E2E sender states.
- * Every outcome is counted (saturating uint32).
+ * Every outcome is counted (saturating uint32). Receive times (frame time stamp, else now_ns)
+ * are used rounded down to whole microseconds, the resolution of a candump -l log, so that
+ * replaying a recorded log reproduces every time-dependent decision bit for bit.
  *
  * Thread and memory rules: one sc_tracker object, caller-owned (inside the engine object),
  * used from one thread. Never allocates, never calls the OS; deterministic for a given frame
@@ -92,7 +94,7 @@ typedef struct sc_trk_sample {
     float force_n;
     uint8_t force_valid;
     uint8_t counter;   /* E2E counter of the sample */
-    uint64_t rx_ns;    /* receive time (frame time stamp, else now_ns of on_frame) */
+    uint64_t rx_ns;    /* receive time (frame time stamp, else now_ns), whole microseconds */
 } sc_trk_sample;
 
 typedef struct sc_trk_counters {
