@@ -5,10 +5,11 @@
  * Host tool library: allocates with malloc.
  *
  * Marching cubes here polygonises each cube by walking its faces (the segments on each face
- * connect the edge crossings, the inside corners of an ambiguous face are kept apart), so
- * neighbouring cubes always agree on their shared face and the surface is closed and
- * 2-manifold; triangles are wound counter-clockwise seen from outside (normals point out of
- * the label).
+ * connect the edge crossings at their midpoints; the inside corners of an ambiguous face are
+ * kept apart), so neighbouring cubes always agree on their shared face; each closed loop of
+ * 4+ crossings is fanned around an added centre vertex, so the only edges two cubes share
+ * are face segments and the surface is closed and 2-manifold. Triangles are wound
+ * counter-clockwise seen from outside (normals point out of the label).
  */
 #ifndef SC_ISOSURFACE_H
 #define SC_ISOSURFACE_H
