@@ -6,3 +6,9 @@ foreach(_t test_sc_udp_display test_sc_png_write test_sc_png_sink test_sc_log_li
     target_compile_definitions(${_t} PRIVATE _GNU_SOURCE)
   endif()
 endforeach()
+
+# The viewer's GIF writer is tested against an independent decoder.
+if(TARGET test_sc_viewer_gif)
+  target_sources(test_sc_viewer_gif PRIVATE ${PROJECT_SOURCE_DIR}/tools/viewer/vw_gif.c)
+  target_include_directories(test_sc_viewer_gif PRIVATE ${PROJECT_SOURCE_DIR}/tools/viewer)
+endif()
