@@ -8,9 +8,14 @@ foreach(_t test_sc_candump test_sc_socketcan)
   endif()
 endforeach()
 #    The tracker emulator's generator (tools/tracker_emu) against the tracker.
-if(TARGET test_sc_trkemu AND TARGET sc_trkemu)
-  target_link_libraries(test_sc_trkemu PRIVATE sc_trkemu)
-  target_compile_definitions(test_sc_trkemu PRIVATE _GNU_SOURCE)
+foreach(_t test_sc_trkemu test_can_tracker_bus)
+  if(TARGET ${_t} AND TARGET sc_trkemu)
+    target_link_libraries(${_t} PRIVATE sc_trkemu)
+    target_compile_definitions(${_t} PRIVATE _GNU_SOURCE)
+  endif()
+endforeach()
+if(TARGET test_can_tracker_bus AND TARGET sc_linux)
+  target_link_libraries(test_can_tracker_bus PRIVATE sc_linux m)
 endif()
 
 # 2. An independent reader of config/sonocomp.dbc: Debian's python3-canmatrix loads the DBC and
