@@ -50,7 +50,8 @@ static const char *const k_target_names[] = {"none", "udp", "png", "drm", "fbdev
 /* The key table. Numeric ranges and defaults come from sc_config.h where the engine has a
  * compile-time limit; every default passes its own range check (test_sc_rtcfg). */
 static const key_def k_keys[] = {
-    {"can.interface", "SocketCAN interface of the tracker bus", K_IFNAME, F(can_interface),
+    {"can.interface", "SocketCAN interface of the tracker bus; none: no CAN (probe lifted)",
+     K_IFNAME, F(can_interface),
      TXT(SC_RTCFG_IFNAME_MAX, "can0", "an interface name of 1..15 characters [A-Za-z0-9_.-]")},
     {"display.target", "where the B-scan lines go (docs/display-link.md for udp)", K_TARGET,
      F(display_target),
@@ -59,7 +60,7 @@ static const key_def k_keys[] = {
     {"frame_rate_hz", "frames per second (one physics step and one image per frame)", K_U32,
      F(frame_rate_hz), NUM(SC_FRAME_RATE_MIN_HZ, SC_FRAME_RATE_MAX_HZ, SC_FRAME_RATE_DEFAULT_HZ)},
     {"case", "case file loaded at start", K_PATH, F(case_path),
-     TXT(SC_RTCFG_PATH_MAX, "cases/neck.sccase", "a file path")},
+     TXT(SC_RTCFG_PATH_MAX, "cases/neck-ijv.scase", "a file path")},
     {"physics.method", "soft-tissue solver (switchable at run time over CAN)", K_ENUM,
      F(physics_method), ENUM("msds", "msds | fem", k_method_names)},
     {"physics.iterations", "solver iterations per frame (paper: 20)", K_U32,
@@ -98,7 +99,7 @@ static const key_def k_keys[] = {
     {"watchdog.timeout_ms", "watchdog timeout in milliseconds", K_U32, F(watchdog_timeout_ms),
      NUM(100, 60000, 1000)},
     {"tracker.timeout_ms", "no valid pose for this long means the probe is lifted", K_U32,
-     F(tracker_timeout_ms), NUM(10, 5000, 200)},
+     F(tracker_timeout_ms), NUM(10, 5000, 100)},
     {"log.level", "lowest level of log records written", K_ENUM, F(log_level),
      ENUM("info", "debug | info | warn | error", k_log_names)},
     {"status.line", "live status line once a second (auto: when stderr is a terminal)", K_ENUM,
