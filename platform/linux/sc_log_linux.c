@@ -100,6 +100,7 @@ static void emit_line(sc_log_linux *l, const char *line, size_t n)
 
 static void drain(sc_log_linux *l)
 {
+    pthread_mutex_lock(&l->drain_lock);
     unsigned tail = atomic_load_explicit(&l->tail, memory_order_relaxed);
     unsigned head = atomic_load_explicit(&l->head, memory_order_acquire);
     while (tail != head) {
@@ -113,6 +114,7 @@ static void drain(sc_log_linux *l)
         atomic_store_explicit(&l->tail, tail, memory_order_release);
         atomic_fetch_add(&l->written, 1u);
     }
+    pthread_mutex_unlock(&l->drain_lock);
 }
 
 static void *writer_main(void *arg)
@@ -163,6 +165,7 @@ int sc_log_linux_start(sc_log_linux *l, int fd, sc_log_level min_level)
     atomic_init(&l->written, 0u);
     atomic_init(&l->running, 1);
     pthread_mutex_init(&l->lock, NULL);
+    pthread_mutex_init(&l->drain_lock, NULL);
     if (pthread_create(&l->thread, NULL, writer_main, l) != 0) {
         atomic_store(&l->running, 0);
         return SC_ERR_IO;
@@ -211,6 +214,7 @@ void sc_log_linux_msg(sc_log_linux *l, sc_log_level level, const char *event, co
             n += (size_t)m < sizeof line - n ? (size_t)m : sizeof line - n - 1u;
         }
     }
+    drain(l); /* records logged before this message go out before it */
     pthread_mutex_lock(&l->lock);
     emit_line(l, line, n);
     pthread_mutex_unlock(&l->lock);

@@ -7,7 +7,8 @@
  * (SC_LOG_LINUX_RING records, single producer: the engine thread) and a writer thread formats
  * and writes them; a full ring drops the record and counts it. Platform messages from other
  * code (start-up, shutdown; free text) and the status line are written directly under the
- * writer's lock, so lines never interleave. When the status line is on, a log line first
+ * writer's lock, so lines never interleave; a platform message first drains the ring, so
+ * records keep their order. When the status line is on, a log line first
  * clears it ("\r\033[K") and the next status update redraws it.
  *
  * Allocation: none after sc_log_linux_start (the ring is inside the struct). Thread rules:
@@ -49,6 +50,7 @@ typedef struct sc_log_linux {
     pthread_t thread;
     int thread_started;
     pthread_mutex_t lock;    /* one line at a time on fd */
+    pthread_mutex_t drain_lock; /* one consumer of the ring at a time */
     sc_log_linux_rec ring[SC_LOG_LINUX_RING];
 } sc_log_linux;
 
