@@ -1,7 +1,7 @@
 /* sc-casebuild: build, inspect and verify sonocomp case files.
  *
  *   sc-casebuild phantom <neck-ijv|femoral|femoral-dvt> -o OUT.scase [--seed N] [--spacing MM]
- *   sc-casebuild import --volume V.{mha,mhd,nrrd,nhdr} [--labels L.{...}] -o OUT.scase
+ *   sc-casebuild import --volume V.{mha,mhd,nrrd,nhdr,dcm}|DICOMDIR/ [--labels L.{...}] -o OUT.scase
  *                [--name NAME] [--description TEXT] [--spacing MM] [--window LO:HI]
  *                [--mesh-nodes NX,NY,NZ] [--mesh-box X0,Y0,Z0,SX,SY,SZ]
  *   sc-casebuild info CASE.scase
@@ -40,7 +40,8 @@ static int usage(void)
             "  sc-casebuild import --volume FILE [--labels FILE] -o OUT.scase [--name NAME]\n"
             "               [--description TEXT] [--spacing MM] [--window LO:HI]\n"
             "               [--mesh-nodes NX,NY,NZ] [--mesh-box X0,Y0,Z0,SX,SY,SZ]\n"
-            "               (FILE: .mha, .mhd, .nrrd, .nhdr; raw or compressed)\n"
+            "               (FILE: .mha, .mhd, .nrrd, .nhdr, raw or compressed; .dcm or a DICOM\n"
+            "                series folder when built with DCMTK)\n"
             "  sc-casebuild info CASE\n"
             "  sc-casebuild verify CASE...\n"
             "  sc-casebuild slice CASE --axis x|y|z --index N -o OUT.pgm [--labels]\n"

@@ -14,6 +14,10 @@
 #include "sc_err.h"
 #include "sc_labels.h"
 #include "sc_materials.h"
+#ifdef SC_HAVE_DCMTK
+#include "sc_dicom.h"
+#endif
+#include <sys/stat.h>
 
 static int fail(char *err, size_t errlen, int rc, const char *fmt, ...)
 {
@@ -771,13 +775,31 @@ int sc_image_read(const char *path, sc_image *img, char *err, size_t errlen)
     }
     image_init(img);
     int rc;
+    struct stat st;
+    const int is_dir = stat(path, &st) == 0 && S_ISDIR(st.st_mode);
     if (ends_with(path, ".mha") || ends_with(path, ".mhd")) {
         rc = read_metaimage(path, img, err, errlen);
     } else if (ends_with(path, ".nrrd") || ends_with(path, ".nhdr")) {
         rc = read_nrrd(path, img, err, errlen);
+    } else if (is_dir || ends_with(path, ".dcm") || ends_with(path, ".dicom")) {
+#ifdef SC_HAVE_DCMTK
+        rc = sc_dicom_read(path, img, err, errlen);
+        if (rc == SC_OK) {
+            long long d[3] = {img->dim[0], img->dim[1], img->dim[2]};
+            rc = set_dims(img, d, 3, err, errlen);
+            if (rc != SC_OK) {
+                sc_image_free(img);
+                return rc;
+            }
+        }
+#else
+        return fail(err, errlen, SC_ERR_NOT_SUPPORTED,
+                    "%s: DICOM support not built (install libdcmtk-dev and reconfigure)", path);
+#endif
     } else {
         return fail(err, errlen, SC_ERR_NOT_SUPPORTED,
-                    "%s: unknown format (.mha .mhd .nrrd .nhdr; DICOM not built in)", path);
+                    "%s: unknown format (.mha .mhd .nrrd .nhdr, .dcm or a DICOM series folder)",
+                    path);
     }
     if (rc != SC_OK) {
         return rc;

@@ -19,26 +19,7 @@
 #include <stdint.h>
 
 #include "sc_case.h"
-
-typedef enum sc_elem_type {
-    SC_ELEM_U8,
-    SC_ELEM_I8,
-    SC_ELEM_U16,
-    SC_ELEM_I16,
-    SC_ELEM_U32,
-    SC_ELEM_I32,
-    SC_ELEM_F32,
-    SC_ELEM_F64
-} sc_elem_type;
-
-typedef struct sc_image {
-    uint32_t dim[3];
-    double spacing[3];
-    double origin[3];
-    double dir[9]; /* row-major; column a = direction of grid axis a */
-    sc_elem_type type; /* element type of the file */
-    double *data;      /* dim[0]*dim[1]*dim[2] values, x fastest (malloc'd) */
-} sc_image;
+#include "sc_image.h"
 
 /* Read a MetaImage or NRRD file (by extension; .mha .mhd .nrrd .nhdr). On error returns a
  * negative sc_err (SC_ERR_NOT_FOUND, SC_ERR_IO, SC_ERR_PARSE, SC_ERR_NOT_SUPPORTED,
