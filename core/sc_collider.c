@@ -1,0 +1,376 @@
+/* sc_collider.c: probe collider (sphere / rounded box) with libccd MPR; see sc_collider.h. */
+#include "sc_collider.h"
+
+#include <math.h>
+#include <stddef.h>
+
+#include <ccd/ccd.h>
+
+#include "sc_assert.h"
+#include "sc_err.h"
+
+sc_collider_def sc_collider_default_def(void)
+{
+    sc_collider_def d;
+    d.shape = SC_COLLIDER_ROUNDED_BOX;
+    d.sphere_radius_mm = 10.0f;
+    d.half_mm[0] = 20.0f;
+    d.half_mm[1] = 5.0f;
+    d.half_mm[2] = 10.0f;
+    d.round_radius_mm = 2.0f;
+    d.margin_mm = 0.5f;
+    return d;
+}
+
+int sc_collider_def_validate(const sc_collider_def *d)
+{
+    if (d == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    if (!isfinite(d->sphere_radius_mm) || !isfinite(d->half_mm[0]) || !isfinite(d->half_mm[1]) ||
+        !isfinite(d->half_mm[2]) || !isfinite(d->round_radius_mm) || !isfinite(d->margin_mm)) {
+        return SC_ERR_NOT_FINITE;
+    }
+    if (d->margin_mm < 0.0f || d->margin_mm > 100.0f) {
+        return SC_ERR_RANGE;
+    }
+    switch (d->shape) {
+    case SC_COLLIDER_SPHERE:
+        return (d->sphere_radius_mm > 0.0f && d->sphere_radius_mm < 1000.0f) ? SC_OK
+                                                                           : SC_ERR_RANGE;
+    case SC_COLLIDER_ROUNDED_BOX:
+        if (d->round_radius_mm < 0.0f) {
+            return SC_ERR_RANGE;
+        }
+        for (uint32_t i = 0; i < 3u; i++) {
+            if (!(d->half_mm[i] > d->round_radius_mm) || d->half_mm[i] > 1000.0f) {
+                return SC_ERR_RANGE;
+            }
+        }
+        return SC_OK;
+    default:
+        return SC_ERR_INVALID_ARG;
+    }
+}
+
+int sc_collider_init(sc_collider *c, const sc_collider_def *def)
+{
+    if (c == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    const int rc = sc_collider_def_validate(def);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    c->def = *def;
+    c->active = 0;
+    c->to_vol = sc_xform_identity();
+    c->to_probe = sc_xform_identity();
+    if (def->shape == SC_COLLIDER_SPHERE) {
+        c->core_half_mm[0] = c->core_half_mm[1] = c->core_half_mm[2] = 0.0f;
+        c->center_probe_mm[2] = -def->sphere_radius_mm;
+    } else {
+        for (uint32_t i = 0; i < 3u; i++) {
+            c->core_half_mm[i] = def->half_mm[i] - def->round_radius_mm;
+        }
+        c->center_probe_mm[2] = -def->half_mm[2];
+    }
+    c->center_probe_mm[0] = 0.0f;
+    c->center_probe_mm[1] = 0.0f;
+    return SC_OK;
+}
+
+int sc_collider_set_pose(sc_collider *c, const sc_pose *pose)
+{
+    SC_ASSERT(c != NULL);
+    c->active = 0;
+    if (pose == NULL) {
+        return SC_OK;
+    }
+    for (uint32_t i = 0; i < 3u; i++) {
+        if (!isfinite(pose->pos_mm[i])) {
+            return SC_ERR_POSE_IMPLAUSIBLE;
+        }
+    }
+    const float n2 = sc_quat_norm2(pose->q);
+    if (!isfinite(n2) || fabsf(n2 - 1.0f) > 1e-3f) {
+        return SC_ERR_POSE_IMPLAUSIBLE;
+    }
+    c->to_vol = sc_xform_from_pose(pose);
+    c->to_probe = sc_xform_inverse(&c->to_vol);
+    c->active = 1;
+    return SC_OK;
+}
+
+/* ---- libccd objects ---------------------------------------------------------------------- */
+
+typedef struct ccd_probe {
+    const sc_collider *c;
+    double inflate_mm; /* sphere radius added to the core (rounding + margin) */
+    double hint[3];    /* interior point that MPR starts its ray from (volume frame) */
+} ccd_probe;
+
+typedef struct ccd_point {
+    double p[3];
+} ccd_point;
+
+static void probe_support(const void *obj, const ccd_vec3_t *dir, ccd_vec3_t *out)
+{
+    const ccd_probe *o = obj;
+    const sc_collider *c = o->c;
+    const float *r = c->to_vol.r;
+    /* direction in the probe frame: R^T dir */
+    double dl[3];
+    for (uint32_t i = 0; i < 3u; i++) {
+        dl[i] = (double)r[i] * dir->v[0] + (double)r[3u + i] * dir->v[1] +
+                (double)r[6u + i] * dir->v[2];
+    }
+    const double len = sqrt(dl[0] * dl[0] + dl[1] * dl[1] + dl[2] * dl[2]);
+    double sl[3];
+    for (uint32_t i = 0; i < 3u; i++) {
+        const double h = (double)c->core_half_mm[i];
+        sl[i] = (double)c->center_probe_mm[i] + (dl[i] > 0.0 ? h : (dl[i] < 0.0 ? -h : 0.0));
+        if (len > 0.0) {
+            sl[i] += o->inflate_mm * dl[i] / len;
+        }
+    }
+    for (uint32_t i = 0; i < 3u; i++) {
+        out->v[i] = (double)r[3u * i] * sl[0] + (double)r[3u * i + 1u] * sl[1] +
+                    (double)r[3u * i + 2u] * sl[2] + (double)c->to_vol.t_mm[i];
+    }
+}
+
+/* MPR casts its ray from this interior point of the probe towards the node and returns the
+ * surface it hits: starting from the point of the core box nearest to the node makes that ray
+ * the exact minimal-translation direction of the swept box (the geometric centre would send
+ * nodes near the ends of a long footprint out sideways). */
+static void probe_center(const void *obj, ccd_vec3_t *out)
+{
+    const ccd_probe *o = obj;
+    out->v[0] = o->hint[0];
+    out->v[1] = o->hint[1];
+    out->v[2] = o->hint[2];
+}
+
+/* Nearest point of the core box to the probe-frame point l; if l is inside the core, a point
+ * 0.01 mm inward from l along the normal of the nearest core face. Result in the volume frame. */
+static void core_hint(const sc_collider *c, const float l[3], double out[3])
+{
+    float q[3];
+    float best = 1e30f;
+    uint32_t best_axis = 0u;
+    int inside = 1;
+    for (uint32_t i = 0; i < 3u; i++) {
+        const float rel = l[i] - c->center_probe_mm[i];
+        const float h = c->core_half_mm[i];
+        float cl = rel > h ? h : (rel < -h ? -h : rel);
+        if (rel > h || rel < -h) {
+            inside = 0;
+        }
+        const float gap = h - fabsf(rel);
+        if (gap < best) {
+            best = gap;
+            best_axis = i;
+        }
+        q[i] = cl + c->center_probe_mm[i];
+    }
+    if (inside) {
+        const float rel = l[best_axis] - c->center_probe_mm[best_axis];
+        q[best_axis] = l[best_axis] - (rel >= 0.0f ? 0.01f : -0.01f);
+    }
+    float v[3];
+    sc_xform_apply(&c->to_vol, q, v);
+    out[0] = (double)v[0];
+    out[1] = (double)v[1];
+    out[2] = (double)v[2];
+}
+
+static void point_support(const void *obj, const ccd_vec3_t *dir, ccd_vec3_t *out)
+{
+    (void)dir;
+    const ccd_point *o = obj;
+    out->v[0] = o->p[0];
+    out->v[1] = o->p[1];
+    out->v[2] = o->p[2];
+}
+
+static void point_center(const void *obj, ccd_vec3_t *out)
+{
+    const ccd_point *o = obj;
+    out->v[0] = o->p[0];
+    out->v[1] = o->p[1];
+    out->v[2] = o->p[2];
+}
+
+/* ---- detection --------------------------------------------------------------------------- */
+
+static float inflate_of(const sc_collider *c)
+{
+    return (c->def.shape == SC_COLLIDER_SPHERE ? c->def.sphere_radius_mm
+                                               : c->def.round_radius_mm) +
+           c->def.margin_mm;
+}
+
+static void index_range(float lo, float hi, float origin, float cell, uint32_t n, uint32_t *i0,
+                        uint32_t *i1)
+{
+    if (n <= 1u) {
+        *i0 = 0u;
+        *i1 = n; /* exclusive */
+        return;
+    }
+    float a = floorf((lo - origin) / cell);
+    float b = ceilf((hi - origin) / cell);
+    if (!(a >= 0.0f)) {
+        a = 0.0f;
+    }
+    if (!(b <= (float)(n - 1u))) {
+        b = (float)(n - 1u);
+    }
+    if (!(b >= a) || a > (float)(n - 1u) || b < 0.0f) {
+        *i0 = 0u;
+        *i1 = 0u;
+        return;
+    }
+    *i0 = (uint32_t)a;
+    *i1 = (uint32_t)b + 1u;
+}
+
+void sc_collider_detect(const sc_collider *c, const sc_collider_grid *g, const float *x,
+                        const float *y, const float *z, const uint8_t *fixed,
+                        float max_disp_mm, sc_contact_set *out)
+{
+    SC_ASSERT(c != NULL && g != NULL && out != NULL);
+    SC_ASSERT(g->nx * g->ny * g->nz <= SC_MAX_CONTACTS);
+    out->count = 0u;
+    out->candidates = 0u;
+    out->mpr_calls = 0u;
+    if (!c->active) {
+        return;
+    }
+    const float infl = inflate_of(c);
+    const float widen = infl + (isfinite(max_disp_mm) && max_disp_mm > 0.0f ? max_disp_mm : 0.0f);
+    /* AABB of the core box (or centre) in the volume frame, widened */
+    float lo[3], hi[3], cen[3];
+    sc_xform_apply(&c->to_vol, c->center_probe_mm, cen);
+    for (uint32_t i = 0; i < 3u; i++) {
+        const float *r = &c->to_vol.r[3u * i];
+        const float ext = fabsf(r[0]) * c->core_half_mm[0] + fabsf(r[1]) * c->core_half_mm[1] +
+                          fabsf(r[2]) * c->core_half_mm[2];
+        lo[i] = cen[i] - ext - widen;
+        hi[i] = cen[i] + ext + widen;
+    }
+    uint32_t r0[3], r1[3];
+    index_range(lo[0], hi[0], g->origin_mm[0], g->cell_mm[0], g->nx, &r0[0], &r1[0]);
+    index_range(lo[1], hi[1], g->origin_mm[1], g->cell_mm[1], g->ny, &r0[1], &r1[1]);
+    index_range(lo[2], hi[2], g->origin_mm[2], g->cell_mm[2], g->nz, &r0[2], &r1[2]);
+
+    ccd_t ccd;
+    CCD_INIT(&ccd);
+    ccd.support1 = probe_support;
+    ccd.center1 = probe_center;
+    ccd.support2 = point_support;
+    ccd.center2 = point_center;
+    ccd.max_iterations = 100u;
+    ccd.mpr_tolerance = 1e-6;
+    ccd_probe probe = {c, (double)infl, {0.0, 0.0, 0.0}};
+    const float lim[3] = {c->core_half_mm[0] + infl, c->core_half_mm[1] + infl,
+                          c->core_half_mm[2] + infl};
+
+    for (uint32_t k = r0[2]; k < r1[2]; k++) {
+        for (uint32_t j = r0[1]; j < r1[1]; j++) {
+            for (uint32_t i = r0[0]; i < r1[0]; i++) {
+                const uint32_t n = i + g->nx * (j + g->ny * k);
+                if (fixed != NULL && fixed[n] != 0u) {
+                    continue;
+                }
+                out->candidates++;
+                const float p[3] = {x[n], y[n], z[n]};
+                float l[3];
+                sc_xform_apply(&c->to_probe, p, l);
+                /* conservative: outside the inflated shape's box in the probe frame */
+                if (fabsf(l[0] - c->center_probe_mm[0]) > lim[0] ||
+                    fabsf(l[1] - c->center_probe_mm[1]) > lim[1] ||
+                    fabsf(l[2] - c->center_probe_mm[2]) > lim[2]) {
+                    continue;
+                }
+                const ccd_point pt = {{(double)p[0], (double)p[1], (double)p[2]}};
+                core_hint(c, l, probe.hint);
+                ccd_real_t depth = 0.0;
+                ccd_vec3_t dir, pos;
+                out->mpr_calls++;
+                if (ccdMPRPenetration(&probe, &pt, &ccd, &depth, &dir, &pos) != 0) {
+                    continue;
+                }
+                const double dl =
+                    sqrt(dir.v[0] * dir.v[0] + dir.v[1] * dir.v[1] + dir.v[2] * dir.v[2]);
+                if (!(dl > 0.0) || !isfinite(depth)) {
+                    continue;
+                }
+                /* moving the node by depth along dir reaches the inflated surface; the real
+                 * surface is margin closer */
+                const double d_real = depth - (double)c->def.margin_mm;
+                sc_contact *ct = &out->c[out->count++];
+                ct->node = n;
+                for (uint32_t a = 0; a < 3u; a++) {
+                    const double u = dir.v[a] / dl;
+                    ct->n[a] = (float)u;
+                    ct->p_mm[a] = (float)((double)p[a] + d_real * u);
+                }
+            }
+        }
+    }
+}
+
+float sc_contact_depth_mm(const sc_contact *ct, float x, float y, float z)
+{
+    return ct->n[0] * (ct->p_mm[0] - x) + ct->n[1] * (ct->p_mm[1] - y) +
+           ct->n[2] * (ct->p_mm[2] - z);
+}
+
+void sc_contact_add_forces(const sc_contact_set *s, const float *x, const float *y,
+                           const float *z, const float *kappa_n_per_mm, float kappa_scale,
+                           float *fx, float *fy, float *fz)
+{
+    for (uint32_t q = 0; q < s->count; q++) {
+        const sc_contact *ct = &s->c[q];
+        const uint32_t n = ct->node;
+        const float d = sc_contact_depth_mm(ct, x[n], y[n], z[n]);
+        if (d > 0.0f) {
+            const float f = kappa_n_per_mm[n] * kappa_scale * d;
+            fx[n] += f * ct->n[0];
+            fy[n] += f * ct->n[1];
+            fz[n] += f * ct->n[2];
+        }
+    }
+}
+
+void sc_contact_clear_forces(const sc_contact_set *s, float *fx, float *fy, float *fz)
+{
+    for (uint32_t q = 0; q < s->count; q++) {
+        const uint32_t n = s->c[q].node;
+        fx[n] = 0.0f;
+        fy[n] = 0.0f;
+        fz[n] = 0.0f;
+    }
+}
+
+float sc_collider_signed_distance_mm(const sc_collider *c, const float p_mm[3])
+{
+    if (!c->active) {
+        return 1e30f;
+    }
+    float l[3];
+    sc_xform_apply(&c->to_probe, p_mm, l);
+    const float rad =
+        c->def.shape == SC_COLLIDER_SPHERE ? c->def.sphere_radius_mm : c->def.round_radius_mm;
+    float q[3], out2 = 0.0f, inmax = -1e30f;
+    for (uint32_t i = 0; i < 3u; i++) {
+        q[i] = fabsf(l[i] - c->center_probe_mm[i]) - c->core_half_mm[i];
+        const float qp = q[i] > 0.0f ? q[i] : 0.0f;
+        out2 += qp * qp;
+        inmax = q[i] > inmax ? q[i] : inmax;
+    }
+    const float box = sqrtf(out2) + (inmax < 0.0f ? inmax : 0.0f);
+    return box - rad;
+}
