@@ -8,6 +8,7 @@
  *   sc-casebuild verify CASE.scase...
  *   sc-casebuild slice CASE.scase --axis x|y|z --index N -o OUT.pgm [--labels]
  *   sc-casebuild isosurface CASE.scase --label L -o OUT.{ply,obj} [--sigma MM] [--iterations N]
+ *   sc-casebuild bench [--repeat N] CASE.scase...   (validating loader timing, a table)
  *
  * Exit status: 0 success, 1 a case refused / an input unreadable, 2 usage.
  */
@@ -16,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "sc_case.h"
 #include "sc_caseimport.h"
@@ -46,7 +48,8 @@ static int usage(void)
             "  sc-casebuild verify CASE...\n"
             "  sc-casebuild slice CASE --axis x|y|z --index N -o OUT.pgm [--labels]\n"
             "  sc-casebuild isosurface CASE --label L -o OUT.ply|OUT.obj [--sigma MM] "
-            "[--iterations N]\n");
+            "[--iterations N]\n"
+            "  sc-casebuild bench [--repeat N] CASE...   (loader timing table)\n");
     return 2;
 }
 
@@ -423,6 +426,71 @@ static int cmd_slice(int argc, char **argv)
     return 0;
 }
 
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
+}
+
+static int cmp_dbl(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Load time of the validating loader (CRC of every byte + one label pass) per case. */
+static int cmd_bench(int argc, char **argv)
+{
+    int repeat = 11;
+    int first = 0;
+    if (argc >= 2 && strcmp(argv[0], "--repeat") == 0) {
+        repeat = atoi(argv[1]);
+        first = 2;
+        repeat = repeat < 1 ? 1 : (repeat > 1000 ? 1000 : repeat);
+    }
+    if (argc <= first) {
+        return usage();
+    }
+    printf("%-40s %10s %10s %9s %9s %9s %9s\n", "case", "MB", "voxels", "map ms",
+           "load min", "load med", "GB/s");
+    int bad = 0;
+    for (int i = first; i < argc; i++) {
+        sc_storage_linux st;
+        sc_storage_linux_init(&st, NULL);
+        sc_storage_dev dev = sc_storage_linux_dev(&st);
+        const uint8_t *data;
+        size_t size;
+        double t0 = now_ms();
+        int rc = sc_storage_open(&dev, argv[i], &data, &size);
+        double t_map = now_ms() - t0;
+        if (rc != SC_OK) {
+            fprintf(stderr, "%s: %s\n", argv[i], sc_err_name(rc));
+            bad = 1;
+            continue;
+        }
+        double *t = malloc((size_t)repeat * sizeof *t);
+        sc_case c;
+        for (int r = 0; r < repeat && rc == SC_OK; r++) {
+            double a = now_ms();
+            rc = sc_case_load(data, size, &c);
+            t[r] = now_ms() - a;
+        }
+        if (rc != SC_OK) {
+            fprintf(stderr, "%s: REFUSED: %s\n", argv[i], sc_err_name(rc));
+            bad = 1;
+        } else {
+            qsort(t, (size_t)repeat, sizeof *t, cmp_dbl);
+            printf("%-40s %10.2f %10" PRIu64 " %9.3f %9.2f %9.2f %9.2f\n", argv[i],
+                   (double)size / 1e6, c.voxel_count, t_map, t[0], t[repeat / 2],
+                   (double)size / 1e6 / t[repeat / 2]);
+        }
+        free(t);
+        sc_storage_close(&dev, data, size);
+    }
+    return bad;
+}
+
 static int cmd_isosurface(int argc, char **argv)
 {
     if (argc < 1) {
@@ -506,6 +574,9 @@ int main(int argc, char **argv)
     }
     if (strcmp(cmd, "isosurface") == 0) {
         return cmd_isosurface(argc - 2, argv + 2);
+    }
+    if (strcmp(cmd, "bench") == 0) {
+        return cmd_bench(argc - 2, argv + 2);
     }
     return usage();
 }
