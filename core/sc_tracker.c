@@ -7,6 +7,9 @@
 
 _Static_assert(SC_MSG_CMD_CASE == 0 && SC_MSG_POSE_FD == 7, "rx message indices 0..7");
 _Static_assert(SC_TRK_RX_MSGS == (unsigned)SC_MSG_POSE_FD + 1u, "rx state per message");
+/* 1,104 bytes on x86_64 with the default SC_CAN_CMD_QUEUE_MAX of 8: 8 E2E receivers of 64 B,
+ * 2 assembly slots of 56 B, the command FIFO (28 B each), counters (116 B). */
+_Static_assert(sizeof(sc_tracker) <= 1200u + 28u * SC_CAN_CMD_QUEUE_MAX, "tracker state grew");
 
 sc_tracker_def sc_tracker_default_def(void)
 {

@@ -24,7 +24,7 @@
  *
  * Thread and memory rules: one sc_tracker object, caller-owned (inside the engine object),
  * used from one thread. Never allocates, never calls the OS; deterministic for a given frame
- * sequence and time stamps. sizeof(sc_tracker) is about 1 KiB.
+ * sequence and time stamps. sizeof(sc_tracker) = 1,104 bytes (x86_64, default limits).
  */
 #ifndef SC_TRACKER_H
 #define SC_TRACKER_H
