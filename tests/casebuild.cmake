@@ -11,3 +11,9 @@ foreach(_src ${_casebuild_tests})
   add_test(NAME ${_name} COMMAND ${_name})
   set_tests_properties(${_name} PROPERTIES LABELS casebuild TIMEOUT 600)
 endforeach()
+
+# The phantom cases the build ships (target `cases`) must pass the loader.
+add_test(NAME casebuild_cases_verify
+         COMMAND sc-casebuild verify ${CMAKE_BINARY_DIR}/cases/neck-ijv.scase
+                 ${CMAKE_BINARY_DIR}/cases/femoral.scase ${CMAKE_BINARY_DIR}/cases/femoral-dvt.scase)
+set_tests_properties(casebuild_cases_verify PROPERTIES LABELS casebuild TIMEOUT 120)

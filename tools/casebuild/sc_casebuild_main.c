@@ -4,6 +4,7 @@
  *   sc-casebuild import --volume V.{mha,mhd,nrrd,nhdr,dcm}|DICOMDIR/ [--labels L.{...}] -o OUT.scase
  *                [--name NAME] [--description TEXT] [--spacing MM] [--window LO:HI]
  *                [--mesh-nodes NX,NY,NZ] [--mesh-box X0,Y0,Z0,SX,SY,SZ]
+ *                [--calibration 12 numbers] [--registration 12 numbers] (row-major R, then t)
  *   sc-casebuild info CASE.scase
  *   sc-casebuild verify CASE.scase...
  *   sc-casebuild slice CASE.scase --axis x|y|z --index N -o OUT.pgm [--labels]
@@ -42,6 +43,8 @@ static int usage(void)
             "  sc-casebuild import --volume FILE [--labels FILE] -o OUT.scase [--name NAME]\n"
             "               [--description TEXT] [--spacing MM] [--window LO:HI]\n"
             "               [--mesh-nodes NX,NY,NZ] [--mesh-box X0,Y0,Z0,SX,SY,SZ]\n"
+            "               [--calibration R00,..,R22,TX,TY,TZ]  (image -> probe, mm)\n"
+            "               [--registration R00,..,R22,TX,TY,TZ] (tracker -> mannequin, mm)\n"
             "               (FILE: .mha, .mhd, .nrrd, .nhdr, raw or compressed; .dcm or a DICOM\n"
             "                series folder when built with DCMTK)\n"
             "  sc-casebuild info CASE\n"
@@ -327,6 +330,14 @@ static int cmd_import(int argc, char **argv)
             o.mesh_nodes[0] = (uint32_t)v[0];
             o.mesh_nodes[1] = (uint32_t)v[1];
             o.mesh_nodes[2] = (uint32_t)v[2];
+        } else if (strcmp(a, "--calibration") == 0 || strcmp(a, "--registration") == 0) {
+            float v[12];
+            if (parse_floats(val, v, 12) != 0) {
+                return usage();
+            }
+            sc_xform *x = a[2] == 'c' ? &o.image_to_probe : &o.tracker_to_patient;
+            memcpy(x->r, v, sizeof x->r);
+            memcpy(x->t_mm, v + 9, sizeof x->t_mm);
         } else if (strcmp(a, "--mesh-box") == 0) {
             if (parse_floats(val, o.mesh_box_mm, 6) != 0) {
                 return usage();

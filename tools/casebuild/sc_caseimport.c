@@ -849,6 +849,8 @@ sc_import_opts sc_import_default_opts(void)
     o.mesh_nodes[0] = 24u;
     o.mesh_nodes[1] = 12u;
     o.mesh_nodes[2] = 12u;
+    o.image_to_probe = sc_xform_identity();
+    o.tracker_to_patient = sc_xform_identity();
     return o;
 }
 
@@ -1059,6 +1061,8 @@ int sc_import_case(const sc_import_opts *o, sc_import_result *r, char *err, size
     };
     d->material_count = (uint32_t)(sizeof mats / sizeof mats[0]);
     memcpy(d->materials, mats, sizeof mats);
+    d->image_to_probe = o->image_to_probe;
+    d->tracker_to_patient = o->tracker_to_patient;
     d->mesh.nx = o->mesh_nodes[0];
     d->mesh.ny = o->mesh_nodes[1];
     d->mesh.nz = o->mesh_nodes[2];

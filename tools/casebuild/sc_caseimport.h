@@ -39,6 +39,8 @@ typedef struct sc_import_opts {
     uint32_t mesh_nodes[3];   /* default 24 x 12 x 12 */
     int has_mesh_box;
     float mesh_box_mm[6];     /* origin xyz, size xyz in the volume frame; default: the volume */
+    sc_xform image_to_probe;      /* probe calibration; default identity */
+    sc_xform tracker_to_patient;  /* mannequin registration; default identity */
 } sc_import_opts;
 
 typedef struct sc_import_result {
