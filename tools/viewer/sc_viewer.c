@@ -58,6 +58,7 @@ typedef struct vw_opts {
     uint32_t gif_every;
     const char *screenshot;
     uint32_t width, height;
+    double hold_s; /* keep the window showing the last frame this long before exiting */
     int quiet;
 } vw_opts;
 
@@ -279,6 +280,7 @@ static void usage(FILE *f)
             "      --gif-every N     every N-th shown frame goes into the GIF (default 2)\n"
             "      --screenshot FILE PNG of the window content at exit\n"
             "      --size WxH        raster / window size (default 640x640)\n"
+            "      --hold S          keep the window open S seconds after the end\n"
             "  -q, --quiet           no per-second status on stderr\n"
             "  -h, --help            this help\n"
             "  -V, --version         version\n\n"
@@ -315,7 +317,7 @@ int main(int argc, char **argv)
     vw_opts o = {.bind_addr = "0.0.0.0", .port = 5600u, .png_every = 1u, .gif_every = 2u,
                  .width = 640u, .height = 640u};
     enum { OPT_HEADLESS = 1000, OPT_IDLE, OPT_PNG, OPT_PNG_EVERY, OPT_GIF, OPT_GIF_EVERY,
-           OPT_SHOT, OPT_SIZE };
+           OPT_SHOT, OPT_SIZE, OPT_HOLD };
     static const struct option lo[] = {
         {"port", required_argument, NULL, 'p'},      {"bind", required_argument, NULL, 'b'},
         {"headless", no_argument, NULL, OPT_HEADLESS}, {"frames", required_argument, NULL, 'n'},
@@ -326,6 +328,7 @@ int main(int argc, char **argv)
         {"gif-every", required_argument, NULL, OPT_GIF_EVERY},
         {"screenshot", required_argument, NULL, OPT_SHOT},
         {"size", required_argument, NULL, OPT_SIZE}, {"quiet", no_argument, NULL, 'q'},
+        {"hold", required_argument, NULL, OPT_HOLD},
         {"help", no_argument, NULL, 'h'},            {"version", no_argument, NULL, 'V'},
         {NULL, 0, NULL, 0}};
     int c;
@@ -365,6 +368,12 @@ int main(int argc, char **argv)
             break;
         case OPT_PNG:
             o.png_dir = optarg;
+            break;
+        case OPT_HOLD:
+            if (parse_double(optarg, &o.hold_s) || o.hold_s > 3600.0) {
+                fprintf(stderr, "sc-viewer: --hold %s: expected seconds\n", optarg);
+                return 2;
+            }
             break;
         case OPT_PNG_EVERY:
         case OPT_GIF_EVERY:
@@ -630,6 +639,24 @@ int main(int argc, char **argv)
             rc = 1;
         }
     }
+#ifdef SC_VIEWER_SDL
+    if (tex && o.hold_s > 0.0 && !g_signal) {
+        const double until = now_s() + o.hold_s;
+        while (now_s() < until && !g_signal) {
+            SDL_Event ev;
+            while (SDL_PollEvent(&ev)) {
+                if (ev.type == SDL_QUIT) {
+                    g_signal = SIGINT;
+                }
+            }
+            SDL_RenderClear(ren);
+            SDL_RenderCopy(ren, tex, NULL, NULL);
+            SDL_RenderPresent(ren);
+            struct timespec nap = {0, 50 * 1000 * 1000};
+            nanosleep(&nap, NULL);
+        }
+    }
+#endif
     uint32_t gif_frames = 0;
     if (gif_open) {
         gif_frames = gif.frames;
