@@ -6,7 +6,7 @@
 # candump -L records the bus on its own. Then both logs are replayed through the tracker.
 # Checks on the host: every injected fault counted live, the kernel filter dropped the foreign
 # id, every frame had a kernel time stamp, and the replays of our log and of candump's log
-# reach the same verdicts as the live run. Classic CAN and CAN FD.
+# reach the same verdicts as the live run. Classic CAN and CAN FD; the listener runs as nobody.
 #   tools/hil/can-test.sh HIL_BUILD_DIR WORKDIR
 set -euo pipefail
 [ $# -eq 2 ] || { echo "usage: $0 HIL_BUILD_DIR WORKDIR" >&2; exit 2; }
@@ -18,13 +18,19 @@ cp "$hil_build/tools/tracker_emu/sc-tracker-emu" "$hil_build/tools/tracker_emu/s
    "$work/payload/"
 cat > "$work/payload/test.sh" <<'T'
 cd /tmp
+# the listener runs unprivileged, as the engine does on the appliance
+mkdir -p /etc
+grep -q '^nobody:' /etc/passwd 2>/dev/null || echo 'nobody:x:65534:65534:nobody:/tmp:/bin/sh' >> /etc/passwd
+grep -q '^nogroup:' /etc/group 2>/dev/null || echo 'nogroup:x:65534:' >> /etc/group
+chmod 1777 /tmp
+chmod 755 / /bin /payload /payload/sc-tracker-listen
 ip link set vcan0 down && ip link set vcan0 mtu 72 && ip link set vcan0 up || exit 20
 faults="--fault bad-crc:7 --fault repeat:11 --fault implausible:13 --fault counter-jump:97 --fault silence:150"
 for mode in classic fd; do
     fdopt=""; [ $mode = fd ] && fdopt="--fd"
     candump -L vcan0 > cd-$mode.log 2>/dev/null &
     cd_pid=$!
-    /payload/sc-tracker-listen --iface vcan0 --duration-s 6 --log rx-$mode.log > live-$mode.txt &
+    su -s /bin/sh nobody -c "/payload/sc-tracker-listen --iface vcan0 --duration-s 6 --log rx-$mode.log > live-$mode.txt" &
     rx_pid=$!
     sleep 0.5
     /payload/sc-tracker-emu --script sweep --duration-s 4 $fdopt --iface vcan0 $faults 2> emu-$mode.txt || exit 21
@@ -71,6 +77,7 @@ for mode in ("classic", "fd"):
     check(emu_frames > 100, "%s: emulator sent %d frames" % (mode, emu_frames))
     if mode == "fd":
         check(g("live", "fd_capable") == 1, "fd: vcan0 with MTU 72 opened as CAN FD")
+    check(g("live", "uid") not in (0, -1), "%s: the listener ran unprivileged (uid %d)" % (mode, g("live", "uid")))
     # live: every injected fault counted
     check(g("live", "frames") == emu_frames + 1,
           "%s: listener got every emulator frame plus 100#00 (%d)" % (mode, g("live", "frames")))

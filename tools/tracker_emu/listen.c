@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "sc_candump.h"
 #include "sc_config.h"
@@ -181,7 +182,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "sc-tracker-listen: %s: %s\n", log_path, strerror(errno));
         return 1;
     }
-    printf("fd_capable=%d\n", node.fd_capable);
+    printf("fd_capable=%d\nuid=%u\n", node.fd_capable, (unsigned)getuid());
     fflush(stdout);
     const uint64_t start = mono_ns();
     const uint64_t end = start + (uint64_t)(duration_s * 1e9);
