@@ -3,8 +3,8 @@
  * 0xFFFFFFFF, final XOR 0xFFFFFFFF. Check value: CRC of the ASCII bytes "123456789" is
  * 0xCBF43926. Used by the case file sections and the display link packets.
  *
- * Thread and memory rules: pure functions over caller bytes, reentrant; the 1 KiB table is
- * const (flash on an MCU). Never allocates, never calls the OS, cannot fail.
+ * Thread and memory rules: pure functions over caller bytes, reentrant; the 8 KiB of tables
+ * (slicing-by-8) are const (flash on an MCU). Never allocates, never calls the OS, cannot fail.
  */
 #ifndef SC_CRC32_H
 #define SC_CRC32_H
@@ -15,7 +15,8 @@
 /* Initial running value for sc_crc32_update(). */
 #define SC_CRC32_INIT 0xFFFFFFFFu
 
-/* CRC-32 of n bytes in one call. O(n), one table lookup per byte. data may be NULL when n == 0. */
+/* CRC-32 of n bytes in one call. O(n), eight table lookups per 8 bytes. data may be NULL when
+ * n == 0. */
 uint32_t sc_crc32(const void *data, size_t n);
 
 /* Incremental form: crc = SC_CRC32_INIT; crc = sc_crc32_update(crc, a, na); ...;

@@ -57,6 +57,12 @@ static void table_matches_bitwise_reference_on_every_byte_and_lengths(void **sta
     for (size_t n = 0; n <= sizeof buf; n += 37u) {
         assert_int_equal(sc_crc32(buf, n), crc32_bitwise(buf, n));
     }
+    /* every length and start offset around the 8-byte step: tails and misaligned starts */
+    for (size_t off = 0; off < 8u; off++) {
+        for (size_t n = 0; n <= 40u; n++) {
+            assert_int_equal(sc_crc32(buf + off, n), crc32_bitwise(buf + off, n));
+        }
+    }
 }
 
 static void incremental_equals_one_shot(void **state)
