@@ -614,3 +614,52 @@ void sc_case_label_histogram(const sc_case *c, uint64_t counts[SC_MAX_LABELS])
         counts[c->volume.labels[i] % SC_MAX_LABELS]++;
     }
 }
+
+void sc_case_slot_init(sc_case_slot *s)
+{
+    memset(s, 0, sizeof *s);
+}
+
+int sc_case_slot_switch(sc_case_slot *s, const sc_storage_dev *dev, const char *name)
+{
+    if (s == NULL || dev == NULL || dev->ops == NULL || name == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    const uint8_t *data = NULL;
+    size_t size = 0;
+    int rc = sc_storage_open(dev, name, &data, &size);
+    if (rc == SC_OK) {
+        sc_case c;
+        rc = sc_case_load(data, size, &c);
+        if (rc == SC_OK) {
+            if (s->dev != NULL) {
+                sc_storage_close(s->dev, s->data, s->size);
+            }
+            s->dev = dev;
+            s->data = data;
+            s->size = size;
+            s->c = c;
+            s->loaded = 1;
+        } else {
+            sc_storage_close(dev, data, size);
+        }
+    }
+    s->last_error = rc;
+    if (rc != SC_OK) {
+        s->refused++;
+    }
+    return rc;
+}
+
+void sc_case_slot_close(sc_case_slot *s)
+{
+    if (s != NULL && s->dev != NULL) {
+        sc_storage_close(s->dev, s->data, s->size);
+    }
+    if (s != NULL) {
+        s->dev = NULL;
+        s->data = NULL;
+        s->size = 0;
+        s->loaded = 0;
+    }
+}

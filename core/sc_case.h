@@ -31,6 +31,7 @@
 #include <stdint.h>
 
 #include "sc_config.h"
+#include "sc_hal_storage.h"
 #include "sc_mesh.h"
 #include "sc_pose.h"
 #include "sc_volume.h"
@@ -139,6 +140,31 @@ int sc_case_write(const sc_case_def *def, uint8_t *buf, size_t cap, size_t *out_
  * SC_ERR_CASE_SPACING, SC_ERR_CASE_TRANSFORM, SC_ERR_CASE_MATERIAL, SC_ERR_CASE_LABEL,
  * SC_ERR_CASE_MESH_NODES, SC_ERR_CASE_MESH_BOX. */
 int sc_case_load(const uint8_t *bytes, size_t size, sc_case *out);
+
+/* The running case and the storage mapping that backs it. Zero-initialise (or
+ * sc_case_slot_init) before first use. */
+typedef struct sc_case_slot {
+    const sc_storage_dev *dev; /* storage of the mapping below; NULL when empty */
+    const uint8_t *data;
+    size_t size;
+    sc_case c;                 /* valid when loaded != 0 */
+    int loaded;
+    int last_error;            /* result of the last sc_case_slot_switch() */
+    uint32_t refused;          /* switches refused so far */
+} sc_case_slot;
+
+void sc_case_slot_init(sc_case_slot *s);
+
+/* Switch the running case to `name` from dev: open (map) it, validate it with sc_case_load(),
+ * and only if it is valid release the previous mapping and make it the running case. On any
+ * error the new mapping is closed, the running case and its mapping stay untouched, `refused`
+ * is counted. Not for frame time: O(file size) (sc_case_load), plus the storage open.
+ * Never allocates. Errors: SC_ERR_INVALID_ARG, the storage's open errors (SC_ERR_NOT_FOUND,
+ * SC_ERR_IO, ...), every sc_case_load() error. */
+int sc_case_slot_switch(sc_case_slot *s, const sc_storage_dev *dev, const char *name);
+
+/* Release the running case's mapping; the slot becomes empty. O(1) plus the storage close. */
+void sc_case_slot_close(sc_case_slot *s);
 
 /* Label histogram of a loaded case: counts[l] = voxels with label l, l < SC_MAX_LABELS.
  * O(voxels). Never allocates, cannot fail for a case from sc_case_load(). */

@@ -535,6 +535,67 @@ static void refused_case_leaves_the_running_case_untouched(void **state)
     assert_memory_equal(&running, &snapshot, sizeof running);
 }
 
+/* A fake storage with two named images that counts open mappings. */
+typedef struct fake_storage {
+    const uint8_t *good, *bad;
+    size_t good_size, bad_size;
+    int open_maps;
+} fake_storage;
+
+static int fake_open(void *ctx, const char *name, const uint8_t **data, size_t *size)
+{
+    fake_storage *f = (fake_storage *)ctx;
+    if (strcmp(name, "good") == 0) {
+        *data = f->good;
+        *size = f->good_size;
+    } else if (strcmp(name, "bad") == 0) {
+        *data = f->bad;
+        *size = f->bad_size;
+    } else {
+        return SC_ERR_NOT_FOUND;
+    }
+    f->open_maps++;
+    return SC_OK;
+}
+
+static void fake_close(void *ctx, const uint8_t *data, size_t size)
+{
+    (void)data;
+    (void)size;
+    ((fake_storage *)ctx)->open_maps--;
+}
+
+static void slot_switch_keeps_the_running_case_when_the_new_one_is_refused(void **state)
+{
+    (void)state;
+    sc_case_def d = make_def();
+    size_t n = write_def(&d, g_buf);
+    memcpy(g_bad, g_buf, n);
+    g_bad[n / 2u] ^= 0x40u; /* corrupt a voxel */
+    static const sc_storage_ops ops = {fake_open, fake_close};
+    fake_storage fs = {g_buf, g_bad, n, n, 0};
+    sc_storage_dev dev = {&ops, &fs};
+    sc_case_slot slot;
+    sc_case_slot_init(&slot);
+    assert_int_equal(sc_case_slot_switch(&slot, &dev, "good"), SC_OK);
+    assert_true(slot.loaded);
+    assert_int_equal(fs.open_maps, 1);
+    sc_case before = slot.c;
+    assert_int_equal(sc_case_slot_switch(&slot, &dev, "bad"), SC_ERR_CASE_CRC);
+    assert_int_equal(sc_case_slot_switch(&slot, &dev, "missing"), SC_ERR_NOT_FOUND);
+    assert_int_equal(slot.refused, 2);
+    assert_int_equal(slot.last_error, SC_ERR_NOT_FOUND);
+    assert_int_equal(fs.open_maps, 1); /* the refused mapping was released */
+    assert_memory_equal(&slot.c, &before, sizeof before);
+    assert_ptr_equal(slot.data, g_buf);
+    /* switching to a good case releases the old mapping */
+    assert_int_equal(sc_case_slot_switch(&slot, &dev, "good"), SC_OK);
+    assert_int_equal(fs.open_maps, 1);
+    sc_case_slot_close(&slot);
+    assert_int_equal(fs.open_maps, 0);
+    assert_false(slot.loaded);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -553,6 +614,7 @@ int main(void)
         cmocka_unit_test(unterminated_or_control_character_text_is_refused),
         cmocka_unit_test(writer_refuses_small_buffers_and_null_volumes),
         cmocka_unit_test(refused_case_leaves_the_running_case_untouched),
+        cmocka_unit_test(slot_switch_keeps_the_running_case_when_the_new_one_is_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
