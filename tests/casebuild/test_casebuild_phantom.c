@@ -223,6 +223,11 @@ static void image_shows_anechoic_lumen_enhancement_and_bone_shadow(void **state)
     double below = mean_box(v, ijv->x_mm - 2.0f, ijv->x_mm + 2.0f, zb + 0.8f, zb + 3.0f, deep_fat);
     double beside = mean_box(v, -24.0f, -16.0f, zb + 0.8f, zb + 3.0f, deep_fat);
     assert_true(below > beside + 15.0);
+    /* bright artery wall: the top of the ring (specular, across the beam) well above tissue */
+    const sc_phantom_vessel *cca = &p.vessels[1];
+    double wall = mean_box(v, cca->x_mm - 1.5f, cca->x_mm + 1.5f, cca->z_mm - cca->half_d_mm,
+                           cca->z_mm - cca->half_d_mm + cca->wall_mm, 1u << SC_LABEL_ARTERY);
+    assert_true(wall > tissue + 40.0);
     /* bone: bright cortex, dark shadow below it */
     double above_bone = mean_box(v, 2.0f, 10.0f, 30.0f, 34.0f, 1u << SC_LABEL_MUSCLE);
     double shadow = mean_box(v, 2.0f, 10.0f, 39.0f, 44.0f, 1u << SC_LABEL_BONE);
