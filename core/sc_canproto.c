@@ -7,14 +7,28 @@
 
 #define Q14 0.00006103515625f /* 1/16384: quaternion components, range [-2, 2) */
 
-#define E2E_SIGS                                                                               \
-    {"E2E_CRC", 0, 8, 0, 1.0f, 0.0f, 0.0f, 255.0f, ""},                                         \
-        {"E2E_Counter", 8, 4, 0, 1.0f, 0.0f, 0.0f, 15.0f, ""}
+#define E2E_SIGS                                                                                   \
+    {"E2E_CRC", 0, 8, 0, 1.0f, 0.0f, 0.0f, 255.0f, ""},                                            \
+    {                                                                                              \
+        "E2E_Counter", 8, 4, 0, 1.0f, 0.0f, 0.0f, 15.0f, ""                                        \
+    }
 
-#define SIG_POS(n, sb) {n, sb, 16, 1, 0.05f, 0.0f, -1638.4f, 1638.35f, "mm"}
-#define SIG_Q(n, sb) {n, sb, 16, 1, Q14, 0.0f, -2.0f, 1.99993896484375f, ""}
-#define SIG_FORCE(sb) {"ContactForce", sb, 16, 0, 0.01f, 0.0f, 0.0f, 655.34f, "N"}
-#define SIG_TRACKING(sb) {"TrackingState", sb, 2, 0, 1.0f, 0.0f, 0.0f, 1.0f, ""}
+#define SIG_POS(n, sb)                                                                             \
+    {                                                                                              \
+        n, sb, 16, 1, 0.05f, 0.0f, -1638.4f, 1638.35f, "mm"                                        \
+    }
+#define SIG_Q(n, sb)                                                                               \
+    {                                                                                              \
+        n, sb, 16, 1, Q14, 0.0f, -2.0f, 1.99993896484375f, ""                                      \
+    }
+#define SIG_FORCE(sb)                                                                              \
+    {                                                                                              \
+        "ContactForce", sb, 16, 0, 0.01f, 0.0f, 0.0f, 655.34f, "N"                                 \
+    }
+#define SIG_TRACKING(sb)                                                                           \
+    {                                                                                              \
+        "TrackingState", sb, 2, 0, 1.0f, 0.0f, 0.0f, 1.0f, ""                                      \
+    }
 
 static const sc_can_sig sigs_cmd_case[] = {
     E2E_SIGS,
@@ -55,9 +69,9 @@ static const sc_can_sig sigs_pose_aux[] = {
     SIG_TRACKING(48),
 };
 static const sc_can_sig sigs_pose_fd[] = {
-    E2E_SIGS,        SIG_POS("PosX", 16), SIG_POS("PosY", 32), SIG_POS("PosZ", 48),
-    SIG_Q("QuatW", 64), SIG_Q("QuatX", 80), SIG_Q("QuatY", 96),  SIG_Q("QuatZ", 112),
-    SIG_FORCE(128),  SIG_TRACKING(144),
+    E2E_SIGS,           SIG_POS("PosX", 16), SIG_POS("PosY", 32), SIG_POS("PosZ", 48),
+    SIG_Q("QuatW", 64), SIG_Q("QuatX", 80),  SIG_Q("QuatY", 96),  SIG_Q("QuatZ", 112),
+    SIG_FORCE(128),     SIG_TRACKING(144),
 };
 static const sc_can_sig sigs_status[] = {
     E2E_SIGS,
@@ -83,14 +97,15 @@ static const sc_can_sig sigs_diag[] = {
     {"LiftEvents", 56, 8, 0, 1.0f, 0.0f, 0.0f, 255.0f, ""},
 };
 
-#define MSG(n, id, len, fd, cyc, to, sigs)                                                     \
-    {n, id, id, len, fd, cyc, to, (uint8_t)(sizeof(sigs) / sizeof((sigs)[0])), sigs}
+#define MSG(n, id, len, fd, cyc, to, sigs)                                                         \
+    {                                                                                              \
+        n, id, id, len, fd, cyc, to, (uint8_t)(sizeof(sigs) / sizeof((sigs)[0])), sigs             \
+    }
 
 static const sc_can_msg_info msg_table[SC_MSG_COUNT] = {
     [SC_MSG_CMD_CASE] = MSG("CmdSelectCase", SC_CANID_CMD_CASE, 8, 0, 0, 0, sigs_cmd_case),
     [SC_MSG_CMD_METHOD] = MSG("CmdSetMethod", SC_CANID_CMD_METHOD, 8, 0, 0, 0, sigs_cmd_method),
-    [SC_MSG_CMD_IMAGING] =
-        MSG("CmdSetImaging", SC_CANID_CMD_IMAGING, 8, 0, 0, 0, sigs_cmd_imaging),
+    [SC_MSG_CMD_IMAGING] = MSG("CmdSetImaging", SC_CANID_CMD_IMAGING, 8, 0, 0, 0, sigs_cmd_imaging),
     [SC_MSG_CMD_RESET] = MSG("CmdReset", SC_CANID_CMD_RESET, 8, 0, 0, 0, sigs_cmd_reset),
     [SC_MSG_POSE_POS] = MSG("ProbePosePos", SC_CANID_POSE_POS, 8, 0, 10, 100, sigs_pose_pos),
     [SC_MSG_POSE_QUAT] = MSG("ProbePoseQuat", SC_CANID_POSE_QUAT, 8, 0, 10, 100, sigs_pose_quat),
@@ -191,7 +206,8 @@ int sc_canproto_decode_phys(const sc_can_frame *f, sc_msg *msg, float *phys, siz
         return SC_ERR_NO_SPACE;
     }
     for (unsigned i = 0; i < info->sig_count; i++) {
-        phys[i] = sc_canproto_raw_to_phys(&info->sigs[i], sc_canproto_get_raw(f->data, &info->sigs[i]));
+        phys[i] =
+            sc_canproto_raw_to_phys(&info->sigs[i], sc_canproto_get_raw(f->data, &info->sigs[i]));
     }
     *msg = m;
     return 0;

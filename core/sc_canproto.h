@@ -107,10 +107,10 @@ enum { SC_TRACKING_OK = 0, SC_TRACKING_LOST = 1 };
 
 typedef struct sc_pose_msg {
     float pos_mm[3];
-    float q[4];        /* w, x, y, z as sent (not normalised) */
-    float force_n;     /* contact force, valid when force_valid */
+    float q[4];    /* w, x, y, z as sent (not normalised) */
+    float force_n; /* contact force, valid when force_valid */
     uint8_t force_valid;
-    uint8_t tracking;  /* SC_TRACKING_* */
+    uint8_t tracking; /* SC_TRACKING_* */
 } sc_pose_msg;
 
 /* Encodes one pose sample with E2E counter `counter` (same for all parts): 3 classic frames
@@ -137,18 +137,18 @@ enum { SC_SCAN_LINEAR = 0, SC_SCAN_CURVILINEAR = 1 };
 enum { SC_RESET_TISSUE = 1, SC_RESET_FAULTS = 2, SC_RESET_ALL = 3 };
 
 typedef struct sc_imaging_cmd {
-    float depth_mm;        /* 10..250 */
-    float gain_db;         /* -40..40, 0.5 dB steps */
-    float dyn_range_db;    /* 20..100 */
-    float tgc_db_per_cm;   /* 0..10 */
-    uint8_t geometry;      /* SC_SCAN_* */
+    float depth_mm;      /* 10..250 */
+    float gain_db;       /* -40..40, 0.5 dB steps */
+    float dyn_range_db;  /* 20..100 */
+    float tgc_db_per_cm; /* 0..10 */
+    uint8_t geometry;    /* SC_SCAN_* */
 } sc_imaging_cmd;
 
 typedef struct sc_cmd {
     sc_cmd_kind kind;
-    uint8_t case_id;       /* SELECT_CASE: 0..254 */
-    uint8_t method;        /* SET_METHOD: SC_METHOD_* */
-    uint8_t reset_target;  /* RESET: SC_RESET_* */
+    uint8_t case_id;        /* SELECT_CASE: 0..254 */
+    uint8_t method;         /* SET_METHOD: SC_METHOD_* */
+    uint8_t reset_target;   /* RESET: SC_RESET_* */
     sc_imaging_cmd imaging; /* SET_IMAGING */
 } sc_cmd;
 
@@ -159,22 +159,22 @@ int sc_canproto_encode_cmd(const sc_cmd *c, uint8_t counter, sc_can_frame *out);
 int sc_canproto_decode_cmd(const sc_can_frame *f, sc_cmd *out);
 
 /* ---- engine status (out) ----------------------------------------------------------------- */
-#define SC_STATUS_CASE_NONE 255u
+#define SC_STATUS_CASE_NONE         255u
 #define SC_AREA_RATIO_NOT_AVAILABLE (-1.0f)
 
 typedef struct sc_status_msg {
-    uint8_t state;          /* sc_health_state */
-    uint8_t method;         /* SC_METHOD_* */
-    uint8_t probe_contact;  /* collider touching the skin */
-    uint8_t probe_lifted;   /* tracker silent or lost: collider removed */
-    uint16_t fault_bits;    /* sc_health active bits */
-    uint32_t deadline_misses;  /* saturates at 65535 on the bus */
-    uint8_t case_id;           /* SC_STATUS_CASE_NONE when none */
-    uint32_t worst_frame_us;   /* saturates at 65535 */
-    float vein_area_ratio;     /* lumen area / rest area, <0 not available */
+    uint8_t state;            /* sc_health_state */
+    uint8_t method;           /* SC_METHOD_* */
+    uint8_t probe_contact;    /* collider touching the skin */
+    uint8_t probe_lifted;     /* tracker silent or lost: collider removed */
+    uint16_t fault_bits;      /* sc_health active bits */
+    uint32_t deadline_misses; /* saturates at 65535 on the bus */
+    uint8_t case_id;          /* SC_STATUS_CASE_NONE when none */
+    uint32_t worst_frame_us;  /* saturates at 65535 */
+    float vein_area_ratio;    /* lumen area / rest area, <0 not available */
     float artery_area_ratio;
-    uint32_t poses_accepted;   /* sent modulo 65536 */
-    uint32_t rejected_e2e;     /* saturating on the bus */
+    uint32_t poses_accepted; /* sent modulo 65536 */
+    uint32_t rejected_e2e;   /* saturating on the bus */
     uint32_t rejected_plausibility;
     uint32_t lift_events;
 } sc_status_msg;

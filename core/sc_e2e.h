@@ -25,7 +25,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define SC_E2E_COUNTER_MOD 16u
+#define SC_E2E_COUNTER_MOD  16u
 #define SC_E2E_HEADER_BYTES 2u
 
 /* CRC-8 SAE J1850, polynomial 0x1D, not reflected, over len bytes starting from crc (the start
@@ -83,11 +83,11 @@ sc_e2e_rx_def sc_e2e_rx_default_def(uint16_t data_id);
 
 typedef struct sc_e2e_rx {
     sc_e2e_rx_def def;
-    uint8_t have_last;    /* a usable message was seen since init/timeout */
+    uint8_t have_last; /* a usable message was seen since init/timeout */
     uint8_t last_counter;
-    uint8_t new_data;     /* a message arrived since the last poll */
-    uint64_t last_ok_ns;  /* receive time of the last usable message */
-    uint32_t lost;        /* messages lost, from counter gaps of OK_SOME_LOST */
+    uint8_t new_data;                    /* a message arrived since the last poll */
+    uint64_t last_ok_ns;                 /* receive time of the last usable message */
+    uint32_t lost;                       /* messages lost, from counter gaps of OK_SOME_LOST */
     uint32_t count[SC_E2E_STATUS_COUNT]; /* outcomes seen, saturating */
 } sc_e2e_rx;
 

@@ -101,8 +101,7 @@ const char *sc_trk_outcome_name(sc_trk_outcome o)
 
 int sc_trk_outcome_is_e2e_reject(sc_trk_outcome o)
 {
-    return o == SC_TRK_E2E_WRONG_CRC || o == SC_TRK_E2E_WRONG_SEQUENCE ||
-           o == SC_TRK_E2E_REPEATED;
+    return o == SC_TRK_E2E_WRONG_CRC || o == SC_TRK_E2E_WRONG_SEQUENCE || o == SC_TRK_E2E_REPEATED;
 }
 
 int sc_trk_outcome_is_implausible(sc_trk_outcome o)
@@ -192,9 +191,8 @@ static sc_trk_outcome judge(sc_tracker *t, const sc_pose_msg *m, uint64_t ts_ns)
         /* dt from receive times, floored at one pose period: frames queued behind each other
          * arrive together but were sampled a period apart. */
         const uint64_t cyc_ns = (uint64_t)d->pose_cycle_ms * 1000000u;
-        const uint64_t dt_ns = ts_ns > t->cur.rx_ns && ts_ns - t->cur.rx_ns > cyc_ns
-                                   ? ts_ns - t->cur.rx_ns
-                                   : cyc_ns;
+        const uint64_t dt_ns =
+            ts_ns > t->cur.rx_ns && ts_ns - t->cur.rx_ns > cyc_ns ? ts_ns - t->cur.rx_ns : cyc_ns;
         const float dt_s = (float)dt_ns * 1e-9f;
         float d2 = 0.0f;
         for (unsigned i = 0; i < 3u; i++) {
@@ -240,8 +238,8 @@ static sc_trk_outcome take_sample(sc_tracker *t, const sc_pose_msg *m, uint8_t c
         return o;
     }
     const float inv = 1.0f / sqrtf(sc_quat_norm2(m->q));
-    sc_trk_sample s = {.force_n = m->force_n, .force_valid = m->force_valid,
-                       .counter = counter, .rx_ns = ts_ns};
+    sc_trk_sample s = {
+        .force_n = m->force_n, .force_valid = m->force_valid, .counter = counter, .rx_ns = ts_ns};
     for (unsigned i = 0; i < 3u; i++) {
         s.pose.pos_mm[i] = m->pos_mm[i];
     }

@@ -40,14 +40,14 @@
 typedef struct sc_tracker_def {
     float ws_min_mm[3]; /* workspace box, tracker frame: a pose outside is implausible */
     float ws_max_mm[3];
-    float quat_norm_tol;        /* | |q| - 1 | above this is implausible (0 < tol < 0.5) */
-    float max_speed_mm_s;       /* linear speed limit between accepted poses */
-    float max_ang_speed_rad_s;  /* angular speed limit between accepted poses */
-    float max_force_n;          /* contact force above this is implausible */
-    uint32_t pose_timeout_ms;   /* no valid pose for this long: probe lifted */
-    uint32_t pose_cycle_ms;     /* nominal pose period: floor of the speed check's dt */
-    uint8_t max_delta_counter;  /* E2E: counter steps accepted (1 = no loss tolerated) */
-    uint8_t accept_fd;          /* accept the CAN FD pose 0x110 */
+    float quat_norm_tol;       /* | |q| - 1 | above this is implausible (0 < tol < 0.5) */
+    float max_speed_mm_s;      /* linear speed limit between accepted poses */
+    float max_ang_speed_rad_s; /* angular speed limit between accepted poses */
+    float max_force_n;         /* contact force above this is implausible */
+    uint32_t pose_timeout_ms;  /* no valid pose for this long: probe lifted */
+    uint32_t pose_cycle_ms;    /* nominal pose period: floor of the speed check's dt */
+    uint8_t max_delta_counter; /* E2E: counter steps accepted (1 = no loss tolerated) */
+    uint8_t accept_fd;         /* accept the CAN FD pose 0x110 */
 } sc_tracker_def;
 
 /* Defaults: workspace x,y in [-400, 400] mm, z in [-100, 500] mm; norm tolerance 0.02;
@@ -69,16 +69,16 @@ typedef enum sc_trk_outcome {
     SC_TRK_E2E_WRONG_CRC,
     SC_TRK_E2E_WRONG_SEQUENCE,
     SC_TRK_E2E_REPEATED,
-    SC_TRK_POSE_STALE,        /* a sample older than the last assembled one completed late */
-    SC_TRK_NOT_TRACKING,      /* the tracker itself reports it lost the probe */
+    SC_TRK_POSE_STALE,   /* a sample older than the last assembled one completed late */
+    SC_TRK_NOT_TRACKING, /* the tracker itself reports it lost the probe */
     SC_TRK_REJ_QUAT_NORM,
     SC_TRK_REJ_WORKSPACE,
     SC_TRK_REJ_FORCE,
     SC_TRK_REJ_SPEED,
     SC_TRK_REJ_ANG_SPEED,
-    SC_TRK_CMD_REJECTED,      /* a command signal outside its DBC range */
-    SC_TRK_CMD_QUEUE_FULL,    /* the engine did not take commands fast enough: dropped */
-    SC_TRK_BUS_ERROR,         /* an error frame from the controller */
+    SC_TRK_CMD_REJECTED,   /* a command signal outside its DBC range */
+    SC_TRK_CMD_QUEUE_FULL, /* the engine did not take commands fast enough: dropped */
+    SC_TRK_BUS_ERROR,      /* an error frame from the controller */
     SC_TRK_OUTCOME_COUNT
 } sc_trk_outcome;
 
@@ -90,24 +90,24 @@ int sc_trk_outcome_is_implausible(sc_trk_outcome o);
 
 /* The newest valid sample. */
 typedef struct sc_trk_sample {
-    sc_pose pose;      /* quaternion normalised */
+    sc_pose pose; /* quaternion normalised */
     float force_n;
     uint8_t force_valid;
-    uint8_t counter;   /* E2E counter of the sample */
-    uint64_t rx_ns;    /* receive time (frame time stamp, else now_ns), whole microseconds */
+    uint8_t counter; /* E2E counter of the sample */
+    uint64_t rx_ns;  /* receive time (frame time stamp, else now_ns), whole microseconds */
 } sc_trk_sample;
 
 typedef struct sc_trk_counters {
     uint32_t outcome[SC_TRK_OUTCOME_COUNT];
-    uint32_t frames;             /* every frame given to on_frame */
-    uint32_t incomplete;         /* partial samples dropped (a part lost or rejected) */
-    uint32_t lift_events;        /* valid -> lifted transitions */
-    uint32_t e2e_lost;           /* messages lost as seen by counter gaps (OK_SOME_LOST) */
-    uint32_t bus_err_class[6];   /* error frames per SC_CAN_ERRF_* bit */
+    uint32_t frames;           /* every frame given to on_frame */
+    uint32_t incomplete;       /* partial samples dropped (a part lost or rejected) */
+    uint32_t lift_events;      /* valid -> lifted transitions */
+    uint32_t e2e_lost;         /* messages lost as seen by counter gaps (OK_SOME_LOST) */
+    uint32_t bus_err_class[6]; /* error frames per SC_CAN_ERRF_* bit */
 } sc_trk_counters;
 
 #define SC_TRK_ASM_SLOTS 2u
-#define SC_TRK_RX_MSGS 8u /* the 8 messages the engine receives: 4 commands, 4 pose */
+#define SC_TRK_RX_MSGS   8u /* the 8 messages the engine receives: 4 commands, 4 pose */
 
 typedef struct sc_trk_asm {
     uint8_t used;
@@ -124,14 +124,14 @@ typedef struct sc_tracker {
     sc_e2e_tx tx[SC_STATUS_FRAMES];
     sc_trk_asm slot[SC_TRK_ASM_SLOTS];
     uint32_t slot_seq;
-    uint8_t have_pose;        /* a fresh valid pose exists (not lifted) */
+    uint8_t have_pose; /* a fresh valid pose exists (not lifted) */
     uint8_t have_last_counter;
-    uint8_t last_counter;     /* counter of the last assembled sample */
+    uint8_t last_counter; /* counter of the last assembled sample */
     sc_trk_sample cur;
     sc_cmd cmd[SC_CAN_CMD_QUEUE_MAX];
     uint8_t cmd_head;
     uint8_t cmd_count;
-    uint32_t bus_errors;      /* SC_CAN_ERRF_* seen since the last take */
+    uint32_t bus_errors; /* SC_CAN_ERRF_* seen since the last take */
     sc_trk_counters n;
 } sc_tracker;
 

@@ -67,8 +67,7 @@ static int fail(sc_candump_reject *why, sc_candump_reject r)
     return SC_ERR_PARSE;
 }
 
-int sc_candump_parse_line(const char *line, size_t len, sc_candump_rec *out,
-                          sc_candump_reject *why)
+int sc_candump_parse_line(const char *line, size_t len, sc_candump_rec *out, sc_candump_reject *why)
 {
     while (len > 0u && (line[len - 1u] == '\n' || line[len - 1u] == '\r')) {
         len--;
@@ -305,9 +304,9 @@ int sc_candump_format(const sc_candump_rec *r, char *buf, size_t cap)
         return SC_ERR_INVALID_ARG;
     }
     char tmp[SC_CANDUMP_LINE_MAX + 64];
-    int n = snprintf(tmp, sizeof tmp, "(%010llu.%06llu) %s ",
-                     (unsigned long long)(r->ts_us / 1000000u),
-                     (unsigned long long)(r->ts_us % 1000000u), r->iface);
+    int n =
+        snprintf(tmp, sizeof tmp, "(%010llu.%06llu) %s ", (unsigned long long)(r->ts_us / 1000000u),
+                 (unsigned long long)(r->ts_us % 1000000u), r->iface);
     if (n < 0) {
         return SC_ERR_INVALID_ARG;
     }

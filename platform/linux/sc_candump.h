@@ -27,30 +27,30 @@
 #include "sc_hal_can.h"
 
 #define SC_CANDUMP_IFNAME_MAX 15u  /* IFNAMSIZ - 1 */
-#define SC_CANDUMP_LINE_MAX 256u   /* longest valid line: FD, 64 bytes with dots < 256 */
+#define SC_CANDUMP_LINE_MAX   256u /* longest valid line: FD, 64 bytes with dots < 256 */
 
 typedef enum sc_candump_reject {
     SC_CDR_OK = 0,
-    SC_CDR_EMPTY,          /* blank line */
-    SC_CDR_LINE_TOO_LONG,  /* longer than SC_CANDUMP_LINE_MAX */
-    SC_CDR_TIMESTAMP,      /* missing or malformed "(sec.usec)" (6 fraction digits) */
-    SC_CDR_IFACE,          /* missing interface name, or longer than 15 characters */
-    SC_CDR_ID,             /* id not 3 or 8 hex digits, or out of range */
-    SC_CDR_SEPARATOR,      /* no '#' after the id, or "###" (CAN XL, not supported) */
-    SC_CDR_DATA,           /* odd number of hex digits, non-hex, misplaced '.' */
-    SC_CDR_LENGTH,         /* too many bytes (classic > 8, FD > 64) or invalid FD length */
-    SC_CDR_FD_FLAGS,       /* FD flags digit missing or not hex */
-    SC_CDR_DLC,            /* bad "_<dlc>" suffix or remote frame length */
-    SC_CDR_TRAILING,       /* unexpected characters after the frame */
+    SC_CDR_EMPTY,         /* blank line */
+    SC_CDR_LINE_TOO_LONG, /* longer than SC_CANDUMP_LINE_MAX */
+    SC_CDR_TIMESTAMP,     /* missing or malformed "(sec.usec)" (6 fraction digits) */
+    SC_CDR_IFACE,         /* missing interface name, or longer than 15 characters */
+    SC_CDR_ID,            /* id not 3 or 8 hex digits, or out of range */
+    SC_CDR_SEPARATOR,     /* no '#' after the id, or "###" (CAN XL, not supported) */
+    SC_CDR_DATA,          /* odd number of hex digits, non-hex, misplaced '.' */
+    SC_CDR_LENGTH,        /* too many bytes (classic > 8, FD > 64) or invalid FD length */
+    SC_CDR_FD_FLAGS,      /* FD flags digit missing or not hex */
+    SC_CDR_DLC,           /* bad "_<dlc>" suffix or remote frame length */
+    SC_CDR_TRAILING,      /* unexpected characters after the frame */
     SC_CDR_COUNT
 } sc_candump_reject;
 
 const char *sc_candump_reject_name(sc_candump_reject r);
 
 typedef struct sc_candump_rec {
-    uint64_t ts_us;                       /* log time stamp, microseconds */
+    uint64_t ts_us; /* log time stamp, microseconds */
     char iface[SC_CANDUMP_IFNAME_MAX + 1];
-    sc_can_frame frame;                   /* frame.ts_ns = ts_us * 1000 */
+    sc_can_frame frame; /* frame.ts_ns = ts_us * 1000 */
 } sc_candump_rec;
 
 /* Parses one line (without or with its trailing newline / CR). 0 and *out filled, or
@@ -66,9 +66,9 @@ int sc_candump_format(const sc_candump_rec *r, char *buf, size_t cap);
 /* Reads records from a stream, skipping and counting malformed lines. */
 typedef struct sc_candump_reader {
     FILE *fp;
-    uint32_t line_no;                  /* lines read so far */
-    uint32_t records;                  /* good records returned */
-    uint32_t rejected[SC_CDR_COUNT];   /* per reason */
+    uint32_t line_no;                /* lines read so far */
+    uint32_t records;                /* good records returned */
+    uint32_t rejected[SC_CDR_COUNT]; /* per reason */
     uint32_t last_reject_line;
     sc_candump_reject last_reject;
 } sc_candump_reader;

@@ -285,8 +285,8 @@ static const sc_can_ops node_ops = {
 int sc_socketcan_open(sc_socketcan *s, const sc_socketcan_sys *sys, void *sys_user,
                       const char *ifname)
 {
-    *s = (sc_socketcan){.sys = sys, .sys_user = sys_user, .handle = -1,
-                        .state = SC_CAN_STATE_STOPPED};
+    *s = (sc_socketcan){
+        .sys = sys, .sys_user = sys_user, .handle = -1, .state = SC_CAN_STATE_STOPPED};
     if (ifname == NULL || ifname[0] == '\0' || strlen(ifname) >= IFNAMSIZ) {
         return SC_ERR_INVALID_ARG;
     }
@@ -396,7 +396,9 @@ static int posix_recv(void *u, int h, sc_socketcan_raw *out, int *is_fd, uint64_
         struct cmsghdr align;
     } ctrl;
     struct iovec iov = {.iov_base = &fr, .iov_len = sizeof fr};
-    struct msghdr msg = {.msg_iov = &iov, .msg_iovlen = 1, .msg_control = ctrl.buf,
+    struct msghdr msg = {.msg_iov = &iov,
+                         .msg_iovlen = 1,
+                         .msg_control = ctrl.buf,
                          .msg_controllen = sizeof ctrl.buf};
     const ssize_t n = recvmsg(h, &msg, MSG_DONTWAIT);
     if (n < 0) {

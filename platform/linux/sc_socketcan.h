@@ -67,9 +67,9 @@ typedef struct sc_socketcan {
     int fd_capable;
     sc_can_state state;
     sc_can_counters counters;
-    uint32_t kernel_drops;      /* last SO_RXQ_OVFL value seen */
+    uint32_t kernel_drops; /* last SO_RXQ_OVFL value seen */
     uint64_t rx_frames, rx_error_frames, tx_frames;
-    uint32_t rx_unconvertible;  /* frames that could not be represented (counted, skipped) */
+    uint32_t rx_unconvertible; /* frames that could not be represented (counted, skipped) */
 } sc_socketcan;
 
 /* Opens the node (ifname at most 15 characters). SC_ERR_INVALID_ARG for a bad name,

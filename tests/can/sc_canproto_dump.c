@@ -35,10 +35,14 @@ int main(void)
     sc_can_frame f[3];
     size_t n;
     const sc_pose_msg poses[] = {
-        {.pos_mm = {12.3f, -45.6f, 78.9f}, .q = {0.9238795f, 0.0f, 0.3826834f, 0.0f},
-         .force_n = 3.21f, .force_valid = 1},
-        {.pos_mm = {-1638.4f, 1638.35f, 0.0f}, .q = {-2.0f, 1.9999f, -0.5f, 0.25f},
-         .force_valid = 0, .tracking = SC_TRACKING_LOST},
+        {.pos_mm = {12.3f, -45.6f, 78.9f},
+         .q = {0.9238795f, 0.0f, 0.3826834f, 0.0f},
+         .force_n = 3.21f,
+         .force_valid = 1},
+        {.pos_mm = {-1638.4f, 1638.35f, 0.0f},
+         .q = {-2.0f, 1.9999f, -0.5f, 0.25f},
+         .force_valid = 0,
+         .tracking = SC_TRACKING_LOST},
     };
     for (size_t p = 0; p < sizeof poses / sizeof poses[0]; p++) {
         for (int fd = 0; fd <= 1; fd++) {
@@ -54,8 +58,11 @@ int main(void)
         {.kind = SC_CMD_SELECT_CASE, .case_id = 42},
         {.kind = SC_CMD_SET_METHOD, .method = SC_METHOD_FEM},
         {.kind = SC_CMD_SET_IMAGING,
-         .imaging = {.depth_mm = 45.5f, .gain_db = -7.5f, .dyn_range_db = 65.0f,
-                     .tgc_db_per_cm = 0.8f, .geometry = SC_SCAN_CURVILINEAR}},
+         .imaging = {.depth_mm = 45.5f,
+                     .gain_db = -7.5f,
+                     .dyn_range_db = 65.0f,
+                     .tgc_db_per_cm = 0.8f,
+                     .geometry = SC_SCAN_CURVILINEAR}},
         {.kind = SC_CMD_RESET, .reset_target = SC_RESET_FAULTS},
     };
     for (size_t c = 0; c < sizeof cmds / sizeof cmds[0]; c++) {
@@ -68,12 +75,19 @@ int main(void)
     sc_e2e_tx_init(&tx[0], SC_CANID_STATUS);
     sc_e2e_tx_init(&tx[1], SC_CANID_TIMING);
     sc_e2e_tx_init(&tx[2], SC_CANID_DIAG);
-    const sc_status_msg st = {.state = 2, .method = 1, .probe_contact = 1, .fault_bits = 0x0204,
-                              .deadline_misses = 17, .case_id = 5, .worst_frame_us = 9876,
+    const sc_status_msg st = {.state = 2,
+                              .method = 1,
+                              .probe_contact = 1,
+                              .fault_bits = 0x0204,
+                              .deadline_misses = 17,
+                              .case_id = 5,
+                              .worst_frame_us = 9876,
                               .vein_area_ratio = 0.42f,
                               .artery_area_ratio = SC_AREA_RATIO_NOT_AVAILABLE,
-                              .poses_accepted = 1234, .rejected_e2e = 5,
-                              .rejected_plausibility = 6, .lift_events = 2};
+                              .poses_accepted = 1234,
+                              .rejected_e2e = 5,
+                              .rejected_plausibility = 6,
+                              .lift_events = 2};
     if (sc_canproto_encode_status(&st, tx, f) != 0) {
         return 1;
     }
@@ -85,7 +99,8 @@ int main(void)
     for (int m = 0; m < (int)SC_MSG_COUNT; m++) {
         const sc_can_msg_info *info = sc_canproto_info((sc_msg)m);
         for (int rep = 0; rep < 20; rep++) {
-            sc_can_frame g = {.id = info->can_id, .len = info->len,
+            sc_can_frame g = {.id = info->can_id,
+                              .len = info->len,
                               .flags = info->fd ? (uint8_t)SC_CAN_FLAG_FD : 0u};
             for (unsigned s = 2; s < info->sig_count; s++) {
                 rng = rng * 1664525u + 1013904223u;

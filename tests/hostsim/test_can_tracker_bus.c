@@ -37,10 +37,10 @@ typedef struct session {
     /* per-stream view of delivered intact frames (index by id & 0xF: 0x100..0x102, 0x110) */
     int have_last[16];
     uint8_t last_counter[16];
-    uint32_t exp_gap_lost;    /* gaps of 1..max_delta-1 frames */
-    uint32_t exp_wrong_seq;   /* bigger jumps (or going back) */
+    uint32_t exp_gap_lost;  /* gaps of 1..max_delta-1 frames */
+    uint32_t exp_wrong_seq; /* bigger jumps (or going back) */
     uint32_t exp_repeated;
-    uint32_t exp_bad_crc;     /* delivered copies that differ from what was sent */
+    uint32_t exp_bad_crc; /* delivered copies that differ from what was sent */
     uint32_t delivered;
     FILE *log;
     uint64_t hash;
@@ -279,9 +279,9 @@ static void losses_are_counted_as_counter_gaps_or_wrong_sequences(void **state)
         /* 60 Hz polls over a 100 Hz tracker losing 10 %: the probe stays tracked */
         assert_true(live.polls_live_without_pose * 100u <= live.polls_live);
         printf("# %s, 10%% loss: %u of %u polls without a pose while the tracker sent, "
-               "%u lifts, %u samples accepted of %u\n", fd ? "FD" : "classic",
-               live.polls_live_without_pose, live.polls_live, k->lift_events, live.accepted,
-               fd ? live.n_sent : live.n_sent / 3u);
+               "%u lifts, %u samples accepted of %u\n",
+               fd ? "FD" : "classic", live.polls_live_without_pose, live.polls_live, k->lift_events,
+               live.accepted, fd ? live.n_sent : live.n_sent / 3u);
     }
 }
 
@@ -291,8 +291,10 @@ static void combined_faults_never_yield_a_bad_pose_and_replay_is_bit_exact(void 
     for (int fd = 0; fd <= 1; fd++) {
         memset(&live, 0, sizeof live);
         memset(&again, 0, sizeof again);
-        const sc_hs_can_faults f = {.drop_ppm = 100000u, .corrupt_ppm = 10000u,
-                                    .duplicate_ppm = 10000u, .reorder_ppm = 10000u};
+        const sc_hs_can_faults f = {.drop_ppm = 100000u,
+                                    .corrupt_ppm = 10000u,
+                                    .duplicate_ppm = 10000u,
+                                    .reorder_ppm = 10000u};
         char *buf = NULL;
         size_t len = 0;
         live.log = open_memstream(&buf, &len);

@@ -33,8 +33,7 @@ static void lines_written_by_candump_parse_to_the_right_frames(void **state)
     assert_int_equal(r.frame.flags, SC_CAN_FLAG_FD | SC_CAN_FLAG_BRS);
     assert_int_equal(r.frame.len, 4);
 
-    assert_int_equal(parse("(0000000001.000001) can0 1F334455#1122334455667788\r\n", &r, &why),
-                     0);
+    assert_int_equal(parse("(0000000001.000001) can0 1F334455#1122334455667788\r\n", &r, &why), 0);
     assert_int_equal(r.frame.id, 0x1F334455u);
     assert_int_equal(r.frame.flags, SC_CAN_FLAG_EXT);
     assert_int_equal(r.frame.len, 8);
@@ -52,7 +51,7 @@ static void lines_written_by_candump_parse_to_the_right_frames(void **state)
     assert_int_equal(parse("(1.000000) can0 123#1122334455667788_C", &r, &why), 0);
     assert_int_equal(r.frame.len, 8);
     assert_int_equal(parse("(1.000000) can0 123#11 R", &r, &why), 0); /* candump -x marker */
-    assert_int_equal(parse("(1.000000) can0 123##0", &r, &why), 0);    /* empty FD frame */
+    assert_int_equal(parse("(1.000000) can0 123##0", &r, &why), 0);   /* empty FD frame */
     assert_int_equal(r.frame.flags, SC_CAN_FLAG_FD);
 
     /* an error frame: bus-off + controller passive */
@@ -82,7 +81,8 @@ static void every_frame_kind_round_trips_bit_for_bit(void **state)
     in[4].frame = (sc_can_frame){.id = 0x055, .len = 2, .flags = SC_CAN_FLAG_RTR};
     in[5].frame = (sc_can_frame){.id = SC_CAN_ERRF_BUS_OFF | SC_CAN_ERRF_WARNING |
                                        SC_CAN_ERRF_PROTOCOL | SC_CAN_ERRF_RESTARTED,
-                                 .len = 8, .flags = SC_CAN_FLAG_ERR};
+                                 .len = 8,
+                                 .flags = SC_CAN_FLAG_ERR};
     for (int i = 0; i < 6; i++) {
         in[i].frame.ts_ns = in[i].ts_us * 1000u;
         char line[SC_CANDUMP_LINE_MAX + 64];

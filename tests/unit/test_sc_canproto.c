@@ -91,14 +91,13 @@ static void every_raw_value_of_a_16_bit_signal_survives_phys_and_back(void **sta
     const sc_can_msg_info *qi = sc_canproto_info(SC_MSG_POSE_QUAT);
     for (int32_t raw = -32768; raw <= 32767; raw++) {
         int64_t back = 0;
-        assert_int_equal(sc_canproto_phys_to_raw(&info->sigs[2],
-                                                 sc_canproto_raw_to_phys(&info->sigs[2], raw),
-                                                 &back),
+        assert_int_equal(sc_canproto_phys_to_raw(
+                             &info->sigs[2], sc_canproto_raw_to_phys(&info->sigs[2], raw), &back),
                          0);
         assert_int_equal(back, raw);
-        assert_int_equal(
-            sc_canproto_phys_to_raw(&qi->sigs[2], sc_canproto_raw_to_phys(&qi->sigs[2], raw), &back),
-            0);
+        assert_int_equal(sc_canproto_phys_to_raw(&qi->sigs[2],
+                                                 sc_canproto_raw_to_phys(&qi->sigs[2], raw), &back),
+                         0);
         assert_int_equal(back, raw);
     }
 }
@@ -139,11 +138,17 @@ static void every_command_round_trips(void **state)
         {.kind = SC_CMD_SET_METHOD, .method = SC_METHOD_MSDS},
         {.kind = SC_CMD_SET_METHOD, .method = SC_METHOD_FEM},
         {.kind = SC_CMD_SET_IMAGING,
-         .imaging = {.depth_mm = 60.0f, .gain_db = -12.5f, .dyn_range_db = 60.0f,
-                     .tgc_db_per_cm = 1.2f, .geometry = SC_SCAN_LINEAR}},
+         .imaging = {.depth_mm = 60.0f,
+                     .gain_db = -12.5f,
+                     .dyn_range_db = 60.0f,
+                     .tgc_db_per_cm = 1.2f,
+                     .geometry = SC_SCAN_LINEAR}},
         {.kind = SC_CMD_SET_IMAGING,
-         .imaging = {.depth_mm = 250.0f, .gain_db = 40.0f, .dyn_range_db = 20.0f,
-                     .tgc_db_per_cm = 10.0f, .geometry = SC_SCAN_CURVILINEAR}},
+         .imaging = {.depth_mm = 250.0f,
+                     .gain_db = 40.0f,
+                     .dyn_range_db = 20.0f,
+                     .tgc_db_per_cm = 10.0f,
+                     .geometry = SC_SCAN_CURVILINEAR}},
         {.kind = SC_CMD_RESET, .reset_target = SC_RESET_TISSUE},
         {.kind = SC_CMD_RESET, .reset_target = SC_RESET_ALL},
     };
@@ -222,12 +227,20 @@ static void status_round_trips_and_saturates(void **state)
     sc_e2e_tx_init(&tx[0], SC_CANID_STATUS);
     sc_e2e_tx_init(&tx[1], SC_CANID_TIMING);
     sc_e2e_tx_init(&tx[2], SC_CANID_DIAG);
-    sc_status_msg s = {.state = 2, .method = 1, .probe_contact = 1, .probe_lifted = 0,
-                       .fault_bits = 0x0A5Au, .deadline_misses = 1234, .case_id = 7,
-                       .worst_frame_us = 15321, .vein_area_ratio = 0.25f,
+    sc_status_msg s = {.state = 2,
+                       .method = 1,
+                       .probe_contact = 1,
+                       .probe_lifted = 0,
+                       .fault_bits = 0x0A5Au,
+                       .deadline_misses = 1234,
+                       .case_id = 7,
+                       .worst_frame_us = 15321,
+                       .vein_area_ratio = 0.25f,
                        .artery_area_ratio = SC_AREA_RATIO_NOT_AVAILABLE,
-                       .poses_accepted = 70000, .rejected_e2e = 12,
-                       .rejected_plausibility = 300, .lift_events = 3};
+                       .poses_accepted = 70000,
+                       .rejected_e2e = 12,
+                       .rejected_plausibility = 300,
+                       .lift_events = 3};
     sc_can_frame f[3];
     assert_int_equal(sc_canproto_encode_status(&s, tx, f), 0);
     sc_status_msg d = {0};
@@ -356,8 +369,7 @@ static void dbc_file_defines_exactly_the_codec_tables(void **state)
             sig_i = 0;
             msgs++;
         } else if (sscanf(line, " SG_ %127s : %u|%u@%c%c (%lf,%lf) [%lf|%lf] \"%63[^\"]\"", name,
-                          &start, &bits, &order, &sign, &factor, &offset, &mn, &mx,
-                          unit) >= 9) {
+                          &start, &bits, &order, &sign, &factor, &offset, &mn, &mx, unit) >= 9) {
             assert_non_null(cur);
             assert_true(sig_i < cur->sig_count);
             const sc_can_sig *g = &cur->sigs[sig_i++];

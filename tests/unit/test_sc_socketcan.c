@@ -43,8 +43,7 @@ static int f_set_filters(void *u, int h, const sc_socketcan_rawfilter *fl, size_
     f->filt_n = n;
     return 0;
 }
-static int f_recv(void *u, int h, sc_socketcan_raw *out, int *is_fd, uint64_t *ts,
-                  uint32_t *drops)
+static int f_recv(void *u, int h, sc_socketcan_raw *out, int *is_fd, uint64_t *ts, uint32_t *drops)
 {
     fake *f = u;
     (void)h;
@@ -199,8 +198,8 @@ static void filters_become_kernel_filters_that_separate_standard_and_extended(vo
     sc_socketcan s;
     assert_int_equal(sc_socketcan_open(&s, &fake_sys, &fk, "vcan0"), 0);
     sc_can_dev dev = sc_socketcan_dev(&s);
-    const sc_can_filter fl[2] = {{.id = 0x100, .mask = 0x7F0}, {.id = 0x18DA00F1, .mask = 0x1FFFFFFF,
-                                                              .flags = SC_CAN_FLAG_EXT}};
+    const sc_can_filter fl[2] = {{.id = 0x100, .mask = 0x7F0},
+                                 {.id = 0x18DA00F1, .mask = 0x1FFFFFFF, .flags = SC_CAN_FLAG_EXT}};
     assert_int_equal(sc_can_set_filters(&dev, fl, 2), 0);
     assert_int_equal(fk.filt_n, 2);
     assert_int_equal(fk.filt[0].can_id, 0x100);

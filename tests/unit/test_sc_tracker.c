@@ -82,9 +82,8 @@ static void parts_of_consecutive_samples_may_interleave(void **state)
     assert_int_equal(sc_canproto_encode_pose(&b, 5, 0, fb, 3, &n), 0);
     /* order on the bus: A.pos B.pos A.quat B.quat A.aux B.aux */
     const sc_can_frame *order[6] = {&fa[0], &fb[0], &fa[1], &fb[1], &fa[2], &fb[2]};
-    const sc_trk_outcome want[6] = {SC_TRK_POSE_PART, SC_TRK_POSE_PART, SC_TRK_POSE_PART,
-                                    SC_TRK_POSE_PART, SC_TRK_POSE_ACCEPTED,
-                                    SC_TRK_POSE_ACCEPTED};
+    const sc_trk_outcome want[6] = {SC_TRK_POSE_PART, SC_TRK_POSE_PART,     SC_TRK_POSE_PART,
+                                    SC_TRK_POSE_PART, SC_TRK_POSE_ACCEPTED, SC_TRK_POSE_ACCEPTED};
     for (int i = 0; i < 6; i++) {
         assert_int_equal(sc_tracker_on_frame(&trk, order[i], (uint64_t)(10 + i) * MS), want[i]);
     }
@@ -369,8 +368,8 @@ static void status_frames_carry_the_tracker_counters(void **s)
     sc_pose_msg p = pose_at(0.0f, 0.0f, 0.0f);
     assert_int_equal(send_pose(&p, 0, 1 * MS, 1), SC_TRK_POSE_ACCEPTED);
     assert_int_equal(send_pose(&p, 0, 11 * MS, 1), SC_TRK_E2E_REPEATED);
-    sc_status_msg st = {.state = 1, .case_id = 3, .vein_area_ratio = 1.0f,
-                        .artery_area_ratio = 1.0f};
+    sc_status_msg st = {
+        .state = 1, .case_id = 3, .vein_area_ratio = 1.0f, .artery_area_ratio = 1.0f};
     sc_can_frame f[3];
     assert_int_equal(sc_tracker_encode_status(&trk, &st, f), 0);
     sc_status_msg d = {0};
@@ -413,21 +412,19 @@ int main(void)
         cmocka_unit_test_setup(classic_pose_is_assembled_from_three_frames_and_normalised, setup),
         cmocka_unit_test_setup(parts_of_consecutive_samples_may_interleave, setup),
         cmocka_unit_test_setup(a_lost_part_drops_its_sample_and_is_counted, setup),
-        cmocka_unit_test_setup(a_sample_completed_after_a_newer_one_is_stale_and_never_used,
-                               setup),
+        cmocka_unit_test_setup(a_sample_completed_after_a_newer_one_is_stale_and_never_used, setup),
         cmocka_unit_test_setup(fd_pose_is_accepted_unless_disabled, setup),
         cmocka_unit_test_setup(every_e2e_fault_is_rejected_counted_and_never_used, setup),
-        cmocka_unit_test_setup(every_plausibility_rejection_is_named_counted_and_never_used,
-                               setup),
+        cmocka_unit_test_setup(every_plausibility_rejection_is_named_counted_and_never_used, setup),
         cmocka_unit_test_setup(a_fast_move_becomes_plausible_when_enough_time_passed, setup),
         cmocka_unit_test_setup(
             silence_past_the_timeout_lifts_the_probe_and_return_skips_the_speed_check, setup),
         cmocka_unit_test_setup(
             a_tracker_slower_than_the_frame_rate_never_stalls_and_gives_the_newest_pose, setup),
-        cmocka_unit_test_setup(
-            commands_are_queued_in_order_and_overflow_and_bad_values_are_counted, setup),
-        cmocka_unit_test_setup(
-            error_frames_are_reported_to_health_and_foreign_frames_are_ignored, setup),
+        cmocka_unit_test_setup(commands_are_queued_in_order_and_overflow_and_bad_values_are_counted,
+                               setup),
+        cmocka_unit_test_setup(error_frames_are_reported_to_health_and_foreign_frames_are_ignored,
+                               setup),
         cmocka_unit_test_setup(status_frames_carry_the_tracker_counters, setup),
         cmocka_unit_test_setup(invalid_definitions_are_refused, setup),
     };

@@ -126,8 +126,7 @@ static void every_injected_fault_is_counted_by_the_tracker(void **state)
         /* every other sample was accepted */
         assert_int_equal(k->outcome[SC_TRK_POSE_ACCEPTED],
                          e.samples_sent - e.injected[SC_EMU_F_BAD_CRC] -
-                             e.injected[SC_EMU_F_IMPLAUSIBLE] -
-                             e.injected[SC_EMU_F_COUNTER_JUMP]);
+                             e.injected[SC_EMU_F_IMPLAUSIBLE] - e.injected[SC_EMU_F_COUNTER_JUMP]);
         /* between silences the engine always had a pose (polls at 60 Hz, poses at 100 Hz) */
         assert_true(r.polls_with_pose + e.injected[SC_EMU_F_SILENCE] * 20u >= r.polls);
         assert_true(r.polls_with_pose < r.polls);
@@ -137,7 +136,8 @@ static void every_injected_fault_is_counted_by_the_tracker(void **state)
 static void csv_rows_load_and_bad_rows_name_their_line(void **state)
 {
     (void)state;
-    char good[] = "t_s,x,y,z,qw,qx,qy,qz,force\n# comment\n0,1,2,3,1,0,0,0\n0.5, 1,2,3, 1,0,0,0, 4.5\n";
+    char good[] =
+        "t_s,x,y,z,qw,qx,qy,qz,force\n# comment\n0,1,2,3,1,0,0,0\n0.5, 1,2,3, 1,0,0,0, 4.5\n";
     sc_emu_row rows[4];
     size_t n = 0, bad = 0;
     FILE *fp = fmemopen(good, strlen(good), "r");

@@ -76,7 +76,8 @@ static void b_on_frame_classic(uint32_t n)
     sc_tracker_init(&trk, &d);
     for (uint32_t i = 0; i < n; i++) {
         /* a new sample every 3 frames, 10 ms apart */
-        sink += (uint32_t)sc_tracker_on_frame(&trk, &classic[i % 48u], (uint64_t)(i / 3u) * 10000000u + 1u);
+        sink += (uint32_t)sc_tracker_on_frame(&trk, &classic[i % 48u],
+                                              (uint64_t)(i / 3u) * 10000000u + 1u);
     }
 }
 
@@ -123,8 +124,10 @@ int main(int argc, char **argv)
 {
     const uint32_t n = argc > 1 ? (uint32_t)strtoul(argv[1], NULL, 10) : 200000u;
     for (uint32_t s = 0; s < 16u; s++) {
-        sc_pose_msg p = {.pos_mm = {(float)s * 0.2f, 0.0f, 5.0f}, .q = {1.0f, 0.0f, 0.0f, 0.0f},
-                         .force_n = 1.0f, .force_valid = 1};
+        sc_pose_msg p = {.pos_mm = {(float)s * 0.2f, 0.0f, 5.0f},
+                         .q = {1.0f, 0.0f, 0.0f, 0.0f},
+                         .force_n = 1.0f,
+                         .force_valid = 1};
         size_t k;
         sc_canproto_encode_pose(&p, (uint8_t)s, 0, &classic[s * 3u], 3, &k);
         sc_canproto_encode_pose(&p, (uint8_t)s, 1, &fd[s], 1, &k);

@@ -75,9 +75,12 @@ int main(int argc, char **argv)
     double duration_s = 5.0, rate_hz = 60.0;
     int filters = 1;
     static const struct option opts[] = {
-        {"iface", required_argument, 0, 'i'},  {"replay", required_argument, 0, 'r'},
-        {"log", required_argument, 0, 'l'},    {"duration-s", required_argument, 0, 'd'},
-        {"rate-hz", required_argument, 0, 'R'}, {"no-filters", no_argument, 0, 'n'},
+        {"iface", required_argument, 0, 'i'},
+        {"replay", required_argument, 0, 'r'},
+        {"log", required_argument, 0, 'l'},
+        {"duration-s", required_argument, 0, 'd'},
+        {"rate-hz", required_argument, 0, 'R'},
+        {"no-filters", no_argument, 0, 'n'},
         {0, 0, 0, 0},
     };
     int c;
@@ -219,8 +222,8 @@ int main(int argc, char **argv)
     sc_can_counters cnt;
     sc_can_state state;
     (void)sc_can_get_state(&dev, &state, &cnt);
-    printf("burst_limited=%llu\nkernel_drops=%u\ncan_state=%d\n",
-           (unsigned long long)burst_limited, cnt.rx_dropped, (int)state);
+    printf("burst_limited=%llu\nkernel_drops=%u\ncan_state=%d\n", (unsigned long long)burst_limited,
+           cnt.rx_dropped, (int)state);
     report(&trk, &st);
     sc_socketcan_close(&node);
     return 0;

@@ -91,16 +91,26 @@ int main(int argc, char **argv)
     double t0_s = 1700000000.0;
     int have_script = 0;
     static const struct option opts[] = {
-        {"script", required_argument, 0, 's'}, {"csv", required_argument, 0, 'c'},
-        {"rate-hz", required_argument, 0, 'r'}, {"duration-s", required_argument, 0, 'd'},
-        {"fd", no_argument, 0, 'F'}, {"point", required_argument, 0, 'p'},
-        {"depth-mm", required_argument, 0, 'D'}, {"hover-mm", required_argument, 0, 'H'},
-        {"length-mm", required_argument, 0, 'L'}, {"period-s", required_argument, 0, 'T'},
-        {"angle-deg", required_argument, 0, 'A'}, {"no-force", no_argument, 0, 'n'},
-        {"fault", required_argument, 0, 'f'}, {"silence-ms", required_argument, 0, 'S'},
-        {"iface", required_argument, 0, 'i'}, {"log", required_argument, 0, 'l'},
-        {"log-iface", required_argument, 0, 'I'}, {"t0", required_argument, 0, 't'},
-        {"help", no_argument, 0, 'h'}, {0, 0, 0, 0},
+        {"script", required_argument, 0, 's'},
+        {"csv", required_argument, 0, 'c'},
+        {"rate-hz", required_argument, 0, 'r'},
+        {"duration-s", required_argument, 0, 'd'},
+        {"fd", no_argument, 0, 'F'},
+        {"point", required_argument, 0, 'p'},
+        {"depth-mm", required_argument, 0, 'D'},
+        {"hover-mm", required_argument, 0, 'H'},
+        {"length-mm", required_argument, 0, 'L'},
+        {"period-s", required_argument, 0, 'T'},
+        {"angle-deg", required_argument, 0, 'A'},
+        {"no-force", no_argument, 0, 'n'},
+        {"fault", required_argument, 0, 'f'},
+        {"silence-ms", required_argument, 0, 'S'},
+        {"iface", required_argument, 0, 'i'},
+        {"log", required_argument, 0, 'l'},
+        {"log-iface", required_argument, 0, 'I'},
+        {"t0", required_argument, 0, 't'},
+        {"help", no_argument, 0, 'h'},
+        {0, 0, 0, 0},
     };
     int c;
     double v;
@@ -197,8 +207,9 @@ int main(int argc, char **argv)
         const int rc = sc_emu_load_csv(fp, rows, MAX_ROWS, &def.n_rows, &bad_line);
         fclose(fp);
         if (rc != 0) {
-            fprintf(stderr, "sc-tracker-emu: %s:%zu: %s (want t_s,x,y,z,qw,qx,qy,qz[,force_n] "
-                            "with increasing t_s)\n",
+            fprintf(stderr,
+                    "sc-tracker-emu: %s:%zu: %s (want t_s,x,y,z,qw,qx,qy,qz[,force_n] "
+                    "with increasing t_s)\n",
                     csv, bad_line, sc_err_str(rc));
             return 2;
         }
@@ -281,8 +292,9 @@ int main(int argc, char **argv)
     if (iface) {
         sc_socketcan_close(&node);
     }
-    fprintf(stderr, "sc-tracker-emu: script %s, %.1f Hz, %s: samples_sent=%llu "
-                    "samples_silent=%llu frames=%llu tx_failed=%llu",
+    fprintf(stderr,
+            "sc-tracker-emu: script %s, %.1f Hz, %s: samples_sent=%llu "
+            "samples_silent=%llu frames=%llu tx_failed=%llu",
             sc_emu_script_name(def.script), def.rate_hz, def.fd ? "fd" : "classic",
             (unsigned long long)emu.samples_sent, (unsigned long long)emu.samples_silent,
             (unsigned long long)emu.frames_sent, (unsigned long long)tx_failed);

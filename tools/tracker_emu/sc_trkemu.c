@@ -124,7 +124,7 @@ sc_pose_msg sc_emu_pose_at(const sc_emu_def *d, double t)
         break;
     }
     case SC_EMU_LIFT:
-        p.pos_mm[2] = t < 1.0 ? lerpf(top, bottom, t)
+        p.pos_mm[2] = t < 1.0   ? lerpf(top, bottom, t)
                       : t < 2.0 ? bottom
                       : t < 2.5 ? lerpf(bottom, top, (t - 2.0) * 2.0)
                                 : top;
@@ -182,8 +182,7 @@ static int fault_due(const sc_emu *e, double t_s)
 {
     for (size_t i = 0; i < e->def.n_faults; i++) {
         const sc_emu_fault *f = &e->def.faults[i];
-        if (f->period > 0u && t_s >= f->start_s && e->sample > 0u &&
-            e->sample % f->period == 0u) {
+        if (f->period > 0u && t_s >= f->start_s && e->sample > 0u && e->sample % f->period == 0u) {
             return (int)f->kind;
         }
     }

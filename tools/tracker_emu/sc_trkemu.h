@@ -92,8 +92,8 @@ sc_emu_def sc_emu_default_def(void);
 
 typedef struct sc_emu {
     sc_emu_def def;
-    uint64_t sample;   /* next sample index */
-    uint8_t counter;   /* next E2E counter */
+    uint64_t sample; /* next sample index */
+    uint8_t counter; /* next E2E counter */
     uint64_t silent_until_ns;
     uint32_t implausible_variant;
     uint64_t injected[SC_EMU_F_COUNT];
