@@ -10,8 +10,7 @@
 /* ---- little-endian field access (alignment- and host-endianness-independent) ------------- */
 static uint32_t rd_u32(const uint8_t *p)
 {
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) |
-           ((uint32_t)p[3] << 24);
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
 }
 
 static uint64_t rd_u64(const uint8_t *p)
@@ -75,14 +74,7 @@ enum {
     HDR_CRC = 60
 };
 /* Section header layout (offsets). */
-enum {
-    SEC_TAG = 0,
-    SEC_FLAGS = 4,
-    SEC_SIZE = 8,
-    SEC_CRC = 16,
-    SEC_RESERVED = 20,
-    SEC_HCRC = 60
-};
+enum { SEC_TAG = 0, SEC_FLAGS = 4, SEC_SIZE = 8, SEC_CRC = 16, SEC_RESERVED = 20, SEC_HCRC = 60 };
 
 _Static_assert(HDR_CRC + 4 == SC_CASE_HEADER_SIZE, "file header layout");
 _Static_assert(SEC_HCRC + 4 == SC_CASE_SECTION_HEADER_SIZE, "section header layout");
@@ -192,7 +184,8 @@ static uint64_t payload_sizes(const sc_case_def *def, uint64_t sizes[SC_CASE_SEC
     sizes[1] = SC_CASE_GRID_SIZE;
     sizes[2] = nvox;
     sizes[3] = nvox;
-    sizes[4] = SC_CASE_MATL_HEAD_SIZE + (uint64_t)def->material_count * SC_CASE_MATERIAL_RECORD_SIZE;
+    sizes[4] =
+        SC_CASE_MATL_HEAD_SIZE + (uint64_t)def->material_count * SC_CASE_MATERIAL_RECORD_SIZE;
     sizes[5] = SC_CASE_MESH_SIZE;
     sizes[6] = SC_CASE_XFRM_SIZE;
     if (nvox == 0u) {
@@ -367,7 +360,8 @@ static int load_sections(const uint8_t *bytes, size_t size, section_ref sec[SC_C
     if (rd_u32(bytes + HDR_HEADER_SIZE) != SC_CASE_HEADER_SIZE) {
         return SC_ERR_CASE_SECTION;
     }
-    if (rd_u32(bytes + HDR_FLAGS) != 0u || !all_zero(bytes + HDR_RESERVED, HDR_CRC - HDR_RESERVED)) {
+    if (rd_u32(bytes + HDR_FLAGS) != 0u ||
+        !all_zero(bytes + HDR_RESERVED, HDR_CRC - HDR_RESERVED)) {
         return SC_ERR_CASE_RESERVED;
     }
     const uint64_t file_size = rd_u64(bytes + HDR_FILE_SIZE);
@@ -525,8 +519,8 @@ int sc_case_load(const uint8_t *bytes, size_t size, sc_case *out)
     if (c.material_count == 0u || c.material_count > SC_MAX_LABELS) {
         return SC_ERR_CASE_MATERIAL;
     }
-    if (sec[4].size != SC_CASE_MATL_HEAD_SIZE +
-                           (uint64_t)c.material_count * SC_CASE_MATERIAL_RECORD_SIZE) {
+    if (sec[4].size !=
+        SC_CASE_MATL_HEAD_SIZE + (uint64_t)c.material_count * SC_CASE_MATERIAL_RECORD_SIZE) {
         return SC_ERR_CASE_SIZE;
     }
     for (uint32_t m = 0; m < c.material_count; m++) {

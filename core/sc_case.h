@@ -37,42 +37,42 @@
 #include "sc_volume.h"
 
 /* ---- format constants (v1) --------------------------------------------------------------- */
-#define SC_CASE_MAGIC "\x89SCASE\r\n" /* 8 bytes, PNG-style: catches text-mode mangling */
-#define SC_CASE_MAGIC_LEN 8u
-#define SC_CASE_VERSION 1u
-#define SC_CASE_HEADER_SIZE 64u
-#define SC_CASE_SECTION_HEADER_SIZE 64u
-#define SC_CASE_ALIGN 64u
-#define SC_CASE_NAME_LEN 64u         /* bytes incl. the terminating NUL */
-#define SC_CASE_DESCRIPTION_LEN 960u /* bytes incl. the terminating NUL */
+#define SC_CASE_MAGIC                "\x89SCASE\r\n" /* 8 bytes, PNG-style: catches text-mode mangling */
+#define SC_CASE_MAGIC_LEN            8u
+#define SC_CASE_VERSION              1u
+#define SC_CASE_HEADER_SIZE          64u
+#define SC_CASE_SECTION_HEADER_SIZE  64u
+#define SC_CASE_ALIGN                64u
+#define SC_CASE_NAME_LEN             64u  /* bytes incl. the terminating NUL */
+#define SC_CASE_DESCRIPTION_LEN      960u /* bytes incl. the terminating NUL */
 #define SC_CASE_MATERIAL_RECORD_SIZE 16u
 /* Tolerance of the rigidity check of transforms and orientation (float32 round-off of a
  * rotation written from doubles is ~1e-7; 1e-4 refuses anything visibly non-rigid). */
 #define SC_CASE_RIGID_TOL 1.0e-4f
 
 /* Section tags: four ASCII characters read as a little-endian u32. */
-#define SC_CASE_TAG(a, b, c, d)                                                                 \
+#define SC_CASE_TAG(a, b, c, d)                                                                    \
     ((uint32_t)(a) | ((uint32_t)(b) << 8) | ((uint32_t)(c) << 16) | ((uint32_t)(d) << 24))
-#define SC_CASE_TAG_INFO SC_CASE_TAG('I', 'N', 'F', 'O')
-#define SC_CASE_TAG_GRID SC_CASE_TAG('G', 'R', 'I', 'D')
-#define SC_CASE_TAG_VOXL SC_CASE_TAG('V', 'O', 'X', 'L')
-#define SC_CASE_TAG_LABL SC_CASE_TAG('L', 'A', 'B', 'L')
-#define SC_CASE_TAG_MATL SC_CASE_TAG('M', 'A', 'T', 'L')
-#define SC_CASE_TAG_MESH SC_CASE_TAG('M', 'E', 'S', 'H')
-#define SC_CASE_TAG_XFRM SC_CASE_TAG('X', 'F', 'R', 'M')
+#define SC_CASE_TAG_INFO      SC_CASE_TAG('I', 'N', 'F', 'O')
+#define SC_CASE_TAG_GRID      SC_CASE_TAG('G', 'R', 'I', 'D')
+#define SC_CASE_TAG_VOXL      SC_CASE_TAG('V', 'O', 'X', 'L')
+#define SC_CASE_TAG_LABL      SC_CASE_TAG('L', 'A', 'B', 'L')
+#define SC_CASE_TAG_MATL      SC_CASE_TAG('M', 'A', 'T', 'L')
+#define SC_CASE_TAG_MESH      SC_CASE_TAG('M', 'E', 'S', 'H')
+#define SC_CASE_TAG_XFRM      SC_CASE_TAG('X', 'F', 'R', 'M')
 #define SC_CASE_SECTION_COUNT 7u
 
 /* Payload sizes of the fixed-size sections. */
-#define SC_CASE_INFO_SIZE (SC_CASE_NAME_LEN + SC_CASE_DESCRIPTION_LEN) /* 1024 */
-#define SC_CASE_GRID_SIZE 80u  /* u32 dim[3], u32 0, f32 spacing[3], origin[3], orient[9], u32 0 */
-#define SC_CASE_MESH_SIZE 40u  /* f32 origin[3], size[3], u32 nx, ny, nz, u32 0 */
-#define SC_CASE_XFRM_SIZE 96u  /* image->probe, tracker->patient: 12 f32 each (r[9], t[3]) */
-#define SC_CASE_MATL_HEAD_SIZE 8u /* u32 count, u32 0; then count 16-byte records */
+#define SC_CASE_INFO_SIZE      (SC_CASE_NAME_LEN + SC_CASE_DESCRIPTION_LEN) /* 1024 */
+#define SC_CASE_GRID_SIZE      80u /* u32 dim[3], u32 0, f32 spacing[3], origin[3], orient[9], u32 0 */
+#define SC_CASE_MESH_SIZE      40u /* f32 origin[3], size[3], u32 nx, ny, nz, u32 0 */
+#define SC_CASE_XFRM_SIZE      96u /* image->probe, tracker->patient: 12 f32 each (r[9], t[3]) */
+#define SC_CASE_MATL_HEAD_SIZE 8u  /* u32 count, u32 0; then count 16-byte records */
 
 _Static_assert(SC_MAX_LABELS >= 9u && SC_MAX_LABELS <= 256u, "labels are 8-bit");
 _Static_assert(SC_MAX_VOLUME_DIM >= 2u, "volume needs at least 2 voxels per axis");
-_Static_assert(SC_MAX_VOLUME_VOXELS <= (uint64_t)SC_MAX_VOLUME_DIM * SC_MAX_VOLUME_DIM *
-                                           SC_MAX_VOLUME_DIM,
+_Static_assert(SC_MAX_VOLUME_VOXELS <=
+                   (uint64_t)SC_MAX_VOLUME_DIM * SC_MAX_VOLUME_DIM * SC_MAX_VOLUME_DIM,
                "voxel limit above what the dimension limit allows");
 _Static_assert(SC_CASE_INFO_SIZE == 1024u, "INFO payload size");
 
@@ -91,14 +91,14 @@ typedef struct sc_case {
     float orientation[9];    /* grid axes in the mannequin frame, row-major, as stored */
     uint32_t material_count; /* 1..SC_MAX_LABELS; every label value is < material_count */
     sc_case_material materials[SC_MAX_LABELS];
-    sc_mesh_def mesh;             /* mesh box (volume frame, mm) and node counts */
-    sc_xform image_to_probe;      /* probe calibration */
-    sc_xform tracker_to_patient;  /* mannequin registration as stored */
-    sc_xform tracker_to_volume;   /* registration with the orientation folded in */
+    sc_mesh_def mesh;            /* mesh box (volume frame, mm) and node counts */
+    sc_xform image_to_probe;     /* probe calibration */
+    sc_xform tracker_to_patient; /* mannequin registration as stored */
+    sc_xform tracker_to_volume;  /* registration with the orientation folded in */
     uint64_t voxel_count;
-    uint32_t case_id;             /* CRC-32 over the file and section headers (without their
-                                   * own CRC fields; they hold the payload CRCs): identifies
-                                   * the case content */
+    uint32_t case_id; /* CRC-32 over the file and section headers (without their
+                       * own CRC fields; they hold the payload CRCs): identifies
+                       * the case content */
 } sc_case;
 
 /* What the writer encodes. volume.voxels and volume.labels must both be non-NULL. */
@@ -147,10 +147,10 @@ typedef struct sc_case_slot {
     const sc_storage_dev *dev; /* storage of the mapping below; NULL when empty */
     const uint8_t *data;
     size_t size;
-    sc_case c;                 /* valid when loaded != 0 */
+    sc_case c; /* valid when loaded != 0 */
     int loaded;
-    int last_error;            /* result of the last sc_case_slot_switch() */
-    uint32_t refused;          /* switches refused so far */
+    int last_error;   /* result of the last sc_case_slot_switch() */
+    uint32_t refused; /* switches refused so far */
 } sc_case_slot;
 
 void sc_case_slot_init(sc_case_slot *s);

@@ -22,7 +22,7 @@ static char g_dir[128];
 #define DX 6u
 #define DY 5u
 #define DZ 4u
-#define N (DX * DY * DZ)
+#define N  (DX * DY * DZ)
 
 static double g_vals[N];
 
@@ -98,9 +98,8 @@ static void run_case(const char *name, int bits, int is_signed, double slope, do
     assert_int_equal(mkdir(d, 0700), 0);
     sc_image ref;
     make_volume(&ref, bits, is_signed, slope, icpt);
-    assert_int_equal(sc_dicom_write_fixture(d, &ref, bits, is_signed, slope, icpt, multiframe,
-                                            compress),
-                     SC_OK);
+    assert_int_equal(
+        sc_dicom_write_fixture(d, &ref, bits, is_signed, slope, icpt, multiframe, compress), SC_OK);
     if (multiframe) {
         char f[300];
         snprintf(f, sizeof f, "%s/volume.dcm", d);

@@ -17,14 +17,14 @@
 #define DX 7u
 #define DY 5u
 #define DZ 4u
-#define N (DX * DY * DZ)
+#define N  (DX * DY * DZ)
 
 static char g_dir[256];
 
-static const char *const met_names[] = {"MET_UCHAR", "MET_CHAR",  "MET_USHORT", "MET_SHORT",
-                                        "MET_UINT",  "MET_INT",   "MET_FLOAT",  "MET_DOUBLE"};
-static const char *const nrrd_names[] = {"uchar", "int8", "ushort", "short",
-                                         "uint",  "int32", "float", "double"};
+static const char *const met_names[] = {"MET_UCHAR", "MET_CHAR", "MET_USHORT", "MET_SHORT",
+                                        "MET_UINT",  "MET_INT",  "MET_FLOAT",  "MET_DOUBLE"};
+static const char *const nrrd_names[] = {"uchar", "int8",  "ushort", "short",
+                                         "uint",  "int32", "float",  "double"};
 static const size_t esize[] = {1, 1, 2, 2, 4, 4, 4, 8};
 
 /* reference value of voxel i for each type: uses the type's range, signs, fractions */
@@ -118,8 +118,7 @@ static size_t deflate_buf(const uint8_t *src, size_t n, uint8_t *dst, size_t cap
 {
     z_stream zs;
     memset(&zs, 0, sizeof zs);
-    assert_int_equal(deflateInit2(&zs, 6, Z_DEFLATED, gzip ? 31 : 15, 8, Z_DEFAULT_STRATEGY),
-                     Z_OK);
+    assert_int_equal(deflateInit2(&zs, 6, Z_DEFLATED, gzip ? 31 : 15, 8, Z_DEFAULT_STRATEGY), Z_OK);
     zs.next_in = (Bytef *)(uintptr_t)src;
     zs.avail_in = (uInt)n;
     zs.next_out = dst;
@@ -216,7 +215,8 @@ static void nrrd_every_type_raw_gzip_ascii_attached_and_detached(void **state)
             static char txt[N * 32u];
             size_t tn = 0;
             for (size_t i = 0; i < N; i++) {
-                tn += (size_t)snprintf(txt + tn, sizeof txt - tn, "%.17g%c", ref_value((sc_elem_type)t, i),
+                tn += (size_t)snprintf(txt + tn, sizeof txt - tn, "%.17g%c",
+                                       ref_value((sc_elem_type)t, i),
                                        (i % DX) == DX - 1u ? '\n' : ' ');
             }
             for (int enc = 0; enc < 3; enc++) {
@@ -241,9 +241,9 @@ static void nrrd_every_type_raw_gzip_ascii_attached_and_detached(void **state)
                                       "kinds: domain domain domain\nendian: %s\n"
                                       "encoding: %s\nspace origin: (-3,2.5,10)\n"
                                       "patient name:=Should Be Ignored\n%s%s",
-                                      nrrd_names[t], DX, DY, DZ, big ? "big" : "little",
-                                      encs[enc], df, detached ? "" : "\n");
-                    const void *data = enc == 0 ? (const void *)g_raw
+                                      nrrd_names[t], DX, DY, DZ, big ? "big" : "little", encs[enc],
+                                      df, detached ? "" : "\n");
+                    const void *data = enc == 0   ? (const void *)g_raw
                                        : enc == 1 ? (const void *)g_z
                                                   : (const void *)txt;
                     size_t dn = enc == 0 ? rn : enc == 1 ? zn : tn;
@@ -423,32 +423,46 @@ static void bad_inputs_are_refused_with_named_errors(void **state)
     sc_image img;
     path_of(p, sizeof p, "missing.mha");
     assert_int_equal(sc_image_read(p, &img, err, sizeof err), SC_ERR_NOT_FOUND);
-    path_of(p, sizeof p, "x.dcm");
+    path_of(p, sizeof p, "x.vtk");
     assert_int_equal(sc_image_read(p, &img, err, sizeof err), SC_ERR_NOT_SUPPORTED);
-    snprintf(hdr, sizeof hdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: %u %u %u\n"
-                              "encoding: raw\n\n", DX, DY, DZ);
+    snprintf(hdr, sizeof hdr,
+             "NRRD0004\ntype: uchar\ndimension: 3\nsizes: %u %u %u\n"
+             "encoding: raw\n\n",
+             DX, DY, DZ);
     assert_int_equal(read_named("short.nrrd", hdr, data, N - 1u), SC_ERR_PARSE);
-    snprintf(hdr, sizeof hdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: %u %u %u\n"
-                              "encoding: bzip2\n\n", DX, DY, DZ);
+    snprintf(hdr, sizeof hdr,
+             "NRRD0004\ntype: uchar\ndimension: 3\nsizes: %u %u %u\n"
+             "encoding: bzip2\n\n",
+             DX, DY, DZ);
     assert_int_equal(read_named("bz.nrrd", hdr, data, N), SC_ERR_NOT_SUPPORTED);
-    snprintf(hdr, sizeof hdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: %u %u %u\n"
-                              "encoding: gzip\n\n", DX, DY, DZ);
+    snprintf(hdr, sizeof hdr,
+             "NRRD0004\ntype: uchar\ndimension: 3\nsizes: %u %u %u\n"
+             "encoding: gzip\n\n",
+             DX, DY, DZ);
     assert_int_equal(read_named("badgz.nrrd", hdr, data, N), SC_ERR_PARSE);
-    snprintf(hdr, sizeof hdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2000 2 2\n"
-                              "encoding: raw\n\n");
+    snprintf(hdr, sizeof hdr,
+             "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2000 2 2\n"
+             "encoding: raw\n\n");
     assert_int_equal(read_named("big.nrrd", hdr, data, N), SC_ERR_CASE_DIMS);
-    snprintf(hdr, sizeof hdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: %u %u %u\n"
-                              "spacings: 1 nan 1\nencoding: raw\n\n", DX, DY, DZ);
+    snprintf(hdr, sizeof hdr,
+             "NRRD0004\ntype: uchar\ndimension: 3\nsizes: %u %u %u\n"
+             "spacings: 1 nan 1\nencoding: raw\n\n",
+             DX, DY, DZ);
     assert_int_equal(read_named("nan.nrrd", hdr, data, N), SC_ERR_CASE_SPACING);
-    snprintf(hdr, sizeof hdr, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: %u %u %u\n"
-                              "space directions: (1,0,0) (0,1,0) (0,0,-1)\nencoding: raw\n\n",
+    snprintf(hdr, sizeof hdr,
+             "NRRD0004\ntype: uchar\ndimension: 3\nsizes: %u %u %u\n"
+             "space directions: (1,0,0) (0,1,0) (0,0,-1)\nencoding: raw\n\n",
              DX, DY, DZ);
     assert_int_equal(read_named("lefthanded.nrrd", hdr, data, N), SC_ERR_CASE_TRANSFORM);
-    snprintf(hdr, sizeof hdr, "NDims = 3\nDimSize = %u %u %u\nElementType = MET_LONG_LONG\n"
-                              "ElementDataFile = LOCAL\n", DX, DY, DZ);
+    snprintf(hdr, sizeof hdr,
+             "NDims = 3\nDimSize = %u %u %u\nElementType = MET_LONG_LONG\n"
+             "ElementDataFile = LOCAL\n",
+             DX, DY, DZ);
     assert_int_equal(read_named("ll.mha", hdr, data, N), SC_ERR_NOT_SUPPORTED);
-    snprintf(hdr, sizeof hdr, "NDims = 3\nDimSize = %u %u %u\nElementType = MET_UCHAR\n"
-                              "CompressedData = True\nElementDataFile = LOCAL\n", DX, DY, DZ);
+    snprintf(hdr, sizeof hdr,
+             "NDims = 3\nDimSize = %u %u %u\nElementType = MET_UCHAR\n"
+             "CompressedData = True\nElementDataFile = LOCAL\n",
+             DX, DY, DZ);
     assert_int_equal(read_named("badz.mha", hdr, data, N), SC_ERR_PARSE);
     /* label values that are not labels */
     float fl[N];
@@ -456,8 +470,10 @@ static void bad_inputs_are_refused_with_named_errors(void **state)
         fl[i] = 1.0f;
     }
     fl[N / 2u] = 1.5f;
-    snprintf(hdr, sizeof hdr, "NRRD0004\ntype: float\ndimension: 3\nsizes: %u %u %u\n"
-                              "encoding: raw\nendian: little\n\n", DX, DY, DZ);
+    snprintf(hdr, sizeof hdr,
+             "NRRD0004\ntype: float\ndimension: 3\nsizes: %u %u %u\n"
+             "encoding: raw\nendian: little\n\n",
+             DX, DY, DZ);
     write_bytes("flab.nrrd", hdr, strlen(hdr), fl, sizeof fl);
     write_bytes("fvol.nrrd", hdr, strlen(hdr), fl, sizeof fl);
     sc_import_opts o = sc_import_default_opts();

@@ -20,7 +20,8 @@ static sc_volume sphere_volume(float r_mm, float sp)
         for (uint32_t j = 0; j < D; j++) {
             for (uint32_t i = 0; i < D; i++) {
                 float x = (float)i * sp - c, y = (float)j * sp - c, z = (float)k * sp - c;
-                g_lab[i + D * (j + D * k)] = (uint8_t)(x * x + y * y + z * z <= r_mm * r_mm ? 4 : 2);
+                g_lab[i + D * (j + D * k)] =
+                    (uint8_t)(x * x + y * y + z * z <= r_mm * r_mm ? 4 : 2);
             }
         }
     }

@@ -18,8 +18,8 @@
 
 typedef struct blob {
     size_t count;
-    float cx, cz;          /* centroid, mm */
-    float width, depth;    /* extent along x and z, mm (voxel count across + 1 voxel) */
+    float cx, cz;       /* centroid, mm */
+    float width, depth; /* extent along x and z, mm (voxel count across + 1 voxel) */
 } blob;
 
 static size_t vidx(const sc_volume *v, uint32_t i, uint32_t j, uint32_t k)
@@ -74,9 +74,8 @@ static void stated(const char *desc, const char *what, float *depth, float *w, f
     const char *p = strstr(desc, what);
     assert_non_null(p);
     float x;
-    assert_int_equal(sscanf(p + strlen(what), " centre %f mm deep at x %f mm, %f x %f mm", depth,
-                            &x, w, h),
-                     4);
+    assert_int_equal(
+        sscanf(p + strlen(what), " centre %f mm deep at x %f mm, %f x %f mm", depth, &x, w, h), 4);
 }
 
 static void check_vessels_at_stated_geometry(sc_phantom_kind kind)
@@ -211,8 +210,8 @@ static void image_shows_anechoic_lumen_enhancement_and_bone_shadow(void **state)
     /* lumen anechoic: well below soft tissue (which sits mid-grey) */
     double lumen = mean_box(v, ijv->x_mm - 3.0f, ijv->x_mm + 3.0f, ijv->z_mm - 2.0f,
                             ijv->z_mm + 2.0f, 1u << SC_LABEL_VEIN);
-    double tissue = mean_box(v, -24.0f, 24.0f, 2.0f, 30.0f,
-                             (1u << SC_LABEL_FAT) | (1u << SC_LABEL_MUSCLE));
+    double tissue =
+        mean_box(v, -24.0f, 24.0f, 2.0f, 30.0f, (1u << SC_LABEL_FAT) | (1u << SC_LABEL_MUSCLE));
     assert_true(lumen < 20.0);
     assert_true(tissue > 50.0 && tissue < 160.0);
     /* posterior acoustic enhancement: the same tissue at the same depth is brighter below

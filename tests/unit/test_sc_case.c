@@ -10,9 +10,9 @@
 #include "sc_err.h"
 #include "sc_labels.h"
 
-#define NX 16u
-#define NY 12u
-#define NZ 10u
+#define NX   16u
+#define NY   12u
+#define NZ   10u
 #define NVOX (NX * NY * NZ)
 
 static uint8_t g_vox[NVOX];
@@ -79,8 +79,7 @@ static size_t write_def(const sc_case_def *d, uint8_t *buf)
 
 static uint32_t le32(const uint8_t *p)
 {
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) |
-           ((uint32_t)p[3] << 24);
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
 }
 
 static void put32(uint8_t *p, uint32_t v)
@@ -172,7 +171,8 @@ static void round_trip_gives_identical_voxels_labels_transforms_and_text(void **
         sum += h[l];
     }
     assert_int_equal(sum, NVOX);
-    assert_int_equal(h[SC_LABEL_VEIN], (NVOX + SC_LABEL_COUNT - 1u - SC_LABEL_VEIN) / SC_LABEL_COUNT);
+    assert_int_equal(h[SC_LABEL_VEIN],
+                     (NVOX + SC_LABEL_COUNT - 1u - SC_LABEL_VEIN) / SC_LABEL_COUNT);
 }
 
 static void orientation_is_folded_into_the_registration(void **state)
@@ -273,7 +273,7 @@ static void dimensions_above_limits_or_overflowing_are_refused(void **state)
         {NX, NY, 0u},
         {SC_MAX_VOLUME_DIM + 1u, 1u, 1u},
         {0xFFFFFFFFu, 0xFFFFFFFFu, 0xFFFFFFFFu}, /* product wraps 64-bit too */
-        {65537u, 65536u, 1u},                     /* 32-bit product wraps to 65536 */
+        {65537u, 65536u, 1u},                    /* 32-bit product wraps to 65536 */
         {SC_MAX_VOLUME_DIM, SC_MAX_VOLUME_DIM, SC_MAX_VOLUME_DIM}, /* > SC_MAX_VOLUME_VOXELS */
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
@@ -361,8 +361,7 @@ static void mesh_box_outside_the_volume_is_refused(void **state)
         {0.0f, 1.0f, 0.0f, 1.0f, 1.0f, 9.5f},  /* below the bottom */
         {0.0f, 1.0f, 0.0f, 0.0f, 1.0f, 1.0f},  /* empty */
         {0.0f, 1.0f, 0.0f, -1.0f, 1.0f, 1.0f}, /* negative size */
-        {NAN, 1.0f, 0.0f, 1.0f, 1.0f, 1.0f},
-        {0.0f, 1.0f, 0.0f, 1.0f, INFINITY, 1.0f},
+        {NAN, 1.0f, 0.0f, 1.0f, 1.0f, 1.0f},   {0.0f, 1.0f, 0.0f, 1.0f, INFINITY, 1.0f},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         sc_case_def d = make_def();
@@ -386,8 +385,12 @@ static void mesh_node_counts_outside_limits_are_refused(void **state)
 {
     (void)state;
     const uint32_t bad[][3] = {
-        {SC_MAX_MESH_NX + 1u, 4u, 4u}, {4u, SC_MAX_MESH_NY + 1u, 4u},
-        {4u, 4u, SC_MAX_MESH_NZ + 1u}, {1u, 4u, 4u}, {4u, 0u, 4u}, {0xFFFFFFFFu, 4u, 4u},
+        {SC_MAX_MESH_NX + 1u, 4u, 4u},
+        {4u, SC_MAX_MESH_NY + 1u, 4u},
+        {4u, 4u, SC_MAX_MESH_NZ + 1u},
+        {1u, 4u, 4u},
+        {4u, 0u, 4u},
+        {0xFFFFFFFFu, 4u, 4u},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         sc_case_def d = make_def();

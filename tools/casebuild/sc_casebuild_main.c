@@ -1,7 +1,8 @@
 /* sc-casebuild: build, inspect and verify sonocomp case files.
  *
  *   sc-casebuild phantom <neck-ijv|femoral|femoral-dvt> -o OUT.scase [--seed N] [--spacing MM]
- *   sc-casebuild import --volume V.{mha,mhd,nrrd,nhdr,dcm}|DICOMDIR/ [--labels L.{...}] -o OUT.scase
+ *   sc-casebuild import --volume V.{mha,mhd,nrrd,nhdr,dcm}|DICOMDIR/ [--labels L.{...}] -o
+ * OUT.scase
  *                [--name NAME] [--description TEXT] [--spacing MM] [--window LO:HI]
  *                [--mesh-nodes NX,NY,NZ] [--mesh-box X0,Y0,Z0,SX,SY,SZ]
  *                [--calibration 12 numbers] [--registration 12 numbers] (row-major R, then t)
@@ -91,8 +92,7 @@ static int write_case_file(const sc_case_def *def, const char *path)
     }
     free(buf);
     if (rename(tmp, path) != 0) {
-        fprintf(stderr, "sc-casebuild: cannot rename %s to %s: %s\n", tmp, path,
-                strerror(errno));
+        fprintf(stderr, "sc-casebuild: cannot rename %s to %s: %s\n", tmp, path, strerror(errno));
         return 1;
     }
     return 0;
@@ -120,10 +120,10 @@ static int open_case(sc_storage_linux *st, sc_storage_dev *dev, const char *path
 
 static void print_xform(const char *what, const sc_xform *x)
 {
-    printf("%-22s R [%.4f %.4f %.4f; %.4f %.4f %.4f; %.4f %.4f %.4f] t [%.3f %.3f %.3f] mm\n",
-           what, (double)x->r[0], (double)x->r[1], (double)x->r[2], (double)x->r[3],
-           (double)x->r[4], (double)x->r[5], (double)x->r[6], (double)x->r[7], (double)x->r[8],
-           (double)x->t_mm[0], (double)x->t_mm[1], (double)x->t_mm[2]);
+    printf("%-22s R [%.4f %.4f %.4f; %.4f %.4f %.4f; %.4f %.4f %.4f] t [%.3f %.3f %.3f] mm\n", what,
+           (double)x->r[0], (double)x->r[1], (double)x->r[2], (double)x->r[3], (double)x->r[4],
+           (double)x->r[5], (double)x->r[6], (double)x->r[7], (double)x->r[8], (double)x->t_mm[0],
+           (double)x->t_mm[1], (double)x->t_mm[2]);
 }
 
 static int cmd_info(int argc, char **argv)
@@ -182,9 +182,8 @@ static int cmd_info(int argc, char **argv)
     }
     printf("\nlabel  name       voxels      share   E (Pa)     Poisson  density (kg/m3)\n");
     for (uint32_t l = 0; l < c.material_count; l++) {
-        const char *nm = l < sizeof label_names / sizeof label_names[0] && label_names[l]
-                             ? label_names[l]
-                             : "-";
+        const char *nm =
+            l < sizeof label_names / sizeof label_names[0] && label_names[l] ? label_names[l] : "-";
         printf("%5u  %-9s %10" PRIu64 "  %6.2f%%  %-9.4g  %-7.3f  %.0f\n", l, nm, hist[l],
                100.0 * (double)hist[l] / (double)c.voxel_count, (double)c.materials[l].e_pa,
                (double)c.materials[l].poisson, (double)c.materials[l].density_kg_m3);
@@ -463,8 +462,8 @@ static int cmd_bench(int argc, char **argv)
     if (argc <= first) {
         return usage();
     }
-    printf("%-40s %10s %10s %9s %9s %9s %9s\n", "case", "MB", "voxels", "map ms",
-           "load min", "load med", "GB/s");
+    printf("%-40s %10s %10s %9s %9s %9s %9s\n", "case", "MB", "voxels", "map ms", "load min",
+           "load med", "GB/s");
     int bad = 0;
     for (int i = first; i < argc; i++) {
         sc_storage_linux st;

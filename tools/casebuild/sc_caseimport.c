@@ -95,8 +95,7 @@ static size_t elem_size(sc_elem_type t)
 }
 
 /* Decode n elements of binary data (either byte order) into doubles. */
-static void decode_binary(const uint8_t *src, size_t n, sc_elem_type t, int big_endian,
-                          double *dst)
+static void decode_binary(const uint8_t *src, size_t n, sc_elem_type t, int big_endian, double *dst)
 {
     const size_t es = elem_size(t);
     uint8_t b[8];
@@ -185,8 +184,8 @@ static int inflate_exact(const uint8_t *src, size_t srclen, uint8_t *dst, size_t
     inflateEnd(&zs);
     if (out_left != 0u) {
         return fail(err, errlen, SC_ERR_PARSE,
-                    "compressed data inflates to %zu of %zu bytes (zlib %d)", want - out_left,
-                    want, zr);
+                    "compressed data inflates to %zu of %zu bytes (zlib %d)", want - out_left, want,
+                    zr);
     }
     return SC_OK;
 }
@@ -603,8 +602,7 @@ static int read_nrrd(const char *path, sc_image *img, char *err, size_t errlen)
             int n = parse_numbers(val, v, 9);
             if (n != 9) {
                 free(file);
-                return fail(err, errlen, SC_ERR_PARSE, "%s: space directions need 3 vectors",
-                            path);
+                return fail(err, errlen, SC_ERR_PARSE, "%s: space directions need 3 vectors", path);
             }
             for (int a = 0; a < 3; a++) {
                 double nrm = sqrt(v[a * 3] * v[a * 3] + v[a * 3 + 1] * v[a * 3 + 1] +
@@ -648,8 +646,7 @@ static int read_nrrd(const char *path, sc_image *img, char *err, size_t errlen)
     }
     if (!have_type || (ndims != 2 && ndims != 3)) {
         free(file);
-        return fail(err, errlen, SC_ERR_PARSE, "%s: NRRD needs type and dimension 2 or 3",
-                    path);
+        return fail(err, errlen, SC_ERR_PARSE, "%s: NRRD needs type and dimension 2 or 3", path);
     }
     rc = set_dims(img, dsz, ndims, err, errlen);
     if (rc != SC_OK) {
@@ -741,8 +738,8 @@ static int read_nrrd(const char *path, sc_image *img, char *err, size_t errlen)
                 char *end;
                 img->data[i] = strtod(p, &end);
                 if (end == p) {
-                    rc = fail(err, errlen, SC_ERR_PARSE, "%s: %zu ascii values, %zu expected",
-                              path, i, n);
+                    rc = fail(err, errlen, SC_ERR_PARSE, "%s: %zu ascii values, %zu expected", path,
+                              i, n);
                 }
                 p = end;
                 while (*p == ',' || isspace((unsigned char)*p)) {
@@ -1035,10 +1032,11 @@ int sc_import_case(const sc_import_opts *o, sc_import_result *r, char *err, size
     if (o->description != NULL) {
         snprintf(r->description, sizeof r->description, "%s", o->description);
     } else {
-        snprintf(r->description, sizeof r->description,
-                 "Imported volume (voxels and geometry only), %u x %u x %u, %.3g x %.3g x %.3g mm%s.",
-                 dim[0], dim[1], dim[2], sp[0], sp[1], sp[2],
-                 have_lab ? ", with label map" : ", no label map (soft tissue)");
+        snprintf(
+            r->description, sizeof r->description,
+            "Imported volume (voxels and geometry only), %u x %u x %u, %.3g x %.3g x %.3g mm%s.",
+            dim[0], dim[1], dim[2], sp[0], sp[1], sp[2],
+            have_lab ? ", with label map" : ", no label map (soft tissue)");
     }
     d->name = r->name;
     d->description = r->description;
@@ -1046,8 +1044,9 @@ int sc_import_case(const sc_import_opts *o, sc_import_result *r, char *err, size
     for (int a = 0; a < 3; a++) {
         d->volume.dim[a] = dim[a];
         d->volume.spacing_mm[a] = (float)sp[a];
-        d->volume.origin_mm[a] = (float)(vol.dir[a] * vol.origin[0] + vol.dir[3 + a] * vol.origin[1] +
-                                         vol.dir[6 + a] * vol.origin[2]);
+        d->volume.origin_mm[a] =
+            (float)(vol.dir[a] * vol.origin[0] + vol.dir[3 + a] * vol.origin[1] +
+                    vol.dir[6 + a] * vol.origin[2]);
     }
     for (int i = 0; i < 9; i++) {
         d->orientation[i] = (float)vol.dir[i];

@@ -29,18 +29,18 @@ void sc_image_free(sc_image *img);
 
 typedef struct sc_import_opts {
     const char *volume_path;
-    const char *labels_path;  /* NULL: every voxel inside the body becomes SC_LABEL_MUSCLE */
-    const char *name;         /* default "imported" (never the file name: it may identify) */
-    const char *description;  /* default: "Imported volume" and the grid */
-    float spacing_mm;         /* > 0: resample to this isotropic spacing; 0: keep the source's */
+    const char *labels_path; /* NULL: every voxel inside the body becomes SC_LABEL_MUSCLE */
+    const char *name;        /* default "imported" (never the file name: it may identify) */
+    const char *description; /* default: "Imported volume" and the grid */
+    float spacing_mm;        /* > 0: resample to this isotropic spacing; 0: keep the source's */
     int has_window;
     float window_lo, window_hi; /* intensity window mapped to 0..255; default: 8-bit data as
                                  * is, other types their 0.1 .. 99.9 percentiles */
-    uint32_t mesh_nodes[3];   /* default 24 x 12 x 12 */
+    uint32_t mesh_nodes[3];     /* default 24 x 12 x 12 */
     int has_mesh_box;
-    float mesh_box_mm[6];     /* origin xyz, size xyz in the volume frame; default: the volume */
-    sc_xform image_to_probe;      /* probe calibration; default identity */
-    sc_xform tracker_to_patient;  /* mannequin registration; default identity */
+    float mesh_box_mm[6];        /* origin xyz, size xyz in the volume frame; default: the volume */
+    sc_xform image_to_probe;     /* probe calibration; default identity */
+    sc_xform tracker_to_patient; /* mannequin registration; default identity */
 } sc_import_opts;
 
 typedef struct sc_import_result {

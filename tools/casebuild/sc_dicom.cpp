@@ -24,7 +24,8 @@ extern "C" {
 #include "sc_err.h"
 }
 
-namespace {
+namespace
+{
 
 int fail(char *err, size_t errlen, int rc, const char *fmt, ...)
 {
@@ -167,12 +168,12 @@ int load_one(const std::string &path, dicom_file &f, char *err, size_t errlen)
         f.fg[0] = top;
     }
     if (f.rows == 0 || f.cols == 0 || (f.bits != 8 && f.bits != 16)) {
-        return fail(err, errlen, SC_ERR_NOT_SUPPORTED, "%s: %ux%u, %u bits allocated",
-                    path.c_str(), f.cols, f.rows, f.bits);
+        return fail(err, errlen, SC_ERR_NOT_SUPPORTED, "%s: %ux%u, %u bits allocated", path.c_str(),
+                    f.cols, f.rows, f.bits);
     }
     if (f.spp != 1 && f.spp != 3) {
-        return fail(err, errlen, SC_ERR_NOT_SUPPORTED, "%s: %u samples per pixel",
-                    path.c_str(), f.spp);
+        return fail(err, errlen, SC_ERR_NOT_SUPPORTED, "%s: %u samples per pixel", path.c_str(),
+                    f.spp);
     }
     return SC_OK;
 }
@@ -189,8 +190,7 @@ int frame_values(dicom_file &f, Sint32 frame, double *out, char *err, size_t err
         const Uint8 *p = nullptr;
         if (f.ds->findAndGetUint8Array(DCM_PixelData, p, &count).bad() || p == nullptr ||
             count < per_frame * (size_t)(frame + 1)) {
-            return fail(err, errlen, SC_ERR_PARSE, "pixel data shorter than %d frames",
-                        frame + 1);
+            return fail(err, errlen, SC_ERR_PARSE, "pixel data shorter than %d frames", frame + 1);
         }
         p += per_frame * (size_t)frame;
         for (size_t i = 0; i < npix; i++) {
@@ -212,8 +212,7 @@ int frame_values(dicom_file &f, Sint32 frame, double *out, char *err, size_t err
         const Uint16 *p = nullptr;
         if (f.ds->findAndGetUint16Array(DCM_PixelData, p, &count).bad() || p == nullptr ||
             count < npix * (size_t)(frame + 1)) {
-            return fail(err, errlen, SC_ERR_PARSE, "pixel data shorter than %d frames",
-                        frame + 1);
+            return fail(err, errlen, SC_ERR_PARSE, "pixel data shorter than %d frames", frame + 1);
         }
         p += npix * (size_t)frame;
         for (size_t i = 0; i < npix; i++) {
@@ -391,9 +390,8 @@ extern "C" int sc_dicom_read(const char *path, sc_image *img, char *err, size_t 
     return SC_OK;
 }
 
-extern "C" int sc_dicom_write_fixture(const char *dir, const sc_image *vol, int bits,
-                                      int is_signed, double slope, double intercept,
-                                      int multiframe, int compress)
+extern "C" int sc_dicom_write_fixture(const char *dir, const sc_image *vol, int bits, int is_signed,
+                                      double slope, double intercept, int multiframe, int compress)
 {
     register_codecs();
     char series[128], study[128], uid[128];
@@ -481,8 +479,7 @@ extern "C" int sc_dicom_write_fixture(const char *dir, const sc_image *vol, int 
     };
     const E_TransferSyntax xfer = compress ? EXS_RLELossless : EXS_LittleEndianExplicit;
     auto save = [&](DcmFileFormat &ff, const std::string &p) -> int {
-        if (compress &&
-            ff.getDataset()->chooseRepresentation(EXS_RLELossless, nullptr).bad()) {
+        if (compress && ff.getDataset()->chooseRepresentation(EXS_RLELossless, nullptr).bad()) {
             return SC_ERR_IO;
         }
         return ff.saveFile(p.c_str(), xfer).good() ? SC_OK : SC_ERR_IO;

@@ -22,7 +22,7 @@ typedef struct sc_image {
     uint32_t dim[3];
     double spacing[3];
     double origin[3];
-    double dir[9]; /* row-major; column a = direction of grid axis a */
+    double dir[9];     /* row-major; column a = direction of grid axis a */
     sc_elem_type type; /* element type of the file */
     double *data;      /* dim[0]*dim[1]*dim[2] values, x fastest (malloc'd) */
 } sc_image;

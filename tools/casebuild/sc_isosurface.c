@@ -10,10 +10,10 @@
 
 /* Cube corner c has offset (c & 1, (c >> 1) & 1, (c >> 2) & 1). */
 typedef struct cube_tables {
-    int edge_of[8][8];  /* cube edge id of a corner pair, -1 if not an edge */
-    int edge_a[12];     /* corner with the smaller offset */
-    int edge_axis[12];  /* axis of the edge */
-    int face[6][4];     /* corners, counter-clockwise seen from outside */
+    int edge_of[8][8]; /* cube edge id of a corner pair, -1 if not an edge */
+    int edge_a[12];    /* corner with the smaller offset */
+    int edge_axis[12]; /* axis of the edge */
+    int face[6][4];    /* corners, counter-clockwise seen from outside */
 } cube_tables;
 
 static void tables_init(cube_tables *t)
@@ -209,9 +209,9 @@ int sc_iso_extract(const sc_volume *vol, const sc_iso_opts *o, sc_iso_mesh *out)
                 int64_t x = g0[0] + i, y = g0[1] + j, z = g0[2] + k;
                 int inside = 0;
                 if (x >= 0 && y >= 0 && z >= 0 && x < dim[0] && y < dim[1] && z < dim[2]) {
-                    inside = vol->labels[(size_t)x +
-                                         (size_t)dim[0] * ((size_t)y + (size_t)dim[1] * (size_t)z)] ==
-                             L;
+                    inside =
+                        vol->labels[(size_t)x +
+                                    (size_t)dim[0] * ((size_t)y + (size_t)dim[1] * (size_t)z)] == L;
                 }
                 in[(size_t)(i + gn[0] * (j + gn[1] * k))] = (uint8_t)inside;
             }
@@ -356,9 +356,10 @@ int sc_iso_write_ply(const sc_iso_mesh *m, const char *path)
     if (f == NULL) {
         return SC_ERR_IO;
     }
-    fprintf(f, "ply\nformat ascii 1.0\ncomment sonocomp label isosurface, mm, volume frame\n"
-               "element vertex %zu\nproperty float x\nproperty float y\nproperty float z\n"
-               "element face %zu\nproperty list uchar int vertex_indices\nend_header\n",
+    fprintf(f,
+            "ply\nformat ascii 1.0\ncomment sonocomp label isosurface, mm, volume frame\n"
+            "element vertex %zu\nproperty float x\nproperty float y\nproperty float z\n"
+            "element face %zu\nproperty list uchar int vertex_indices\nend_header\n",
             m->vertex_count, m->triangle_count);
     for (size_t v = 0; v < m->vertex_count; v++) {
         fprintf(f, "%.4f %.4f %.4f\n", (double)m->xyz[v * 3u], (double)m->xyz[v * 3u + 1u],

@@ -26,8 +26,8 @@ typedef struct sc_iso_opts {
 } sc_iso_opts;
 
 typedef struct sc_iso_mesh {
-    float *xyz;        /* 3 per vertex, volume frame, mm */
-    uint32_t *tri;     /* 3 per triangle */
+    float *xyz;    /* 3 per vertex, volume frame, mm */
+    uint32_t *tri; /* 3 per triangle */
     size_t vertex_count;
     size_t triangle_count;
 } sc_iso_mesh;

@@ -11,9 +11,9 @@
 #include "sc_materials.h"
 
 /* ---- extent of every phantom (volume frame, mm) ---------------------------------------- */
-#define PH_X0 (-24.0f)
-#define PH_Y0 (-20.0f)
-#define PH_Z0 (-2.0f) /* 2 mm of gel above the skin at z = 0 */
+#define PH_X0     (-24.0f)
+#define PH_Y0     (-20.0f)
+#define PH_Z0     (-2.0f) /* 2 mm of gel above the skin at z = 0 */
 #define PH_SIZE_X 48.0f
 #define PH_SIZE_Y 40.0f
 #define PH_SIZE_Z 48.0f
@@ -62,9 +62,14 @@ static void scene_init(scene *s, sc_phantom_kind kind)
         /* groin: CFV medial (10-12 mm), CFA lateral (8-9 mm), femoral nerve lateral to it */
         int dvt = kind == SC_PHANTOM_FEMORAL_DVT;
         /* the thrombosed vein is distended (rounder, larger, bulging medially) */
-        s->v[0] = (sc_phantom_vessel){SC_LABEL_VEIN,      dvt ? -6.5f : -5.5f, 18.0f,
-                                      dvt ? 6.5f : 6.0f,  dvt ? 6.0f : 5.0f,   0.4f,
-                                      -0.02f,             dvt};
+        s->v[0] = (sc_phantom_vessel){SC_LABEL_VEIN,
+                                      dvt ? -6.5f : -5.5f,
+                                      18.0f,
+                                      dvt ? 6.5f : 6.0f,
+                                      dvt ? 6.0f : 5.0f,
+                                      0.4f,
+                                      -0.02f,
+                                      dvt};
         s->v[1] = (sc_phantom_vessel){SC_LABEL_ARTERY, 5.5f, 17.0f, 4.2f, 4.2f, 1.0f, -0.015f, 0};
         s->nerve_x = 13.0f;
         s->nerve_z = 16.0f;
@@ -272,8 +277,8 @@ static float reflectivity(const scene *s, uint8_t label, uint8_t feat, float x, 
         }
         /* subcutaneous fat: hypoechoic lobules with thin, broken bright septa roughly
          * parallel to the skin */
-        float w = z + 0.8f * sinf(x / 3.3f + 0.7f) + 0.6f * sinf(y / 4.1f) +
-                  0.4f * sinf((x + y) / 2.3f);
+        float w =
+            z + 0.8f * sinf(x / 3.3f + 0.7f) + 0.6f * sinf(y / 4.1f) + 0.4f * sinf((x + y) / 2.3f);
         float band = floorf(w / 3.0f);
         float ph = w / 3.0f - band - 0.5f;
         float present = sinf(x / 2.9f + 2.1f * band) + 0.5f * sinf(y / 3.7f - band);
@@ -311,8 +316,7 @@ sc_phantom_def sc_phantom_default_def(void)
     return (sc_phantom_def){.kind = SC_PHANTOM_NECK_IJV, .seed = 1u, .spacing_mm = 0.25f};
 }
 
-static const char *const kind_names[SC_PHANTOM_KIND_COUNT] = {"neck-ijv", "femoral",
-                                                              "femoral-dvt"};
+static const char *const kind_names[SC_PHANTOM_KIND_COUNT] = {"neck-ijv", "femoral", "femoral-dvt"};
 
 int sc_phantom_kind_from_name(const char *name)
 {
@@ -444,8 +448,7 @@ int sc_phantom_generate(const sc_phantom_def *pd, sc_phantom *out)
                     }
                 }
                 /* bright cortex at the bone surface */
-                if (l == SC_LABEL_BONE && k > 0u &&
-                    z - bone_top_mm(&s, x) < 0.8f) {
+                if (l == SC_LABEL_BONE && k > 0u && z - bone_top_mm(&s, x) < 0.8f) {
                     r = 7.0f;
                 }
                 fib[idx] = r * re[idx];
@@ -454,8 +457,8 @@ int sc_phantom_generate(const sc_phantom_def *pd, sc_phantom *out)
     }
 
     /* 4. attenuation along the beam (+z) with TGC; log compression to 8 bits */
-    const float dr_db = 50.0f;   /* displayed dynamic range */
-    const float ref_amp = 9.5f;  /* amplitude shown as white: soft tissue lands near 100 */
+    const float dr_db = 50.0f;  /* displayed dynamic range */
+    const float ref_amp = 9.5f; /* amplitude shown as white: soft tissue lands near 100 */
     for (uint32_t j = 0; j < dim[1]; j++) {
         for (uint32_t i = 0; i < dim[0]; i++) {
             float loss_db = 0.0f;
@@ -487,15 +490,16 @@ int sc_phantom_generate(const sc_phantom_def *pd, sc_phantom *out)
     *d = sc_case_default_def();
     snprintf(out->name, sizeof out->name, "%s", kind_names[pd->kind]);
     const sc_phantom_vessel *vv = &s.v[0], *va = &s.v[1];
-    const char *what = pd->kind == SC_PHANTOM_NECK_IJV
-                           ? "Phantom neck, transverse: internal jugular vein (oval, compressible) "
-                             "beside the common carotid artery (round, stiff) under the "
-                             "sternocleidomastoid; vagus nerve between them; vertebra deep."
-                       : pd->kind == SC_PHANTOM_FEMORAL
-                           ? "Phantom groin, transverse: common femoral vein (medial, compressible) "
-                             "and artery (lateral), femoral nerve, iliopsoas; normal."
-                           : "Phantom groin, transverse: common femoral vein distended and filled "
-                             "with echogenic thrombus (non-compressible: DVT), artery lateral.";
+    const char *what =
+        pd->kind == SC_PHANTOM_NECK_IJV
+            ? "Phantom neck, transverse: internal jugular vein (oval, compressible) "
+              "beside the common carotid artery (round, stiff) under the "
+              "sternocleidomastoid; vagus nerve between them; vertebra deep."
+        : pd->kind == SC_PHANTOM_FEMORAL
+            ? "Phantom groin, transverse: common femoral vein (medial, compressible) "
+              "and artery (lateral), femoral nerve, iliopsoas; normal."
+            : "Phantom groin, transverse: common femoral vein distended and filled "
+              "with echogenic thrombus (non-compressible: DVT), artery lateral.";
     snprintf(out->description, sizeof out->description,
              "%s\nProcedural (no patient data), seed %llu, %.3g mm voxels.\n"
              "Vein centre %.1f mm deep at x %.1f mm, %.1f x %.1f mm outer%s.\n"
@@ -540,8 +544,13 @@ int sc_phantom_generate(const sc_phantom_def *pd, sc_phantom *out)
     d->mesh.origin_mm[1] = -10.0f;
     d->mesh.size_mm[1] = 20.0f;
     d->mesh.origin_mm[2] = 0.0f;
-    /* image frame = probe frame; tracker frame = mannequin frame = volume frame */
+    /* image frame = probe frame. The mannequin's tracker frame has Z up out of the body
+     * (as the tracker emulator and a real tracker on the mannequin report it) and y toward
+     * the feet: tracker -> patient is a half turn about x, (x, y, z) -> (x, -y, -z), with the
+     * tracker origin on the skin at the volume origin. */
     d->image_to_probe = sc_xform_identity();
     d->tracker_to_patient = sc_xform_identity();
+    d->tracker_to_patient.r[4] = -1.0f;
+    d->tracker_to_patient.r[8] = -1.0f;
     return SC_OK;
 }

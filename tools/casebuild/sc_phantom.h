@@ -35,19 +35,19 @@ typedef struct sc_phantom_def {
 
 /* A vessel as generated (cross-section at y = 0; the centre drifts by dx_per_mm along y). */
 typedef struct sc_phantom_vessel {
-    uint8_t label;       /* SC_LABEL_VEIN or SC_LABEL_ARTERY */
-    float x_mm, z_mm;    /* centre at y = 0 */
-    float half_w_mm;     /* outer semi-axis along x (wall included) */
-    float half_d_mm;     /* outer semi-axis along z */
-    float wall_mm;       /* wall thickness */
-    float dx_per_mm;     /* lateral drift per mm of y */
-    int thrombosed;      /* lumen filled with SC_LABEL_THROMBUS */
+    uint8_t label;    /* SC_LABEL_VEIN or SC_LABEL_ARTERY */
+    float x_mm, z_mm; /* centre at y = 0 */
+    float half_w_mm;  /* outer semi-axis along x (wall included) */
+    float half_d_mm;  /* outer semi-axis along z */
+    float wall_mm;    /* wall thickness */
+    float dx_per_mm;  /* lateral drift per mm of y */
+    int thrombosed;   /* lumen filled with SC_LABEL_THROMBUS */
 } sc_phantom_vessel;
 
 typedef struct sc_phantom {
-    sc_case_def def;            /* ready for sc_case_write(); voxels/labels point below */
-    uint8_t *voxels;            /* malloc'd */
-    uint8_t *labels;            /* malloc'd */
+    sc_case_def def;              /* ready for sc_case_write(); voxels/labels point below */
+    uint8_t *voxels;              /* malloc'd */
+    uint8_t *labels;              /* malloc'd */
     sc_phantom_vessel vessels[2]; /* [0] vein, [1] artery */
     char name[SC_CASE_NAME_LEN];
     char description[SC_CASE_DESCRIPTION_LEN];
