@@ -7,6 +7,8 @@
 # Checks on the host: every injected fault counted live, the kernel filter dropped the foreign
 # id, every frame had a kernel time stamp, and the replays of our log and of candump's log
 # reach the same verdicts as the live run. Classic CAN and CAN FD; the listener runs as nobody.
+# Last, can-utils' canplayer plays a log the emulator wrote, and the listener must agree with
+# the offline replay of that log.
 #   tools/hil/can-test.sh HIL_BUILD_DIR WORKDIR
 set -euo pipefail
 [ $# -eq 2 ] || { echo "usage: $0 HIL_BUILD_DIR WORKDIR" >&2; exit 2; }
@@ -44,6 +46,18 @@ for mode in classic fd; do
         tr ' ' '\n' < $f-$mode.txt | grep = | sed "s/^/SCCAN $mode $f /"
     done
     echo "SCCAN $mode candump_lines $(wc -l < cd-$mode.log)"
+done
+# can-utils' canplayer plays a log the emulator wrote; the listener must reach the same
+# verdicts live as the offline replay of that log
+/payload/sc-tracker-emu --script rock --duration-s 3 --log emu-play.log $faults 2> emu-play.txt || exit 30
+su -s /bin/sh nobody -c "/payload/sc-tracker-listen --iface vcan0 --duration-s 5 > live-play.txt" &
+rx_pid=$!
+sleep 0.5
+canplayer -I emu-play.log || exit 31
+wait $rx_pid || exit 32
+/payload/sc-tracker-listen --replay emu-play.log > own-play.txt || exit 33
+for f in emu live own; do
+    tr ' ' '\n' < $f-play.txt | grep = | sed "s/^/SCCAN play $f /"
 done
 exit 0
 T
@@ -110,6 +124,14 @@ for mode in ("classic", "fd"):
             check(g(who, k) == g("live", k), "%s: replay of %s log: %s %d == live %d"
                   % (mode, "our" if who == "own" else "candump's", k, g(who, k), g("live", k)))
     check(g("cd", "not_ours") == 1, "%s: candump's log holds the foreign id" % mode)
+g = lambda who, k: vals.get(("play", who, k), -1)
+check(g("emu", "frames") > 100 and g("live", "frames") == g("emu", "frames"),
+      "canplayer: the listener got all %d frames canplayer played from the emulator's log"
+      % g("emu", "frames"))
+for k in ("pose_accepted", "e2e_wrong_crc", "e2e_repeated", "e2e_wrong_sequence",
+          "rejected_implausible", "incomplete"):
+    check(g("live", k) == g("own", k) and g("live", k) >= 0,
+          "canplayer: live %s %d == offline replay %d" % (k, g("live", k), g("own", k)))
 print("can-test: %s" % ("PASS" if not fails else "FAIL (%d checks)" % len(fails)))
 sys.exit(1 if fails else 0)
 P
