@@ -1,0 +1,1257 @@
+/* sc_bscan.c: B-scan synthesis through the deformed mesh, see sc_bscan.h.
+ *
+ * Frame pipeline: (1) image -> volume transform; (2) deformed nodes into the image frame
+ * (x lateral, y = signed distance to the image plane, z depth): every later test is 2D or a
+ * sign of y; (3) mapper preparation (boundary segments for the walker, plane tets and regions
+ * for the paper's path); (4) per line: rigid positions, mapper overwrites the pixels inside the
+ * mesh with rest positions, then sampling, display processing, label areas, display line.
+ *
+ * Sampling positions are kept in voxel-index units (x - origin) / spacing so the sampler does
+ * no unit conversion.
+ */
+#include "sc_bscan.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <string.h>
+
+#include "sc_assert.h"
+#include "sc_err.h"
+
+/* Barycentric tolerance of point location (region path and oracle): a pixel on a face is in
+ * both tets; the rest map is continuous there, so either answer is right. */
+#define SC_BSCAN_LAMBDA_EPS 1e-5f
+
+/* ---- settings --------------------------------------------------------------------------- */
+
+sc_bscan_def sc_bscan_default_def(void)
+{
+    sc_bscan_def d;
+    d.scan = sc_scan_default_def();
+    d.mapper = SC_BSCAN_MAP_WALK;
+    d.regions_n = SC_BSCAN_REGIONS_DEFAULT;
+    d.gain_db = 0.0f;
+    for (uint32_t i = 0; i < SC_BSCAN_TGC_BANDS; i++) {
+        d.tgc_db[i] = 0.0f;
+    }
+    d.dynamic_range_db = 60.0f;
+    d.volume_range_db = 60.0f;
+    return d;
+}
+
+static int db_ok(float v, float lo, float hi)
+{
+    return v >= lo && v <= hi;
+}
+
+static int check_def(const sc_bscan_def *d)
+{
+    if (!isfinite(d->gain_db) || !isfinite(d->dynamic_range_db) ||
+        !isfinite(d->volume_range_db)) {
+        return SC_ERR_NOT_FINITE;
+    }
+    for (uint32_t i = 0; i < SC_BSCAN_TGC_BANDS; i++) {
+        if (!isfinite(d->tgc_db[i])) {
+            return SC_ERR_NOT_FINITE;
+        }
+        if (!db_ok(d->tgc_db[i], -60.0f, 60.0f)) {
+            return SC_ERR_RANGE;
+        }
+    }
+    if (d->mapper >= (uint32_t)SC_BSCAN_MAP_COUNT || d->regions_n < 1u ||
+        d->regions_n > SC_BSCAN_MAX_REGIONS || !db_ok(d->gain_db, -60.0f, 60.0f) ||
+        !db_ok(d->dynamic_range_db, 10.0f, 120.0f) || !db_ok(d->volume_range_db, 10.0f, 120.0f)) {
+        return SC_ERR_RANGE;
+    }
+    return SC_OK;
+}
+
+/* Display table: out = a * I + b[k] (see sc_bscan_def). */
+static void build_lut(sc_bscan *b)
+{
+    const sc_bscan_def *d = &b->def;
+    const float rng = d->dynamic_range_db;
+    b->lut_a = d->volume_range_db / rng;
+    const float band_mm = d->scan.depth_mm / (float)SC_BSCAN_TGC_BANDS;
+    for (uint32_t k = 0; k < d->scan.samples_n; k++) {
+        const float depth = ((float)k + 0.5f) * b->geom.sample_mm;
+        float t = depth / band_mm - 0.5f;
+        float tgc;
+        if (!(t > 0.0f)) {
+            tgc = d->tgc_db[0];
+        } else if (t >= (float)(SC_BSCAN_TGC_BANDS - 1u)) {
+            tgc = d->tgc_db[SC_BSCAN_TGC_BANDS - 1u];
+        } else {
+            const uint32_t i = (uint32_t)t;
+            const float f = t - (float)i;
+            tgc = d->tgc_db[i] + f * (d->tgc_db[i + 1u] - d->tgc_db[i]);
+        }
+        b->lut_b[k] = 255.0f * (d->gain_db + tgc + rng - d->volume_range_db) / rng;
+        /* 38.26 with the rounding half folded in (see sample_fx) */
+        b->lut_b_fx[k] = (int64_t)floorf(b->lut_b[k] * 1024.0f + 512.0f + 0.5f) * 65536;
+    }
+}
+
+int sc_bscan_set_def(sc_bscan *b, const sc_bscan_def *def)
+{
+    if (b == NULL || def == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    int rc = check_def(def);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    sc_scan_geom g_new;
+    rc = sc_scan_geom_init(&g_new, &def->scan);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    b->geom = g_new;
+    b->def = *def;
+    build_lut(b);
+    return SC_OK;
+}
+
+int sc_bscan_init(sc_bscan *b, const sc_bscan_def *def)
+{
+    if (b == NULL || def == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    b->hull_count = 0u;
+    b->mesh_tets = 0u;
+    b->seg_count = 0u;
+    b->ptet_count = 0u;
+    memset(&b->status, 0, sizeof b->status);
+    return sc_bscan_set_def(b, def);
+}
+
+int sc_bscan_attach_mesh(sc_bscan *b, const sc_mesh *mesh)
+{
+    if (b == NULL || mesh == NULL || mesh->tet_count > SC_MAX_TETS) {
+        return SC_ERR_INVALID_ARG;
+    }
+    uint32_t n = 0;
+    for (uint32_t t = 0; t < mesh->tet_count; t++) {
+        for (uint32_t v = 0; v < 4u; v++) {
+            if (mesh->tet_nbr[t][v] < 0) {
+                if (n >= SC_BSCAN_MAX_HULL_FACES) {
+                    b->hull_count = 0u;
+                    b->mesh_tets = 0u;
+                    return SC_ERR_NO_SPACE;
+                }
+                b->hull[n].tet = t;
+                b->hull[n].face = v;
+                n++;
+            }
+        }
+    }
+    b->hull_count = n;
+    b->mesh_tets = mesh->tet_count;
+    return SC_OK;
+}
+
+const sc_bscan_status *sc_bscan_status_get(const sc_bscan *b)
+{
+    return &b->status;
+}
+
+/* ---- per-frame context -------------------------------------------------------------------- */
+
+typedef struct frame_ctx {
+    sc_xform img2vol;          /* image frame -> volume frame */
+    float vo[3];               /* volume origin, mm */
+    float inv_sp[3];           /* 1 / spacing */
+    uint32_t n;                /* samples per line */
+    /* current line, image frame */
+    float ox, oz, dx, dz;
+    /* current line, voxel-index units: rigid position of sample k is f0 + k * fd */
+    float f0[3], fd[3];
+} frame_ctx;
+
+/* mm (volume frame) -> voxel-index units */
+static void to_vox(const frame_ctx *c, const float p_mm[3], float out[3])
+{
+    for (uint32_t d = 0; d < 3u; d++) {
+        out[d] = (p_mm[d] - c->vo[d]) * c->inv_sp[d];
+    }
+}
+
+static uint32_t first_k(float s, uint32_t n)
+{
+    if (!(s > 0.0f)) {
+        return 0u;
+    }
+    if (s >= (float)n) {
+        return n;
+    }
+    return (uint32_t)ceilf(s);
+}
+
+/* A run of samples [k0, k1) inside the mesh whose sampling position (voxel units) is
+ * a + k b. Mappers emit runs in increasing k, without overlap. */
+static void emit_run(sc_bscan *b, uint32_t k0, uint32_t k1, const float a[3], const float bb[3])
+{
+    SC_ASSERT(k0 < k1 && k1 <= SC_MAX_SCAN_SAMPLES && b->run_count < SC_MAX_SCAN_SAMPLES);
+    SC_ASSERT(b->run_count == 0u || b->runs[b->run_count - 1u].k1 <= k0);
+    sc_bscan_run *r = &b->runs[b->run_count++];
+    r->k0 = (uint16_t)k0;
+    r->k1 = (uint16_t)k1;
+    for (uint32_t d = 0; d < 3u; d++) {
+        r->a[d] = a[d];
+        r->b[d] = bb[d];
+    }
+}
+
+/* Barycentric coordinates of a tet in the image frame as affine functions of the point:
+ * lambda_i(p) = alpha[i] + g[i] . p. Returns 0 for a degenerate (flat) tet. */
+static int tet_affine(const sc_bscan *b, const uint32_t tv[4], float alpha[4], float g[4][3])
+{
+    const float x0 = b->qx[tv[0]], y0 = b->qy[tv[0]], z0 = b->qz[tv[0]];
+    float e[3][3];
+    for (uint32_t i = 0; i < 3u; i++) {
+        e[i][0] = b->qx[tv[i + 1u]] - x0;
+        e[i][1] = b->qy[tv[i + 1u]] - y0;
+        e[i][2] = b->qz[tv[i + 1u]] - z0;
+    }
+    /* rows of the inverse of [e1 e2 e3]: (e2 x e3, e3 x e1, e1 x e2) / det */
+    float r[3][3];
+    for (uint32_t i = 0; i < 3u; i++) {
+        const float *a = e[(i + 1u) % 3u], *c = e[(i + 2u) % 3u];
+        r[i][0] = a[1] * c[2] - a[2] * c[1];
+        r[i][1] = a[2] * c[0] - a[0] * c[2];
+        r[i][2] = a[0] * c[1] - a[1] * c[0];
+    }
+    const float det = e[0][0] * r[0][0] + e[0][1] * r[0][1] + e[0][2] * r[0][2];
+    if (!(fabsf(det) > 1e-12f)) {
+        return 0;
+    }
+    const float inv = 1.0f / det;
+    float sa = 0.0f, sg[3] = {0.0f, 0.0f, 0.0f};
+    for (uint32_t i = 0; i < 3u; i++) {
+        for (uint32_t d = 0; d < 3u; d++) {
+            g[i + 1u][d] = r[i][d] * inv;
+            sg[d] += g[i + 1u][d];
+        }
+        alpha[i + 1u] = -(g[i + 1u][0] * x0 + g[i + 1u][1] * y0 + g[i + 1u][2] * z0);
+        sa += alpha[i + 1u];
+    }
+    alpha[0] = 1.0f - sa;
+    for (uint32_t d = 0; d < 3u; d++) {
+        g[0][d] = -sg[d];
+    }
+    return 1;
+}
+
+/* ---- walker ------------------------------------------------------------------------------ */
+
+/* Boundary triangles cut by the image plane, as 2D segments, bucketed by their first line. */
+static void build_segments(sc_bscan *b, const sc_mesh *m)
+{
+    const uint32_t lines = b->def.scan.lines_n;
+    uint32_t ns = 0;
+    for (uint32_t h = 0; h < b->hull_count; h++) {
+        const uint32_t t = b->hull[h].tet, v = b->hull[h].face;
+        uint32_t f[3], fi = 0;
+        for (uint32_t w = 0; w < 4u; w++) {
+            if (w != v) {
+                f[fi++] = m->tet[t][w];
+            }
+        }
+        const uint32_t pos = (uint32_t)(b->qy[f[0]] > 0.0f) + (uint32_t)(b->qy[f[1]] > 0.0f) +
+                             (uint32_t)(b->qy[f[2]] > 0.0f);
+        if (pos == 0u || pos == 3u) {
+            continue;
+        }
+        /* the two edges whose ends differ in class; the cut point is computed from the lower
+         * node index so that both triangles sharing an edge get the identical point */
+        float px[2], pz[2];
+        uint32_t np = 0;
+        for (uint32_t a = 0; a < 3u; a++) {
+            uint32_t i = f[a], j = f[(a + 1u) % 3u];
+            if ((b->qy[i] > 0.0f) == (b->qy[j] > 0.0f)) {
+                continue;
+            }
+            if (j < i) {
+                const uint32_t s = i;
+                i = j;
+                j = s;
+            }
+            const float tt = b->qy[i] / (b->qy[i] - b->qy[j]);
+            px[np] = b->qx[i] + tt * (b->qx[j] - b->qx[i]);
+            pz[np] = b->qz[i] + tt * (b->qz[j] - b->qz[i]);
+            np++;
+        }
+        SC_ASSERT(np == 2u);
+        /* outward normal: away from the tet's fourth vertex */
+        const uint32_t n0 = f[0], n1 = f[1], n2 = f[2], nv = m->tet[t][v];
+        const float e1[3] = {b->qx[n1] - b->qx[n0], b->qy[n1] - b->qy[n0], b->qz[n1] - b->qz[n0]};
+        const float e2[3] = {b->qx[n2] - b->qx[n0], b->qy[n2] - b->qy[n0], b->qz[n2] - b->qz[n0]};
+        float nrm[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                        e1[0] * e2[1] - e1[1] * e2[0]};
+        const float side = nrm[0] * (b->qx[nv] - b->qx[n0]) + nrm[1] * (b->qy[nv] - b->qy[n0]) +
+                           nrm[2] * (b->qz[nv] - b->qz[n0]);
+        if (side > 0.0f) {
+            nrm[0] = -nrm[0];
+            nrm[2] = -nrm[2];
+        }
+        int32_t lo, hi;
+        if (!sc_scan_geom_line_range(&b->geom, fminf(px[0], px[1]), fmaxf(px[0], px[1]),
+                                     fminf(pz[0], pz[1]), fmaxf(pz[0], pz[1]), &lo, &hi)) {
+            continue;
+        }
+        sc_bscan_seg *s = &b->segs[ns++];
+        s->ax = px[0];
+        s->az = pz[0];
+        s->bx = px[1];
+        s->bz = pz[1];
+        s->nx = nrm[0];
+        s->nz = nrm[2];
+        s->tet = t;
+        s->face = v;
+        s->line_lo = lo;
+        s->line_hi = hi;
+    }
+    b->seg_count = ns;
+    /* counting sort by first line */
+    for (uint32_t l = 0; l <= lines; l++) {
+        b->seg_start[l] = 0u;
+    }
+    for (uint32_t i = 0; i < ns; i++) {
+        b->seg_start[(uint32_t)b->segs[i].line_lo + 1u]++;
+    }
+    for (uint32_t l = 0; l < lines; l++) {
+        b->seg_start[l + 1u] += b->seg_start[l];
+    }
+    for (uint32_t i = 0; i < ns; i++) {
+        /* seg_start[lo] doubles as the fill cursor, restored below */
+        b->seg_sorted[b->seg_start[(uint32_t)b->segs[i].line_lo]++] = i;
+    }
+    for (uint32_t l = lines; l > 0u; l--) {
+        b->seg_start[l] = b->seg_start[l - 1u];
+    }
+    b->seg_start[0] = 0u;
+}
+
+/* Crossings of line l (ray O + s D in the image frame) with the active segments, sorted by s
+ * (entries first on ties, then by segment index: deterministic). Returns the count. */
+static uint32_t line_events(sc_bscan *b, uint32_t l, uint32_t *active_n, const frame_ctx *c)
+{
+    uint32_t na = *active_n;
+    for (uint32_t i = b->seg_start[l]; i < b->seg_start[l + 1u]; i++) {
+        b->active[na++] = b->seg_sorted[i];
+    }
+    const float dd = c->dx * c->dx + c->dz * c->dz;
+    uint32_t ne = 0;
+    for (uint32_t i = 0; i < na;) {
+        const uint32_t si = b->active[i];
+        const sc_bscan_seg *s = &b->segs[si];
+        if (s->line_hi < (int32_t)l) {
+            b->active[i] = b->active[--na];
+            continue;
+        }
+        i++;
+        const float sa = c->dx * (s->az - c->oz) - c->dz * (s->ax - c->ox);
+        const float sb = c->dx * (s->bz - c->oz) - c->dz * (s->bx - c->ox);
+        if ((sa > 0.0f) == (sb > 0.0f)) {
+            continue;
+        }
+        const float t = sa / (sa - sb);
+        const float qx = s->ax + t * (s->bx - s->ax) - c->ox;
+        const float qz = s->az + t * (s->bz - s->az) - c->oz;
+        const float sp = (qx * c->dx + qz * c->dz) / dd;
+        if (sp < b->geom.s_min) {
+            continue;
+        }
+        if (ne >= SC_BSCAN_MAX_LINE_EVENTS) {
+            b->status.event_overflows++;
+            break;
+        }
+        sc_bscan_event ev = {.s = sp, .seg = si,
+                             .entry = (uint8_t)(s->nx * c->dx + s->nz * c->dz < 0.0f)};
+        /* insertion sort: lists are short (2..8 typically) */
+        uint32_t j = ne++;
+        while (j > 0u) {
+            const sc_bscan_event *p = &b->events[j - 1u];
+            const int after = p->s < ev.s || (!(p->s > ev.s) &&
+                                              (p->entry > ev.entry ||
+                                               (p->entry == ev.entry && p->seg < ev.seg)));
+            if (after) {
+                break;
+            }
+            b->events[j] = *p;
+            j--;
+        }
+        b->events[j] = ev;
+    }
+    *active_n = na;
+    return ne;
+}
+
+/* Brute-force point location in the image frame (rare fallback): the tet whose smallest
+ * barycentric coordinate is largest, if that is >= -eps. O(tets). Returns -1 if none. */
+static int32_t locate_brute(const sc_bscan *b, const sc_mesh *m, float x, float z)
+{
+    int32_t best = -1;
+    float best_min = -SC_BSCAN_LAMBDA_EPS;
+    const float p[3] = {x, 0.0f, z};
+    for (uint32_t t = 0; t < m->tet_count; t++) {
+        const uint32_t *tv = m->tet[t];
+        float ymin = b->qy[tv[0]], ymax = ymin;
+        for (uint32_t v = 1; v < 4u; v++) {
+            ymin = fminf(ymin, b->qy[tv[v]]);
+            ymax = fmaxf(ymax, b->qy[tv[v]]);
+        }
+        if (ymin > 0.0f || ymax < 0.0f) {
+            continue;
+        }
+        float al[4], g[4][3];
+        if (!tet_affine(b, tv, al, g)) {
+            continue;
+        }
+        float lmin = 1.0f;
+        for (uint32_t i = 0; i < 4u; i++) {
+            lmin = fminf(lmin, al[i] + g[i][0] * p[0] + g[i][2] * p[2]);
+        }
+        if (lmin > best_min) {
+            best_min = lmin;
+            best = (int32_t)t;
+        }
+    }
+    return best;
+}
+
+/* Walk the current line from tet t, entered through local face f_in (4: none) at line
+ * parameter s_in, writing the rest positions of the samples from *k on. Returns the parameter
+ * where the walk left the mesh (or >= n when it reached the end of the line). */
+static float walk(sc_bscan *b, const sc_mesh *m, const frame_ctx *c, uint32_t t, uint32_t f_in,
+                  float s_in, uint32_t *k, uint32_t *steps)
+{
+    const uint32_t n = c->n;
+    for (;;) {
+        if (*steps >= SC_BSCAN_MAX_WALK_STEPS) {
+            b->status.walk_aborts++;
+            return (float)n; /* the rest of the line stays rigid */
+        }
+        (*steps)++;
+        const uint32_t *tv = m->tet[t];
+        float al[4], g[4][3];
+        if (!tet_affine(b, tv, al, g)) {
+            return s_in; /* flat tet: leave the mesh here (counted as exit) */
+        }
+        float a[4], be[4];
+        for (uint32_t i = 0; i < 4u; i++) {
+            a[i] = al[i] + g[i][0] * c->ox + g[i][2] * c->oz;
+            be[i] = g[i][0] * c->dx + g[i][2] * c->dz;
+        }
+        float s_out = INFINITY;
+        uint32_t f_out = 4u;
+        for (uint32_t i = 0; i < 4u; i++) {
+            if (i != f_in && be[i] < 0.0f) {
+                const float si = -a[i] / be[i];
+                if (si < s_out) {
+                    s_out = si;
+                    f_out = i;
+                }
+            }
+        }
+        if (f_out == 4u) {
+            return s_in; /* no way out along the ray: degenerate, leave */
+        }
+        if (s_out < s_in) {
+            s_out = s_in;
+        }
+        uint32_t k0 = first_k(s_in, n);
+        if (k0 < *k) {
+            k0 = *k;
+        }
+        const uint32_t k1 = first_k(s_out, n);
+        if (k1 > k0) {
+            /* rest position along the ray inside this tet: A + s B (mm), then voxel units */
+            float ra[3] = {0.0f, 0.0f, 0.0f}, rb[3] = {0.0f, 0.0f, 0.0f};
+            for (uint32_t i = 0; i < 4u; i++) {
+                const uint32_t nd = tv[i];
+                ra[0] += a[i] * m->rest_x[nd];
+                ra[1] += a[i] * m->rest_y[nd];
+                ra[2] += a[i] * m->rest_z[nd];
+                rb[0] += be[i] * m->rest_x[nd];
+                rb[1] += be[i] * m->rest_y[nd];
+                rb[2] += be[i] * m->rest_z[nd];
+            }
+            float va[3], vb[3];
+            to_vox(c, ra, va);
+            for (uint32_t d = 0; d < 3u; d++) {
+                vb[d] = rb[d] * c->inv_sp[d];
+            }
+            emit_run(b, k0, k1, va, vb);
+            *k = k1;
+        }
+        if (s_out >= (float)n) {
+            return s_out;
+        }
+        const int32_t nb = m->tet_nbr[t][f_out];
+        if (nb < 0) {
+            return s_out;
+        }
+        const uint32_t u = (uint32_t)nb;
+        uint32_t back = 4u;
+        for (uint32_t v = 0; v < 4u; v++) {
+            if (m->tet_nbr[u][v] == (int32_t)t) {
+                back = v;
+            }
+        }
+        t = u;
+        f_in = back;
+        s_in = s_out;
+    }
+}
+
+static void map_line_walk(sc_bscan *b, const sc_mesh *m, uint32_t l, uint32_t *active_n,
+                          const frame_ctx *c)
+{
+    const uint32_t ne = line_events(b, l, active_n, c);
+    uint32_t k = 0, steps = 0, ei = 0;
+    if (ne > 0u && !b->events[0].entry) {
+        /* the line starts inside the mesh (far behind the face): locate its first pixel */
+        const float s_first_exit = b->events[0].s;
+        ei = 1u;
+        if (s_first_exit > 0.0f) {
+            b->status.locate_fallbacks++;
+            const int32_t t0 = locate_brute(b, m, c->ox, c->oz);
+            if (t0 >= 0) {
+                const float sx = walk(b, m, c, (uint32_t)t0, 4u, 0.0f, &k, &steps);
+                while (ei < ne && b->events[ei].s < sx - 1e-3f) {
+                    ei++;
+                }
+            }
+        }
+    }
+    while (ei < ne && k < c->n) {
+        const sc_bscan_event *e = &b->events[ei++];
+        if (!e->entry) {
+            continue;
+        }
+        if (e->s >= (float)c->n) {
+            break;
+        }
+        const sc_bscan_seg *s = &b->segs[e->seg];
+        const float sx = walk(b, m, c, s->tet, s->face, e->s, &k, &steps);
+        /* boundary crossings before the exit are behind us */
+        while (ei < ne && b->events[ei].s < sx - 1e-3f) {
+            ei++;
+        }
+    }
+    b->status.walk_steps += steps;
+}
+
+/* ---- region path (paper section IV) ---------------------------------------------------- */
+
+static uint32_t region_of_line(uint32_t l, uint32_t lines, uint32_t regions)
+{
+    return (l * regions) / lines;
+}
+
+/* Returns 0 when the path's limits are exceeded (the caller then walks this frame). */
+static int build_regions(sc_bscan *b, const sc_mesh *m)
+{
+    const uint32_t lines = b->def.scan.lines_n, regions = b->def.regions_n;
+    uint32_t np = 0;
+    for (uint32_t t = 0; t < m->tet_count; t++) {
+        const uint32_t *tv = m->tet[t];
+        uint32_t pos = 0;
+        for (uint32_t v = 0; v < 4u; v++) {
+            pos += (uint32_t)(b->qy[tv[v]] > 0.0f);
+        }
+        if (pos == 0u || pos == 4u) {
+            /* all on one side; a tet with a face in the plane (three y = 0, one < 0) counts
+             * through its neighbour on the other side */
+            continue;
+        }
+        float al[4], g[4][3];
+        if (!tet_affine(b, tv, al, g)) {
+            continue;
+        }
+        float xmin = b->qx[tv[0]], xmax = xmin, zmin = b->qz[tv[0]], zmax = zmin;
+        for (uint32_t v = 1; v < 4u; v++) {
+            xmin = fminf(xmin, b->qx[tv[v]]);
+            xmax = fmaxf(xmax, b->qx[tv[v]]);
+            zmin = fminf(zmin, b->qz[tv[v]]);
+            zmax = fmaxf(zmax, b->qz[tv[v]]);
+        }
+        int32_t lo, hi;
+        if (!sc_scan_geom_line_range(&b->geom, xmin, xmax, zmin, zmax, &lo, &hi)) {
+            continue;
+        }
+        if (np >= SC_BSCAN_MAX_PLANE_TETS) {
+            return 0;
+        }
+        sc_bscan_ptet *p = &b->ptets[np];
+        for (uint32_t i = 0; i < 4u; i++) {
+            p->lam[i][0] = al[i];
+            p->lam[i][1] = g[i][0];
+            p->lam[i][2] = g[i][2];
+        }
+        for (uint32_t j = 0; j < 3u; j++) {
+            p->rest[0][j] = 0.0f;
+            p->rest[1][j] = 0.0f;
+            p->rest[2][j] = 0.0f;
+            for (uint32_t i = 0; i < 4u; i++) {
+                p->rest[0][j] += p->lam[i][j] * m->rest_x[tv[i]];
+                p->rest[1][j] += p->lam[i][j] * m->rest_y[tv[i]];
+                p->rest[2][j] += p->lam[i][j] * m->rest_z[tv[i]];
+            }
+        }
+        p->xmin = xmin;
+        p->xmax = xmax;
+        p->zmin = zmin;
+        p->zmax = zmax;
+        b->ptet_lo[np] = lo;
+        b->ptet_hi[np] = hi;
+        np++;
+    }
+    b->ptet_count = np;
+    for (uint32_t r = 0; r <= regions; r++) {
+        b->region_start[r] = 0u;
+    }
+    for (uint32_t r = 0; r < regions; r++) {
+        b->region_box[r][0] = INFINITY;
+        b->region_box[r][1] = -INFINITY;
+        b->region_box[r][2] = INFINITY;
+        b->region_box[r][3] = -INFINITY;
+    }
+    uint32_t total = 0;
+    for (uint32_t i = 0; i < np; i++) {
+        const uint32_t r0 = region_of_line((uint32_t)b->ptet_lo[i], lines, regions);
+        const uint32_t r1 = region_of_line((uint32_t)b->ptet_hi[i], lines, regions);
+        for (uint32_t r = r0; r <= r1; r++) {
+            b->region_start[r + 1u]++;
+        }
+        total += r1 - r0 + 1u;
+    }
+    if (total > SC_BSCAN_MAX_REGION_REFS) {
+        return 0;
+    }
+    for (uint32_t r = 0; r < regions; r++) {
+        b->region_start[r + 1u] += b->region_start[r];
+    }
+    for (uint32_t i = 0; i < np; i++) {
+        const uint32_t r0 = region_of_line((uint32_t)b->ptet_lo[i], lines, regions);
+        const uint32_t r1 = region_of_line((uint32_t)b->ptet_hi[i], lines, regions);
+        for (uint32_t r = r0; r <= r1; r++) {
+            b->region_refs[b->region_start[r]++] = i;
+            float *bx = b->region_box[r];
+            bx[0] = fminf(bx[0], b->ptets[i].xmin);
+            bx[1] = fmaxf(bx[1], b->ptets[i].xmax);
+            bx[2] = fminf(bx[2], b->ptets[i].zmin);
+            bx[3] = fmaxf(bx[3], b->ptets[i].zmax);
+        }
+    }
+    for (uint32_t r = regions; r > 0u; r--) {
+        b->region_start[r] = b->region_start[r - 1u];
+    }
+    b->region_start[0] = 0u;
+    return 1;
+}
+
+static int32_t locate_region(const sc_bscan *b, uint32_t r, float x, float z)
+{
+    const float *bx = b->region_box[r];
+    if (x < bx[0] || x > bx[1] || z < bx[2] || z > bx[3]) {
+        return -1;
+    }
+    for (uint32_t i = b->region_start[r]; i < b->region_start[r + 1u]; i++) {
+        const uint32_t pi = b->region_refs[i];
+        const sc_bscan_ptet *p = &b->ptets[pi];
+        if (x < p->xmin || x > p->xmax || z < p->zmin || z > p->zmax) {
+            continue;
+        }
+        int in = 1;
+        for (uint32_t v = 0; v < 4u && in; v++) {
+            in = p->lam[v][0] + p->lam[v][1] * x + p->lam[v][2] * z >= -SC_BSCAN_LAMBDA_EPS;
+        }
+        if (in) {
+            return (int32_t)pi;
+        }
+    }
+    return -1;
+}
+
+/* Rest positions of samples a..z (all in ptet ta), interpolated linearly between the ends. */
+static void fill_run(sc_bscan *b, const frame_ctx *c, uint32_t ta, uint32_t a, uint32_t z)
+{
+    const sc_bscan_ptet *p = &b->ptets[ta];
+    float ra[3], rz[3], va[3], vz[3];
+    const float xa = c->ox + (float)a * c->dx, za = c->oz + (float)a * c->dz;
+    const float xz = c->ox + (float)z * c->dx, zz = c->oz + (float)z * c->dz;
+    for (uint32_t d = 0; d < 3u; d++) {
+        ra[d] = p->rest[d][0] + p->rest[d][1] * xa + p->rest[d][2] * za;
+        rz[d] = p->rest[d][0] + p->rest[d][1] * xz + p->rest[d][2] * zz;
+    }
+    to_vox(c, ra, va);
+    to_vox(c, rz, vz);
+    /* linear interpolation between the ends: position(k) = va + (k - a) (vz - va) / (z - a) */
+    const float inv = z > a ? 1.0f / (float)(z - a) : 0.0f;
+    float v0[3], vd[3];
+    for (uint32_t d = 0; d < 3u; d++) {
+        vd[d] = (vz[d] - va[d]) * inv;
+        v0[d] = va[d] - (float)a * vd[d];
+    }
+    emit_run(b, a, z + 1u, v0, vd);
+}
+
+static void map_line_regions(sc_bscan *b, uint32_t l, const frame_ctx *c)
+{
+    const uint32_t r = region_of_line(l, b->def.scan.lines_n, b->def.regions_n);
+    const float *bx = b->region_box[r];
+    struct {
+        uint32_t a, z;
+        int32_t ta, tz;
+    } st[64];
+    uint32_t sp = 0;
+    const uint32_t last = c->n - 1u;
+    st[sp].a = 0u;
+    st[sp].z = last;
+    st[sp].ta = locate_region(b, r, c->ox, c->oz);
+    st[sp].tz = locate_region(b, r, c->ox + (float)last * c->dx, c->oz + (float)last * c->dz);
+    sp++;
+    while (sp > 0u) {
+        sp--;
+        const uint32_t a = st[sp].a, z = st[sp].z;
+        const int32_t ta = st[sp].ta, tz = st[sp].tz;
+        if (ta >= 0 && ta == tz) {
+            fill_run(b, c, (uint32_t)ta, a, z);
+            continue;
+        }
+        if (z <= a + 1u) {
+            if (ta >= 0) {
+                fill_run(b, c, (uint32_t)ta, a, a);
+            }
+            if (tz >= 0 && z != a) {
+                fill_run(b, c, (uint32_t)tz, z, z);
+            }
+            continue;
+        }
+        if (ta < 0 && tz < 0) {
+            /* both ends outside: nothing between them can be inside if the segment misses the
+             * box of all the region's tets (the line is straight) */
+            const float x0 = c->ox + (float)a * c->dx, z0 = c->oz + (float)a * c->dz;
+            const float x1 = c->ox + (float)z * c->dx, z1 = c->oz + (float)z * c->dz;
+            if (fmaxf(x0, x1) < bx[0] || fminf(x0, x1) > bx[1] || fmaxf(z0, z1) < bx[2] ||
+                fminf(z0, z1) > bx[3]) {
+                continue;
+            }
+        }
+        const uint32_t mid = a + (z - a + 1u) / 2u;
+        const int32_t tm1 = locate_region(b, r, c->ox + (float)(mid - 1u) * c->dx,
+                                          c->oz + (float)(mid - 1u) * c->dz);
+        const int32_t tm = locate_region(b, r, c->ox + (float)mid * c->dx,
+                                         c->oz + (float)mid * c->dz);
+        SC_ASSERT(sp + 2u <= SC_COUNT_OF(st));
+        st[sp].a = mid;
+        st[sp].z = z;
+        st[sp].ta = tm;
+        st[sp].tz = tz;
+        sp++;
+        st[sp].a = a;
+        st[sp].z = mid - 1u;
+        st[sp].ta = ta;
+        st[sp].tz = tm1;
+        sp++;
+    }
+}
+
+/* ---- oracle ------------------------------------------------------------------------------ */
+
+/* Per pixel, in the volume frame with the deformed nodes as given: every tet is tried; the one
+ * whose smallest barycentric coordinate is largest wins. Independent of the image-frame
+ * node copy and of the walker. O(samples * tets). */
+static void map_line_oracle(sc_bscan *b, const sc_mesh *m, const sc_nodes *nd, uint32_t l,
+                            const frame_ctx *c)
+{
+    float img[3], w[3];
+    for (uint32_t k = 0; k < c->n; k++) {
+        sc_scan_geom_pixel(&b->geom, l, k, img);
+        sc_xform_apply(&c->img2vol, img, w);
+        int32_t best = -1;
+        float best_min = -SC_BSCAN_LAMBDA_EPS, best_l[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+        for (uint32_t t = 0; t < m->tet_count; t++) {
+            const uint32_t *tv = m->tet[t];
+            float p[4][3];
+            int out = 0;
+            for (uint32_t v = 0; v < 4u; v++) {
+                p[v][0] = nd->x[tv[v]];
+                p[v][1] = nd->y[tv[v]];
+                p[v][2] = nd->z[tv[v]];
+            }
+            for (uint32_t d = 0; d < 3u && !out; d++) {
+                const float lo = fminf(fminf(p[0][d], p[1][d]), fminf(p[2][d], p[3][d]));
+                const float hi = fmaxf(fmaxf(p[0][d], p[1][d]), fmaxf(p[2][d], p[3][d]));
+                out = w[d] < lo - 1e-3f || w[d] > hi + 1e-3f;
+            }
+            if (out) {
+                continue;
+            }
+            /* Cramer's rule on [p1-p0 p2-p0 p3-p0] lambda = w - p0 */
+            float e[3][3], r[3];
+            for (uint32_t d = 0; d < 3u; d++) {
+                e[0][d] = p[1][d] - p[0][d];
+                e[1][d] = p[2][d] - p[0][d];
+                e[2][d] = p[3][d] - p[0][d];
+                r[d] = w[d] - p[0][d];
+            }
+#define SC_DET3_(a, bb, cc)                                                                    \
+    ((a)[0] * ((bb)[1] * (cc)[2] - (bb)[2] * (cc)[1]) -                                        \
+     (a)[1] * ((bb)[0] * (cc)[2] - (bb)[2] * (cc)[0]) +                                        \
+     (a)[2] * ((bb)[0] * (cc)[1] - (bb)[1] * (cc)[0]))
+            const float det = SC_DET3_(e[0], e[1], e[2]);
+            if (!(fabsf(det) > 1e-12f)) {
+                continue;
+            }
+            float lam[4];
+            lam[1] = SC_DET3_(r, e[1], e[2]) / det;
+            lam[2] = SC_DET3_(e[0], r, e[2]) / det;
+            lam[3] = SC_DET3_(e[0], e[1], r) / det;
+#undef SC_DET3_
+            lam[0] = 1.0f - lam[1] - lam[2] - lam[3];
+            const float lmin = fminf(fminf(lam[0], lam[1]), fminf(lam[2], lam[3]));
+            if (lmin > best_min) {
+                best_min = lmin;
+                best = (int32_t)t;
+                for (uint32_t v = 0; v < 4u; v++) {
+                    best_l[v] = lam[v];
+                }
+            }
+        }
+        if (best >= 0) {
+            const uint32_t *tv = m->tet[best];
+            float rp[3] = {0.0f, 0.0f, 0.0f}, v[3];
+            for (uint32_t i = 0; i < 4u; i++) {
+                rp[0] += best_l[i] * m->rest_x[tv[i]];
+                rp[1] += best_l[i] * m->rest_y[tv[i]];
+                rp[2] += best_l[i] * m->rest_z[tv[i]];
+            }
+            to_vox(c, rp, v);
+            const float zero[3] = {0.0f, 0.0f, 0.0f};
+            emit_run(b, k, k + 1u, v, zero);
+        }
+    }
+}
+
+/* ---- sampling, display processing, label areas -------------------------------------------- */
+
+typedef struct area_acc {
+    uint32_t now_n[SC_LABEL_COUNT], now_k[SC_LABEL_COUNT];
+    uint32_t rest_n[SC_LABEL_COUNT], rest_k[SC_LABEL_COUNT];
+} area_acc;
+
+/* Nearest label at voxel-index position f, or SC_LABEL_OUTSIDE outside the grid. */
+static uint8_t label_at(const sc_volume *v, float fx, float fy, float fz)
+{
+    const float hx = (float)v->dim[0] - 0.5f, hy = (float)v->dim[1] - 0.5f,
+                hz = (float)v->dim[2] - 0.5f;
+    if (!(fx >= -0.5f && fx < hx && fy >= -0.5f && fy < hy && fz >= -0.5f && fz < hz)) {
+        return (uint8_t)SC_LABEL_OUTSIDE;
+    }
+    const uint32_t i = (uint32_t)(fx + 0.5f), j = (uint32_t)(fy + 0.5f),
+                   k = (uint32_t)(fz + 0.5f);
+    return v->labels[(size_t)i + (size_t)v->dim[0] * ((size_t)j + (size_t)v->dim[1] * k)];
+}
+
+/* Add the runs of equal labels in lab[0..n) to the counts (labels come in long runs; this
+ * keeps the per-pixel loop free of a read-modify-write chain). */
+static void count_labels(const uint8_t *lab, uint32_t n, uint32_t *cnt, uint32_t *ksum)
+{
+    uint32_t k0 = 0;
+    while (k0 < n) {
+        const uint8_t l = lab[k0];
+        uint32_t k1 = k0 + 1u;
+        while (k1 < n && lab[k1] == l) {
+            k1++;
+        }
+        if (l < SC_LABEL_COUNT) {
+            cnt[l] += k1 - k0;
+            ksum[l] += (k0 + k1 - 1u) * (k1 - k0) / 2u;
+        }
+        k0 = k1;
+    }
+}
+
+typedef struct vol_ctx {
+    const uint8_t *vox, *lab;
+    float hi[3];        /* dim - 1/2: the volume's extent in voxel units is [-1/2, hi) */
+    int64_t xmax[3];    /* largest 32.32 position kept: just below the last voxel centre */
+    size_t step[3];     /* to the +1 neighbour (0 on a single-voxel axis) */
+    size_t stride[3];   /* 1, dim0, dim0 * dim1 */
+    int64_t la;         /* display gain lut_a in 16.16 */
+} vol_ctx;
+
+/* Positions are 32.32 fixed point (int64): stepping along a span adds exactly, the step's
+ * rounding drifts by less than 1e-7 voxel over a line. */
+#define SC_FX_ONE 4294967296.0f
+
+static int64_t to_fx32(float v)
+{
+    return (int64_t)floorf(v * 65536.0f + 0.5f) * 65536; /* float has 24 bits: no loss */
+}
+
+static int64_t step_fx32(float v)
+{
+    /* the step keeps every bit float has (v * 2^32 is exact in float) */
+    return (int64_t)(v * SC_FX_ONE);
+}
+
+/* One sample at 32.32 position (X, Y, Z), clamped into [0, xmax]: trilinear with 10-bit
+ * weights rounded to nearest (within 0.2 grey level of the exact value for neighbour
+ * differences up to 128), nearest label, display table. */
+#define SC_W_BITS 10
+#define SC_W_ONE (1 << SC_W_BITS)
+#define SC_W_HALF ((int64_t)1 << (31 - SC_W_BITS)) /* half a weight step in 32.32 */
+
+static inline void sample_fx(const vol_ctx *vc, const int64_t *lut_b_fx, uint32_t k, int64_t X,
+                             int64_t Y, int64_t Z, uint8_t *out, uint8_t *lab_out)
+{
+    X += SC_W_HALF;
+    Y += SC_W_HALF;
+    Z += SC_W_HALF;
+    const int32_t tx = (int32_t)((X >> (32 - SC_W_BITS)) & (SC_W_ONE - 1));
+    const int32_t ty = (int32_t)((Y >> (32 - SC_W_BITS)) & (SC_W_ONE - 1));
+    const int32_t tz = (int32_t)((Z >> (32 - SC_W_BITS)) & (SC_W_ONE - 1));
+    const size_t base = (size_t)(X >> 32) + vc->stride[1] * (size_t)(Y >> 32) +
+                        vc->stride[2] * (size_t)(Z >> 32);
+    const size_t ox = vc->step[0], oy = vc->step[1], oz = vc->step[2];
+    const uint8_t *q = vc->vox + base;
+    const int32_t q000 = q[0], q100 = q[ox], q010 = q[oy], q110 = q[oy + ox];
+    const int32_t q001 = q[oz], q101 = q[oz + ox], q011 = q[oz + oy], q111 = q[oz + oy + ox];
+    /* 18 bits after the first level, 28 bits inside the later ones: int32 is enough */
+    const int32_t c00 = q000 * SC_W_ONE + tx * (q100 - q000);
+    const int32_t c10 = q010 * SC_W_ONE + tx * (q110 - q010);
+    const int32_t c01 = q001 * SC_W_ONE + tx * (q101 - q001);
+    const int32_t c11 = q011 * SC_W_ONE + tx * (q111 - q011);
+    const int32_t c0 = (c00 * SC_W_ONE + ty * (c10 - c00) + SC_W_ONE / 2) >> SC_W_BITS;
+    const int32_t c1 = (c01 * SC_W_ONE + ty * (c11 - c01) + SC_W_ONE / 2) >> SC_W_BITS;
+    const int32_t ifx = (c0 * SC_W_ONE + tz * (c1 - c0) + SC_W_ONE / 2) >> SC_W_BITS;
+    uint8_t label = (uint8_t)SC_LABEL_MUSCLE;
+    if (vc->lab != NULL) {
+        label = vc->lab[base + (tx >= SC_W_ONE / 2 ? ox : 0u) + (ty >= SC_W_ONE / 2 ? oy : 0u) +
+                        (tz >= SC_W_ONE / 2 ? oz : 0u)];
+    }
+    lab_out[k] = label;
+    /* display: out = (A * I + B[k]) >> 26 with I in 1/1024 grey, A = lut_a in 16.16 and
+     * B = lut_b in 38.26 with the rounding half folded in */
+    const int64_t sum = vc->la * (int64_t)ifx + lut_b_fx[k];
+    out[k] = (uint8_t)(label == (uint8_t)SC_LABEL_OUTSIDE || sum < ((int64_t)1 << 26)
+                           ? 0
+                           : (sum >= ((int64_t)255 << 26) ? 255 : (sum >> 26)));
+}
+
+static int64_t clamp_fx(int64_t x, int64_t hi)
+{
+    return x < 0 ? 0 : (x > hi ? hi : x);
+}
+
+static int in_volume(const vol_ctx *vc, const float p[3])
+{
+    return p[0] >= -0.5f && p[0] < vc->hi[0] && p[1] >= -0.5f && p[1] < vc->hi[1] &&
+           p[2] >= -0.5f && p[2] < vc->hi[2];
+}
+
+/* Samples [k0, k1) at voxel positions a + k b. */
+static void sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1,
+                        const float a[3], const float bb[3])
+{
+    float p0[3], p1[3];
+    for (uint32_t d = 0; d < 3u; d++) {
+        p0[d] = a[d] + (float)k0 * bb[d];
+        p1[d] = a[d] + (float)(k1 - 1u) * bb[d];
+    }
+    if (in_volume(vc, p0) && in_volume(vc, p1)) {
+        /* the volume box is convex: every sample between is inside */
+        int64_t X = to_fx32(p0[0]), Y = to_fx32(p0[1]), Z = to_fx32(p0[2]);
+        const int64_t DX = step_fx32(bb[0]), DY = step_fx32(bb[1]), DZ = step_fx32(bb[2]);
+        const int64_t j1 = (int64_t)(k1 - 1u - k0);
+        const int64_t xe = X + j1 * DX, ye = Y + j1 * DY, ze = Z + j1 * DZ;
+        if (X >= 0 && xe >= 0 && Y >= 0 && ye >= 0 && Z >= 0 && ze >= 0 && X <= vc->xmax[0] &&
+            xe <= vc->xmax[0] && Y <= vc->xmax[1] && ye <= vc->xmax[1] && Z <= vc->xmax[2] &&
+            ze <= vc->xmax[2]) {
+            /* clear of the half-voxel border at both ends, so everywhere: no clamping */
+            for (uint32_t k = k0; k < k1; k++) {
+                sample_fx(vc, b->lut_b_fx, k, X, Y, Z, b->line_out, b->line_label);
+                X += DX;
+                Y += DY;
+                Z += DZ;
+            }
+            return;
+        }
+        for (uint32_t k = k0; k < k1; k++) {
+            sample_fx(vc, b->lut_b_fx, k, clamp_fx(X, vc->xmax[0]), clamp_fx(Y, vc->xmax[1]),
+                      clamp_fx(Z, vc->xmax[2]), b->line_out, b->line_label);
+            X += DX;
+            Y += DY;
+            Z += DZ;
+        }
+        return;
+    }
+    for (uint32_t k = k0; k < k1; k++) {
+        const float p[3] = {a[0] + (float)k * bb[0], a[1] + (float)k * bb[1],
+                            a[2] + (float)k * bb[2]};
+        if (!in_volume(vc, p)) {
+            /* outside the case volume: nothing to image */
+            b->line_out[k] = 0u;
+            b->line_label[k] = (uint8_t)SC_LABEL_OUTSIDE;
+            continue;
+        }
+        sample_fx(vc, b->lut_b_fx, k, clamp_fx(to_fx32(p[0]), vc->xmax[0]),
+                  clamp_fx(to_fx32(p[1]), vc->xmax[1]), clamp_fx(to_fx32(p[2]), vc->xmax[2]),
+                  b->line_out, b->line_label);
+    }
+}
+
+/* The whole line: mesh runs at their rest positions, the gaps rigid; then label areas. */
+static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, const frame_ctx *c,
+                        area_acc *acc)
+{
+    const uint32_t n = c->n;
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < b->run_count; i++) {
+        const sc_bscan_run *r = &b->runs[i];
+        if (k < r->k0) {
+            sample_span(b, vc, k, r->k0, c->f0, c->fd);
+        }
+        sample_span(b, vc, r->k0, r->k1, r->a, r->b);
+        k = r->k1;
+    }
+    if (k < n) {
+        sample_span(b, vc, k, n, c->f0, c->fd);
+    }
+    if (vc->lab == NULL) {
+        return;
+    }
+    count_labels(b->line_label, n, acc->now_n, acc->now_k);
+    /* rest areas: the rigid slice's labels; outside the mesh identical to the above */
+    for (uint32_t i = 0; i < b->run_count; i++) {
+        const uint32_t k0 = b->runs[i].k0, k1 = b->runs[i].k1;
+        float p0[3], p1[3];
+        for (uint32_t d = 0; d < 3u; d++) {
+            p0[d] = c->f0[d] + (float)k0 * c->fd[d];
+            p1[d] = c->f0[d] + (float)(k1 - 1u) * c->fd[d];
+        }
+        if (in_volume(vc, p0) && in_volume(vc, p1)) {
+            /* nearest voxel: 16.16 positions offset by a half */
+            int64_t X = to_fx32(p0[0] + 0.5f), Y = to_fx32(p0[1] + 0.5f),
+                    Z = to_fx32(p0[2] + 0.5f);
+            const int64_t DX = step_fx32(c->fd[0]), DY = step_fx32(c->fd[1]),
+                          DZ = step_fx32(c->fd[2]);
+            const int64_t lx = (int64_t)v->dim[0] - 1, ly = (int64_t)v->dim[1] - 1,
+                          lz = (int64_t)v->dim[2] - 1;
+            for (uint32_t kk = k0; kk < k1; kk++) {
+                int64_t ix = X < 0 ? 0 : X >> 32, iy = Y < 0 ? 0 : Y >> 32,
+                        iz = Z < 0 ? 0 : Z >> 32;
+                ix = ix > lx ? lx : ix;
+                iy = iy > ly ? ly : iy;
+                iz = iz > lz ? lz : iz;
+                b->line_label[kk] = vc->lab[(size_t)ix + vc->stride[1] * (size_t)iy +
+                                            vc->stride[2] * (size_t)iz];
+                X += DX;
+                Y += DY;
+                Z += DZ;
+            }
+            continue;
+        }
+        for (uint32_t kk = k0; kk < k1; kk++) {
+            const float s = (float)kk;
+            b->line_label[kk] = label_at(v, c->f0[0] + s * c->fd[0], c->f0[1] + s * c->fd[1],
+                                         c->f0[2] + s * c->fd[2]);
+        }
+    }
+    count_labels(b->line_label, n, acc->rest_n, acc->rest_k);
+}
+
+/* ---- frame ------------------------------------------------------------------------------- */
+
+static int volume_ok(const sc_volume *v)
+{
+    if (v->voxels == NULL) {
+        return 0;
+    }
+    for (uint32_t d = 0; d < 3u; d++) {
+        if (v->dim[d] < 1u || v->dim[d] > SC_MAX_VOLUME_DIM || !isfinite(v->spacing_mm[d]) ||
+            !(v->spacing_mm[d] > 0.0f) || !isfinite(v->origin_mm[d])) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+static int emit_line(sc_bscan *b, const sc_display_dev *disp, uint32_t frame_no, uint32_t l,
+                     int rc)
+{
+    const int r = sc_display_line(disp, frame_no, (uint16_t)l, b->line_out,
+                                  (uint16_t)b->def.scan.samples_n);
+    if (r != SC_OK) {
+        b->status.display_errors++;
+        return rc != SC_OK ? rc : r;
+    }
+    return rc;
+}
+
+int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes,
+                   const sc_volume *volume, const sc_xform *probe_to_volume, int contact,
+                   const sc_display_dev *display, uint32_t frame_no)
+{
+    if (b == NULL || volume == NULL || probe_to_volume == NULL || display == NULL ||
+        !volume_ok(volume)) {
+        return SC_ERR_INVALID_ARG;
+    }
+    if ((mesh == NULL) != (nodes == NULL) ||
+        (mesh != NULL && (mesh->tet_count != b->mesh_tets || b->mesh_tets == 0u))) {
+        return SC_ERR_INVALID_ARG;
+    }
+    if (!sc_xform_is_rigid(probe_to_volume, 1e-3f)) {
+        return SC_ERR_CASE_TRANSFORM;
+    }
+    const sc_scan_def *sd = &b->def.scan;
+    const uint32_t lines = sd->lines_n, n = sd->samples_n;
+    sc_bscan_status *st = &b->status;
+    st->frame_no = frame_no;
+    st->contact = (uint8_t)(contact != 0);
+    st->pixels_in_mesh = 0u;
+    st->plane_hull_segments = 0u;
+    st->plane_tets = 0u;
+    st->walk_steps = 0u;
+
+    const sc_display_frame_info info = {
+        .frame_no = frame_no,
+        .lines = (uint16_t)lines,
+        .samples = (uint16_t)n,
+        .geometry_id = (uint16_t)sd->kind,
+        .flags = (uint16_t)(contact ? SC_DISPLAY_FLAG_CONTACT : 0u),
+        .depth_mm = sd->depth_mm,
+        .width_mm = sd->kind == SC_SCAN_GEOM_LINEAR ? sd->width_mm : sd->sector_deg,
+    };
+    int rc = sc_display_frame_begin(display, &info);
+    if (rc != SC_OK) {
+        st->display_errors++;
+    }
+
+    if (!contact) {
+        memset(b->line_out, 0, n);
+        for (uint32_t l = 0; l < lines; l++) {
+            rc = emit_line(b, display, frame_no, l, rc);
+        }
+        st->areas_valid = 0u;
+        for (uint32_t i = 0; i < SC_LABEL_COUNT; i++) {
+            st->area_now_mm2[i] = 0.0f;
+            st->area_rest_mm2[i] = 0.0f;
+            st->area_ratio[i] = -1.0f;
+        }
+        const int re = sc_display_frame_end(display, frame_no);
+        if (re != SC_OK) {
+            st->display_errors++;
+            rc = rc != SC_OK ? rc : re;
+        }
+        return rc;
+    }
+
+    frame_ctx c;
+    c.img2vol = sc_xform_compose(probe_to_volume, &sd->image_to_probe);
+    c.n = n;
+    for (uint32_t d = 0; d < 3u; d++) {
+        c.vo[d] = volume->origin_mm[d];
+        c.inv_sp[d] = 1.0f / volume->spacing_mm[d];
+    }
+
+    uint32_t mapper = b->def.mapper;
+    if (mesh != NULL) {
+        const sc_xform vol2img = sc_xform_inverse(&c.img2vol);
+        const float *r = vol2img.r, *t = vol2img.t_mm;
+        for (uint32_t i = 0; i < mesh->node_count; i++) {
+            const float x = nodes->x[i], y = nodes->y[i], z = nodes->z[i];
+            b->qx[i] = r[0] * x + r[1] * y + r[2] * z + t[0];
+            b->qy[i] = r[3] * x + r[4] * y + r[5] * z + t[1];
+            b->qz[i] = r[6] * x + r[7] * y + r[8] * z + t[2];
+        }
+        if (mapper == SC_BSCAN_MAP_REGIONS) {
+            if (build_regions(b, mesh)) {
+                st->plane_tets = b->ptet_count;
+            } else {
+                st->region_overflows++;
+                mapper = SC_BSCAN_MAP_WALK;
+            }
+        }
+        if (mapper == SC_BSCAN_MAP_WALK) {
+            build_segments(b, mesh);
+            st->plane_hull_segments = b->seg_count;
+        }
+    }
+
+    vol_ctx vc;
+    vc.vox = volume->voxels;
+    vc.lab = volume->labels;
+    vc.la = (int64_t)(b->lut_a * 65536.0f + 0.5f);
+    for (uint32_t d = 0; d < 3u; d++) {
+        const uint32_t dim = volume->dim[d];
+        vc.hi[d] = (float)dim - 0.5f;
+        /* below the last voxel centre by the weight rounding, so x + 1 stays in the grid */
+        vc.xmax[d] = dim > 1u ? ((int64_t)(dim - 1u) << 32) - 1 - SC_W_HALF : 0;
+        vc.stride[d] = d == 0u ? 1u : (d == 1u ? volume->dim[0]
+                                               : (size_t)volume->dim[0] * volume->dim[1]);
+        vc.step[d] = dim > 1u ? vc.stride[d] : 0u;
+    }
+    area_acc acc;
+    memset(&acc, 0, sizeof acc);
+    uint32_t active_n = 0;
+    for (uint32_t l = 0; l < lines; l++) {
+        c.ox = b->geom.start_x_mm[l];
+        c.oz = b->geom.start_z_mm[l];
+        c.dx = b->geom.step_x_mm[l];
+        c.dz = b->geom.step_z_mm[l];
+        const float o_img[3] = {c.ox, 0.0f, c.oz}, d_img[3] = {c.dx, 0.0f, c.dz};
+        float w0[3], wd[3];
+        sc_xform_apply(&c.img2vol, o_img, w0);
+        sc_xform_rotate(&c.img2vol, d_img, wd);
+        to_vox(&c, w0, c.f0);
+        for (uint32_t d = 0; d < 3u; d++) {
+            c.fd[d] = wd[d] * c.inv_sp[d];
+        }
+        b->run_count = 0u;
+        if (mesh != NULL) {
+            switch (mapper) {
+            case SC_BSCAN_MAP_WALK:
+                map_line_walk(b, mesh, l, &active_n, &c);
+                break;
+            case SC_BSCAN_MAP_REGIONS:
+                map_line_regions(b, l, &c);
+                break;
+            case SC_BSCAN_MAP_ORACLE:
+                map_line_oracle(b, mesh, nodes, l, &c);
+                break;
+            default:
+                SC_ASSERT(0);
+                break;
+            }
+            for (uint32_t i = 0; i < b->run_count; i++) {
+                st->pixels_in_mesh += (uint32_t)b->runs[i].k1 - b->runs[i].k0;
+            }
+        }
+        sample_line(b, &vc, volume, &c, &acc);
+        rc = emit_line(b, display, frame_no, l, rc);
+    }
+    const int re = sc_display_frame_end(display, frame_no);
+    if (re != SC_OK) {
+        st->display_errors++;
+        rc = rc != SC_OK ? rc : re;
+    }
+
+    /* areas: sum over pixels of the pixel area, from counts (exact integers) */
+    const float a0 = b->geom.sample_area_mm2[0];
+    const float a1 = n > 1u ? b->geom.sample_area_mm2[1] - a0 : 0.0f; /* per sample index */
+    st->areas_valid = (uint8_t)(volume->labels != NULL);
+    st->image_area_mm2 = 0.0f;
+    for (uint32_t i = 0; i < SC_LABEL_COUNT; i++) {
+        st->area_now_mm2[i] = a0 * (float)acc.now_n[i] + a1 * (float)acc.now_k[i];
+        st->area_rest_mm2[i] = a0 * (float)acc.rest_n[i] + a1 * (float)acc.rest_k[i];
+        st->area_ratio[i] =
+            st->area_rest_mm2[i] > 0.0f ? st->area_now_mm2[i] / st->area_rest_mm2[i] : -1.0f;
+        st->image_area_mm2 += st->area_rest_mm2[i];
+    }
+    return rc;
+}

@@ -1,0 +1,200 @@
+/*
+ * sc_bscan.h: B-mode image synthesis through the deformed tet mesh, streamed line by line
+ * (paper section IV).
+ *
+ * Per pixel: its position in the deformed mesh is found, the containing tet's barycentric
+ * coordinates carry it to the rest configuration, and the case volume is sampled there
+ * (trilinear). Pixels outside the mesh are sampled rigidly (at their own position); a pixel whose
+ * rest position carries the label SC_LABEL_OUTSIDE (air above the skin) is dark, and without
+ * probe contact the whole image is dark, as a real probe in air shows. Then display processing
+ * (gain, 8-band time-gain compensation, dynamic range) and each scan line leaves through the
+ * HAL display as soon as it is computed.
+ *
+ * Three mappers, chosen at run time, that agree up to ties on tet faces:
+ * - SC_BSCAN_MAP_ORACLE: per pixel, every tet of the mesh is tried (test oracle; slow).
+ * - SC_BSCAN_MAP_REGIONS: the paper's path: the tets cut by the image plane, binned into R
+ *   regions (groups of scan lines); per line, recursive subdivision between the end pixels,
+ *   linear interpolation of rest positions where both ends fall in the same tet.
+ * - SC_BSCAN_MAP_WALK (default, fastest): each scan line is a straight ray; it enters the mesh
+ *   through a boundary triangle (found among the boundary triangles cut by the image plane) and
+ *   walks from tet to face neighbour, the exit parameter of each tet coming from its
+ *   barycentric coordinates along the ray; inside a tet the rest position is affine in the
+ *   sample index.
+ *
+ * The compression measure comes from the same pass: for each label, the image area whose rest
+ * position has that label now, against the area with that label in the rigid (undeformed) slice
+ * at the same pose: the instructor's "did the vein collapse?".
+ *
+ * Memory: all state in the caller's sc_bscan, sized by config/sc_config.h (about 2 MB with the
+ * default limits). Never allocates, never calls the OS. Threads: one writer. Deterministic:
+ * float32 throughout, no data-dependent order; identical inputs give identical images.
+ */
+#ifndef SC_BSCAN_H
+#define SC_BSCAN_H
+
+#include <stdint.h>
+
+#include "sc_config.h"
+#include "sc_hal_display.h"
+#include "sc_labels.h"
+#include "sc_mesh.h"
+#include "sc_pose.h"
+#include "sc_scan_geom.h"
+#include "sc_volume.h"
+
+enum {
+    SC_BSCAN_MAP_WALK = 0,
+    SC_BSCAN_MAP_REGIONS = 1,
+    SC_BSCAN_MAP_ORACLE = 2,
+    SC_BSCAN_MAP_COUNT
+};
+
+/* Runtime settings. The volume's 8-bit values are read as log-compressed echo over
+ * volume_range_db; the displayed value of intensity I at depth band b is
+ *     255 * (I/255 * Rv - Rv + gain_db + tgc_db[b] + R) / R, clamped to 0..255,
+ * with Rv = volume_range_db and R = dynamic_range_db (TGC interpolated linearly between band
+ * centres). With gain 0, TGC 0 and R = Rv the display shows the volume values unchanged. */
+typedef struct sc_bscan_def {
+    sc_scan_def scan;
+    uint32_t mapper;                 /* SC_BSCAN_MAP_* */
+    uint32_t regions_n;              /* R of the region path, 1..SC_BSCAN_MAX_REGIONS */
+    float gain_db;                   /* overall gain, [-60, 60] */
+    float tgc_db[SC_BSCAN_TGC_BANDS]; /* per depth band, shallow first, [-60, 60] */
+    float dynamic_range_db;          /* displayed range, [10, 120] */
+    float volume_range_db;           /* range the volume's 0..255 stands for, [10, 120] */
+} sc_bscan_def;
+
+/* Labels whose area the compression measure follows (all labels are counted). */
+typedef struct sc_bscan_status {
+    uint32_t frame_no;
+    uint8_t contact;
+    uint8_t areas_valid;                      /* 0: no contact or no label map */
+    float area_now_mm2[SC_LABEL_COUNT];       /* image area by rest label, this frame */
+    float area_rest_mm2[SC_LABEL_COUNT];      /* same pose, undeformed mesh */
+    float area_ratio[SC_LABEL_COUNT];         /* now / rest; -1 where the rest area is 0 */
+    float image_area_mm2;
+    uint32_t pixels_in_mesh;                  /* this frame */
+    uint32_t plane_hull_segments;             /* boundary triangles cut by the plane */
+    uint32_t plane_tets;                      /* region path: tets cut by the plane */
+    uint32_t walk_steps;                      /* walker: tet steps this frame */
+    /* cumulative counters of degraded work (each stays exact or falls back, see .c) */
+    uint32_t walk_aborts;        /* a line exceeded SC_BSCAN_MAX_WALK_STEPS */
+    uint32_t event_overflows;    /* a line crossed the boundary > SC_BSCAN_MAX_LINE_EVENTS */
+    uint32_t locate_fallbacks;   /* a line start inside the mesh, located by brute force */
+    uint32_t region_overflows;   /* region path over its limits: frame done by the walker */
+    uint32_t display_errors;     /* display calls that returned an error */
+} sc_bscan_status;
+
+/* A boundary triangle of the mesh: face `face` (opposite that vertex) of tet `tet`. */
+typedef struct sc_bscan_hull_face {
+    uint32_t tet;
+    uint32_t face;
+} sc_bscan_hull_face;
+
+/* A boundary triangle cut by the image plane: its 2D segment in the image frame (x, z). */
+typedef struct sc_bscan_seg {
+    float ax, az, bx, bz;
+    float nx, nz;      /* in-plane part of the outward normal */
+    uint32_t tet;
+    uint32_t face;
+    int32_t line_lo, line_hi;
+} sc_bscan_seg;
+
+/* Region path: a tet cut by the plane, with its barycentric coordinates and rest position as
+ * affine functions of the image-frame (x, z). */
+typedef struct sc_bscan_ptet {
+    float lam[4][3];   /* lambda_i = lam[i][0] + lam[i][1] x + lam[i][2] z */
+    float rest[3][3];  /* rest coordinate d = rest[d][0] + rest[d][1] x + rest[d][2] z */
+    float xmin, xmax, zmin, zmax;
+} sc_bscan_ptet;
+
+/* Samples [k0, k1) of a line inside the mesh; rest position in voxel units is a + k b. */
+typedef struct sc_bscan_run {
+    uint16_t k0, k1;
+    float a[3], b[3];
+} sc_bscan_run;
+
+typedef struct sc_bscan_event {
+    float s;        /* line parameter, samples */
+    uint32_t seg;   /* index into segs */
+    uint8_t entry;  /* 1: the line enters the mesh here */
+} sc_bscan_event;
+
+typedef struct sc_bscan {
+    sc_bscan_def def;
+    sc_scan_geom geom;
+    float lut_a;                             /* display: out = lut_a * I + lut_b[k] */
+    float lut_b[SC_MAX_SCAN_SAMPLES];
+    int64_t lut_b_fx[SC_MAX_SCAN_SAMPLES];   /* lut_b in 38.26 fixed point, + 1/2 */
+    /* mesh boundary, from sc_bscan_attach_mesh */
+    uint32_t hull_count;
+    uint32_t mesh_tets;
+    sc_bscan_hull_face hull[SC_BSCAN_MAX_HULL_FACES];
+    /* per frame: nodes in the image frame (x, y = distance to the plane, z), SoA */
+    SC_ALIGN_HOT float qx[SC_MAX_NODES];
+    SC_ALIGN_HOT float qy[SC_MAX_NODES];
+    SC_ALIGN_HOT float qz[SC_MAX_NODES];
+    /* walker: plane segments, bucketed by first line, and the active set of a line sweep */
+    uint32_t seg_count;
+    sc_bscan_seg segs[SC_BSCAN_MAX_HULL_FACES];
+    uint32_t seg_start[SC_MAX_SCAN_LINES + 1u];
+    uint32_t seg_sorted[SC_BSCAN_MAX_HULL_FACES];
+    uint32_t active[SC_BSCAN_MAX_HULL_FACES];
+    sc_bscan_event events[SC_BSCAN_MAX_LINE_EVENTS];
+    /* region path */
+    uint32_t ptet_count;
+    sc_bscan_ptet ptets[SC_BSCAN_MAX_PLANE_TETS];
+    int32_t ptet_lo[SC_BSCAN_MAX_PLANE_TETS];
+    int32_t ptet_hi[SC_BSCAN_MAX_PLANE_TETS];
+    uint32_t region_start[SC_BSCAN_MAX_REGIONS + 1u];
+    uint32_t region_refs[SC_BSCAN_MAX_REGION_REFS];
+    float region_box[SC_BSCAN_MAX_REGIONS][4]; /* xmin, xmax, zmin, zmax of its tets */
+    /* one line in flight: the runs of samples inside the mesh (the rest is rigid), the
+     * labels and the displayed samples */
+    uint32_t run_count;
+    sc_bscan_run runs[SC_MAX_SCAN_SAMPLES];
+    uint8_t line_label[SC_MAX_SCAN_SAMPLES];
+    uint8_t line_out[SC_MAX_SCAN_SAMPLES];
+    sc_bscan_status status;
+} sc_bscan;
+
+/* Defaults: the linear probe of sc_scan_default_def(), walker, R = 32, gain 0, TGC 0,
+ * 60 dB displayed over a 60 dB volume (the volume shown unchanged). */
+sc_bscan_def sc_bscan_default_def(void);
+
+/* Validate def and set up the geometry and display tables; forgets any attached mesh.
+ * O(lines + samples). Never allocates.
+ * Errors: SC_ERR_INVALID_ARG (NULL), SC_ERR_IMG_GEOMETRY (scan geometry), SC_ERR_RANGE
+ * (mapper, regions_n, gain/TGC/range out of range), SC_ERR_NOT_FINITE. On error b is not
+ * usable (call again with a valid def). */
+int sc_bscan_init(sc_bscan *b, const sc_bscan_def *def);
+
+/* Change runtime settings (geometry, depth, mapper, gain, TGC, range, R) between frames,
+ * keeping the attached mesh. O(lines + samples). Never allocates. Errors as sc_bscan_init; on
+ * error the previous settings stay. */
+int sc_bscan_set_def(sc_bscan *b, const sc_bscan_def *def);
+
+/* Record the boundary triangles of a built mesh (at case load). O(tets), bounded by
+ * SC_MAX_TETS. Never allocates. Errors: SC_ERR_INVALID_ARG, SC_ERR_NO_SPACE (more boundary
+ * triangles than SC_BSCAN_MAX_HULL_FACES). */
+int sc_bscan_attach_mesh(sc_bscan *b, const sc_mesh *mesh);
+
+/* Synthesize one frame and stream it: frame_begin, every line as soon as it is computed,
+ * frame_end; update the status (compression measure). mesh/nodes may be NULL (no mesh: every
+ * pixel rigid); the mesh must be the attached one. probe_to_volume: probe frame -> volume
+ * frame. contact 0: a dark frame (still streamed).
+ * Cost, walker: O(nodes + hull faces + lines * (crossed tets + samples)); region path:
+ * O(tets + lines * samples * tets per region) worst case; oracle O(pixels * tets). Bounded by
+ * SC_MAX_NODES, SC_MAX_TETS, SC_MAX_SCAN_LINES, SC_MAX_SCAN_SAMPLES, SC_BSCAN_MAX_WALK_STEPS.
+ * Never allocates.
+ * Errors: SC_ERR_INVALID_ARG (NULL b/volume/probe/display, volume without voxels, mesh not the
+ * attached one), SC_ERR_CASE_TRANSFORM (probe transform not rigid or not finite), or the first
+ * error a display call returned (the frame is still computed and streamed to the end). */
+int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes,
+                   const sc_volume *volume, const sc_xform *probe_to_volume, int contact,
+                   const sc_display_dev *display, uint32_t frame_no);
+
+/* Status of the last frame (compression measure, work counters). O(1). */
+const sc_bscan_status *sc_bscan_status_get(const sc_bscan *b);
+
+#endif /* SC_BSCAN_H */
