@@ -1,4 +1,5 @@
-/* sc_dlink.c: display link packet codec and frame assembler (see sc_dlink.h, docs/display-link.md). */
+/* sc_dlink.c: display link packet codec and frame assembler (see sc_dlink.h, docs/display-link.md).
+ */
 #include "sc_dlink.h"
 
 #include <math.h>
@@ -24,7 +25,7 @@ enum {
 };
 _Static_assert(OFF_CRC + 4 == SC_DLINK_HEADER_SIZE, "header layout");
 
-#define SC_DLINK_GEOMETRY_MAX 1u
+#define SC_DLINK_GEOMETRY_MAX    1u
 #define SC_DLINK_COMPRESSION_MAX 1000u
 
 static void put16(uint8_t *p, uint16_t v)
@@ -48,8 +49,7 @@ static uint16_t get16(const uint8_t *p)
 
 static uint32_t get32(const uint8_t *p)
 {
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) |
-           ((uint32_t)p[3] << 24);
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
 }
 
 static uint32_t f32_bits(float f)

@@ -28,11 +28,11 @@
 
 #include "sc_config.h"
 
-#define SC_DLINK_MAGIC 0x4C444353u /* bytes 'S' 'C' 'D' 'L' on the wire (little-endian) */
-#define SC_DLINK_VERSION 1u
-#define SC_DLINK_HEADER_SIZE 28u
+#define SC_DLINK_MAGIC         0x4C444353u /* bytes 'S' 'C' 'D' 'L' on the wire (little-endian) */
+#define SC_DLINK_VERSION       1u
+#define SC_DLINK_HEADER_SIZE   28u
 #define SC_DLINK_BEGIN_PAYLOAD 16u /* depth, width, radius f32; compression u16; rsvd u16 */
-#define SC_DLINK_END_PAYLOAD 8u    /* lines_sent u16, lines_dropped u16, reserved u32 */
+#define SC_DLINK_END_PAYLOAD   8u  /* lines_sent u16, lines_dropped u16, reserved u32 */
 /* Largest packet: a line of SC_MAX_SCAN_SAMPLES samples (540 bytes with the default limits,
  * below the 1472-byte UDP payload of a 1500-byte Ethernet MTU, so no IP fragmentation). */
 #define SC_DLINK_MAX_PACKET (SC_DLINK_HEADER_SIZE + SC_MAX_SCAN_SAMPLES)
@@ -52,8 +52,8 @@ typedef enum sc_dlink_type {
 /* Decoded header. For FRAME_BEGIN and FRAME_END line_index is 0. */
 typedef struct sc_dlink_header {
     uint8_t version;
-    uint8_t type; /* sc_dlink_type */
-    uint16_t flags;       /* SC_DISPLAY_FLAG_* of hal/sc_hal_display.h */
+    uint8_t type;   /* sc_dlink_type */
+    uint16_t flags; /* SC_DISPLAY_FLAG_* of hal/sc_hal_display.h */
     uint32_t frame_no;
     uint16_t line_index;  /* LINE: 0 .. line_count-1 */
     uint16_t line_count;  /* lines of the frame: 1 .. SC_MAX_SCAN_LINES */
@@ -64,10 +64,10 @@ typedef struct sc_dlink_header {
 
 /* FRAME_BEGIN payload. */
 typedef struct sc_dlink_begin {
-    float depth_mm;           /* imaging depth */
-    float width_mm;           /* linear: aperture width; curvilinear: sector angle in degrees */
-    float radius_mm;          /* curvilinear: probe face radius (apex behind the face); linear 0 */
-    uint16_t compression_pm;  /* vessel compression measure, permille; or ..._UNKNOWN */
+    float depth_mm;          /* imaging depth */
+    float width_mm;          /* linear: aperture width; curvilinear: sector angle in degrees */
+    float radius_mm;         /* curvilinear: probe face radius (apex behind the face); linear 0 */
+    uint16_t compression_pm; /* vessel compression measure, permille; or ..._UNKNOWN */
 } sc_dlink_begin;
 
 /* FRAME_END payload: what the sender did with this frame's lines. */
@@ -97,8 +97,7 @@ int sc_dlink_encode_begin(uint8_t *buf, size_t cap, const sc_dlink_frame *f,
                           const sc_dlink_begin *b);
 int sc_dlink_encode_line(uint8_t *buf, size_t cap, const sc_dlink_frame *f, uint16_t line_index,
                          const uint8_t *samples, uint16_t count);
-int sc_dlink_encode_end(uint8_t *buf, size_t cap, const sc_dlink_frame *f,
-                        const sc_dlink_end *e);
+int sc_dlink_encode_end(uint8_t *buf, size_t cap, const sc_dlink_frame *f, const sc_dlink_end *e);
 
 /* Decode and check one received packet of len bytes. On success fills *h, points *payload at
  * the payload inside pkt and returns 0. Checks, in this order: length at least a header
@@ -111,53 +110,53 @@ int sc_dlink_encode_end(uint8_t *buf, size_t cap, const sc_dlink_frame *f,
 int sc_dlink_decode(const uint8_t *pkt, size_t len, sc_dlink_header *h, const uint8_t **payload);
 
 /* Payload accessors for a packet that sc_dlink_decode accepted with that type (the decoder
- * has checked the payload: finite depth, width and radius >= 0, compression <= 1000 or unknown, lines_sent +
- * lines_dropped <= line_count, reserved bytes zero). O(1), cannot fail. */
+ * has checked the payload: finite depth, width and radius >= 0, compression <= 1000 or unknown,
+ * lines_sent + lines_dropped <= line_count, reserved bytes zero). O(1), cannot fail. */
 void sc_dlink_parse_begin(const uint8_t *payload, sc_dlink_begin *b);
 void sc_dlink_parse_end(const uint8_t *payload, sc_dlink_end *e);
 
 /* ---- receiver-side frame assembler ----------------------------------------------------- */
 
 typedef struct sc_dlink_rx_stats {
-    uint64_t packets;          /* datagrams offered */
-    uint64_t rejected;         /* failed sc_dlink_decode (sum of the reasons below) */
+    uint64_t packets;  /* datagrams offered */
+    uint64_t rejected; /* failed sc_dlink_decode (sum of the reasons below) */
     uint64_t rej_length, rej_magic, rej_version, rej_crc, rej_type, rej_field;
-    uint64_t lines_received;   /* stored in their frame */
-    uint64_t lines_lost;       /* expected, not received when the frame closed */
-    uint64_t lines_late;       /* arrived for a frame already closed */
-    uint64_t lines_duplicate;  /* same line twice in one frame */
+    uint64_t lines_received;       /* stored in their frame */
+    uint64_t lines_lost;           /* expected, not received when the frame closed */
+    uint64_t lines_late;           /* arrived for a frame already closed */
+    uint64_t lines_duplicate;      /* same line twice in one frame */
     uint64_t lines_sender_dropped; /* reported by the sender in FRAME_END */
-    uint64_t frames_complete;  /* closed with every line */
-    uint64_t frames_incomplete; /* closed with lines lost */
-    uint64_t begins_missing;   /* frame started by a line or end: its FRAME_BEGIN never came */
-    uint64_t ends_missing;     /* frame closed by a newer frame: its FRAME_END never came */
-    uint64_t frames_late;      /* FRAME_BEGIN/END of a frame older than the current one */
+    uint64_t frames_complete;      /* closed with every line */
+    uint64_t frames_incomplete;    /* closed with lines lost */
+    uint64_t begins_missing;       /* frame started by a line or end: its FRAME_BEGIN never came */
+    uint64_t ends_missing;         /* frame closed by a newer frame: its FRAME_END never came */
+    uint64_t frames_late;          /* FRAME_BEGIN/END of a frame older than the current one */
 } sc_dlink_rx_stats;
 
 /* A closed frame, ready to show: image rows 0..line_count-1, each `samples` bytes, stride
  * SC_MAX_SCAN_SAMPLES. Lost rows hold the previous frame's row. */
 typedef struct sc_dlink_done {
     sc_dlink_frame frame;
-    sc_dlink_begin begin;      /* from FRAME_BEGIN, or the previous frame's if it was lost */
+    sc_dlink_begin begin; /* from FRAME_BEGIN, or the previous frame's if it was lost */
     uint16_t lines_received;
     uint16_t lines_lost;
     uint8_t begin_seen;
     uint8_t end_seen;
-    const uint8_t *image;      /* valid until the next frame closes */
+    const uint8_t *image; /* valid until the next frame closes */
 } sc_dlink_done;
 
 typedef struct sc_dlink_asm {
     uint8_t image[2][SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES]; /* assembling / last closed */
-    uint32_t got[(SC_MAX_SCAN_LINES + 31u) / 32u];              /* lines of the open frame */
-    uint8_t cur;                /* plane being assembled */
-    uint8_t open;               /* a frame is being assembled */
-    uint8_t have_done;          /* a closed frame exists */
+    uint32_t got[(SC_MAX_SCAN_LINES + 31u) / 32u];             /* lines of the open frame */
+    uint8_t cur;                                               /* plane being assembled */
+    uint8_t open;                                              /* a frame is being assembled */
+    uint8_t have_done;                                         /* a closed frame exists */
     uint8_t begin_seen;
-    sc_dlink_frame frame;       /* open frame */
-    sc_dlink_begin begin;       /* open frame's (or last known) begin payload */
-    uint16_t received;          /* lines of the open frame */
-    uint32_t last_closed_no;    /* frame number of the last closed frame */
-    sc_dlink_done done;         /* last closed frame */
+    sc_dlink_frame frame;    /* open frame */
+    sc_dlink_begin begin;    /* open frame's (or last known) begin payload */
+    uint16_t received;       /* lines of the open frame */
+    uint32_t last_closed_no; /* frame number of the last closed frame */
+    sc_dlink_done done;      /* last closed frame */
     sc_dlink_rx_stats stats;
 } sc_dlink_asm;
 

@@ -41,10 +41,10 @@ static const char *const k_log_names[] = {"debug", "info", "warn", "error", NULL
 static const char *const k_tristate_names[] = {"auto", "on", "off", NULL};
 static const char *const k_target_names[] = {"none", "udp", "png", "drm", "fbdev", NULL};
 
-#define F(member) offsetof(sc_rtcfg, member)
-#define MIN_U(a, b) ((a) < (b) ? (a) : (b))
-#define NUM(lo, hi, dflt) 0u, (double)(lo), (double)(hi), (double)(dflt), NULL, NULL, NULL
-#define TXT(size, dflt, words) (size), 0.0, 0.0, 0.0, (dflt), (words), NULL
+#define F(member)                offsetof(sc_rtcfg, member)
+#define MIN_U(a, b)              ((a) < (b) ? (a) : (b))
+#define NUM(lo, hi, dflt)        0u, (double)(lo), (double)(hi), (double)(dflt), NULL, NULL, NULL
+#define TXT(size, dflt, words)   (size), 0.0, 0.0, 0.0, (dflt), (words), NULL
 #define ENUM(dflt, words, names) 0u, 0.0, 0.0, 0.0, (dflt), (words), (names)
 
 /* The key table. Numeric ranges and defaults come from sc_config.h where the engine has a
@@ -63,18 +63,17 @@ static const key_def k_keys[] = {
      TXT(SC_RTCFG_PATH_MAX, "cases/neck-ijv.scase", "a file path")},
     {"physics.method", "soft-tissue solver (switchable at run time over CAN)", K_ENUM,
      F(physics_method), ENUM("msds", "msds | fem", k_method_names)},
-    {"physics.iterations", "solver iterations per frame (paper: 20)", K_U32,
-     F(physics_iterations), NUM(1u, SC_PHYS_ITERATIONS_MAX, SC_PHYS_ITERATIONS_DEFAULT)},
+    {"physics.iterations", "solver iterations per frame (paper: 20)", K_U32, F(physics_iterations),
+     NUM(1u, SC_PHYS_ITERATIONS_MAX, SC_PHYS_ITERATIONS_DEFAULT)},
     {"physics.dt_s", "MSDS time step in seconds (paper: 0.01)", K_F32, F(physics_dt_s),
      NUM(0.0001, 0.1, SC_PHYS_DT_DEFAULT_S)},
     {"image.geometry", "scan geometry of the virtual probe", K_ENUM, F(image_geometry),
      ENUM("linear", "linear | curvilinear", k_geometry_names)},
-    {"image.depth_mm", "imaging depth in millimetres", K_F32, F(image_depth_mm),
-     NUM(10, 300, 40)},
+    {"image.depth_mm", "imaging depth in millimetres", K_F32, F(image_depth_mm), NUM(10, 300, 40)},
     {"image.width_mm", "linear probe: aperture width in millimetres", K_F32, F(image_width_mm),
      NUM(5, 100, 38)},
-    {"image.sector_deg", "curvilinear probe: sector angle in degrees", K_F32,
-     F(image_sector_deg), NUM(10, 150, 60)},
+    {"image.sector_deg", "curvilinear probe: sector angle in degrees", K_F32, F(image_sector_deg),
+     NUM(10, 150, 60)},
     {"image.lines", "scan lines per image", K_U32, F(image_lines),
      NUM(16u, SC_MAX_SCAN_LINES, MIN_U(256u, SC_MAX_SCAN_LINES))},
     {"image.samples", "samples per scan line", K_U32, F(image_samples),
@@ -87,8 +86,7 @@ static const key_def k_keys[] = {
     {"rt.sched_fifo",
      "run the frame loop SCHED_FIFO when permitted (a warning and normal priority otherwise)",
      K_BOOL, F(rt_sched_fifo), TXT(0u, "true", "true | false (also yes/no, on/off, 1/0)")},
-    {"rt.priority", "SCHED_FIFO priority of the frame loop", K_U32, F(rt_priority),
-     NUM(1, 99, 80)},
+    {"rt.priority", "SCHED_FIFO priority of the frame loop", K_U32, F(rt_priority), NUM(1, 99, 80)},
     {"rt.cpu", "CPU the frame loop is pinned to; -1: no pinning", K_I32, F(rt_cpu),
      NUM(-1, 1023, -1)},
     {"rt.mlock", "lock and pre-fault all memory (mlockall)", K_BOOL, F(rt_mlock),
@@ -462,8 +460,7 @@ static int printable(const char *v)
 
 static int host_char(char c)
 {
-    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || is_digit(c) || c == '.' ||
-           c == '-';
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || is_digit(c) || c == '.' || c == '-';
 }
 
 static int ifname_char(char c)

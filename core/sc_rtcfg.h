@@ -6,7 +6,8 @@
  * leading and trailing blanks of key and value are dropped; lines end with LF or CR LF; a line
  * is at most SC_RTCFG_LINE_MAX bytes. Every key has a default (sc_rtcfg_default) and a range;
  * a key may appear once per file. The keys, their defaults, ranges and meaning are in the table
- * this module exports (sc_rtcfg_key_describe) and in the documented default file config/sonocomp.conf.
+ * this module exports (sc_rtcfg_key_describe) and in the documented default file
+ * config/sonocomp.conf.
  *
  * Every bad line is refused with its line number, the key and a reason in words; parsing goes
  * on after an error so that one run reports all of them; the settings of refused lines keep
@@ -26,9 +27,9 @@
 
 /* Network interface names are at most 15 characters (Linux IFNAMSIZ 16 with the NUL). */
 #define SC_RTCFG_IFNAME_MAX 16u
-#define SC_RTCFG_HOST_MAX 64u
+#define SC_RTCFG_HOST_MAX   64u
 #define SC_RTCFG_REASON_MAX 128u
-#define SC_RTCFG_KEY_MAX 32u
+#define SC_RTCFG_KEY_MAX    32u
 
 typedef enum sc_rtcfg_target {
     SC_RTCFG_TARGET_NONE = 0, /* "none": images are computed and discarded */
@@ -43,7 +44,11 @@ typedef enum sc_rtcfg_geometry {
     SC_RTCFG_GEOMETRY_LINEAR = 0,
     SC_RTCFG_GEOMETRY_CURVILINEAR = 1
 } sc_rtcfg_geometry;
-typedef enum sc_rtcfg_tristate { SC_RTCFG_AUTO = 0, SC_RTCFG_ON = 1, SC_RTCFG_OFF = 2 } sc_rtcfg_tristate;
+typedef enum sc_rtcfg_tristate {
+    SC_RTCFG_AUTO = 0,
+    SC_RTCFG_ON = 1,
+    SC_RTCFG_OFF = 2
+} sc_rtcfg_tristate;
 
 typedef struct sc_rtcfg {
     char can_interface[SC_RTCFG_IFNAME_MAX]; /* can.interface */
@@ -67,10 +72,10 @@ typedef struct sc_rtcfg {
     float image_gain_db;
     float image_tgc_db[SC_BSCAN_TGC_BANDS]; /* shallow to deep bands */
     float image_dynamic_range_db;
-    uint32_t rt_sched_fifo; /* bool */
-    uint32_t rt_priority;   /* SCHED_FIFO priority 1..99 */
-    int32_t rt_cpu;         /* -1: no pinning */
-    uint32_t rt_mlock;      /* bool */
+    uint32_t rt_sched_fifo;                  /* bool */
+    uint32_t rt_priority;                    /* SCHED_FIFO priority 1..99 */
+    int32_t rt_cpu;                          /* -1: no pinning */
+    uint32_t rt_mlock;                       /* bool */
     char watchdog_device[SC_RTCFG_PATH_MAX]; /* "none", "soft" or a device path */
     uint32_t watchdog_timeout_ms;
     uint32_t tracker_timeout_ms;
@@ -80,10 +85,10 @@ typedef struct sc_rtcfg {
 
 /* One refused line. */
 typedef struct sc_rtcfg_error {
-    int err;        /* SC_ERR_CFG_* */
-    uint32_t line;  /* 1-based line number; 0 for sc_rtcfg_set */
-    char key[SC_RTCFG_KEY_MAX];         /* the key as written (truncated), or "" */
-    char reason[SC_RTCFG_REASON_MAX];   /* e.g. "500 is outside 1 .. 240" */
+    int err;                          /* SC_ERR_CFG_* */
+    uint32_t line;                    /* 1-based line number; 0 for sc_rtcfg_set */
+    char key[SC_RTCFG_KEY_MAX];       /* the key as written (truncated), or "" */
+    char reason[SC_RTCFG_REASON_MAX]; /* e.g. "500 is outside 1 .. 240" */
 } sc_rtcfg_error;
 
 /* Description of one key, for --help and the documentation test. The texts are generated

@@ -54,8 +54,8 @@ size_t sc_log_linux_format(char *buf, size_t cap, const sc_log_linux_rec *r)
                      sc_err_name(r->err), (long long)r->a, (long long)r->b);
     } else {
         m = snprintf(buf + n, cap - n, " level=%s event=%s a=%lld b=%lld",
-                     sc_log_linux_level_name(r->level), r->event ? r->event : "?",
-                     (long long)r->a, (long long)r->b);
+                     sc_log_linux_level_name(r->level), r->event ? r->event : "?", (long long)r->a,
+                     (long long)r->b);
     }
     if (m > 0) {
         n += (size_t)m < cap - n ? (size_t)m : cap - n - 1u;
@@ -191,8 +191,7 @@ void sc_log_linux_stop(sc_log_linux *l)
     }
 }
 
-void sc_log_linux_msg(sc_log_linux *l, sc_log_level level, const char *event, const char *fmt,
-                      ...)
+void sc_log_linux_msg(sc_log_linux *l, sc_log_level level, const char *event, const char *fmt, ...)
 {
     if (level < l->min_level) {
         return;

@@ -38,18 +38,18 @@ typedef struct sc_log_linux_rec {
 } sc_log_linux_rec;
 
 typedef struct sc_log_linux {
-    int fd;                  /* 2 unless a test redirects */
+    int fd; /* 2 unless a test redirects */
     sc_log_level min_level;
-    int status_active;       /* a status line is on screen (tty mode) */
-    int status_enabled;      /* draw the status line with '\r' (terminal) */
-    atomic_uint head;        /* next write (producer) */
-    atomic_uint tail;        /* next read (writer thread) */
-    atomic_ullong dropped;   /* ring full */
-    atomic_ullong written;   /* records written out */
+    int status_active;     /* a status line is on screen (tty mode) */
+    int status_enabled;    /* draw the status line with '\r' (terminal) */
+    atomic_uint head;      /* next write (producer) */
+    atomic_uint tail;      /* next read (writer thread) */
+    atomic_ullong dropped; /* ring full */
+    atomic_ullong written; /* records written out */
     atomic_int running;
     pthread_t thread;
     int thread_started;
-    pthread_mutex_t lock;    /* one line at a time on fd */
+    pthread_mutex_t lock;       /* one line at a time on fd */
     pthread_mutex_t drain_lock; /* one consumer of the ring at a time */
     sc_log_linux_rec ring[SC_LOG_LINUX_RING];
 } sc_log_linux;
@@ -61,8 +61,8 @@ sc_log_dev sc_log_linux_dev(sc_log_linux *l);
 /* Drain the ring, stop and join the writer. Idempotent. */
 void sc_log_linux_stop(sc_log_linux *l);
 /* A platform message: `event` plus free-form key=value text (printf format). Written at once. */
-void sc_log_linux_msg(sc_log_linux *l, sc_log_level level, const char *event, const char *fmt,
-                      ...) __attribute__((format(printf, 4, 5)));
+void sc_log_linux_msg(sc_log_linux *l, sc_log_level level, const char *event, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
 /* Draw the status line (terminal mode: '\r', no newline; otherwise it is not drawn). */
 void sc_log_linux_set_status_mode(sc_log_linux *l, int terminal);
 void sc_log_linux_status(sc_log_linux *l, const char *text);

@@ -13,7 +13,7 @@
 #include "sc_png_write.h"
 #include "sc_scanconv.h"
 
-#define STRIDE SC_MAX_SCAN_SAMPLES
+#define STRIDE      SC_MAX_SCAN_SAMPLES
 #define FRAME_BYTES ((size_t)SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES)
 
 struct sc_png_sink {
@@ -21,7 +21,7 @@ struct sc_png_sink {
     uint32_t every_n;
     uint32_t max_frames;
     /* frame loop side */
-    uint8_t *frame;             /* lines being collected */
+    uint8_t *frame; /* lines being collected */
     uint8_t got[SC_MAX_SCAN_LINES];
     uint32_t got_n;
     sc_display_frame_info info;
@@ -29,7 +29,7 @@ struct sc_png_sink {
     /* hand-off */
     pthread_mutex_t lock;
     pthread_cond_t cond;
-    int pending;                /* the writer has a frame to write */
+    int pending; /* the writer has a frame to write */
     int stopping;
     uint8_t *handoff;
     sc_display_frame_info handoff_info;
@@ -38,7 +38,7 @@ struct sc_png_sink {
     uint8_t *raster;
     pthread_t thread;
     int thread_started;
-    sc_png_sink_stats st;       /* under lock */
+    sc_png_sink_stats st; /* under lock */
 };
 
 static void *writer_main(void *arg)
@@ -130,9 +130,9 @@ static int png_frame_end(void *ctx, uint32_t frame_no)
         }
     }
     int rc = 0;
-    const int wanted = (s->every_n <= 1u || frame_no % s->every_n == 0u) &&
-                       (s->max_frames == 0u || s->st.frames_written + (uint64_t)s->pending <
-                                                   s->max_frames);
+    const int wanted =
+        (s->every_n <= 1u || frame_no % s->every_n == 0u) &&
+        (s->max_frames == 0u || s->st.frames_written + (uint64_t)s->pending < s->max_frames);
     if (wanted) {
         if (s->pending) {
             s->st.frames_busy++;
@@ -159,8 +159,7 @@ static int png_link_state(void *ctx, sc_display_link_state *st)
     return 0;
 }
 
-static const sc_display_ops k_png_ops = {png_frame_begin, png_line, png_frame_end,
-                                         png_link_state};
+static const sc_display_ops k_png_ops = {png_frame_begin, png_line, png_frame_end, png_link_state};
 
 int sc_png_sink_open(sc_png_sink **out, const sc_png_sink_def *def)
 {

@@ -10,7 +10,7 @@
 
 typedef struct png_out {
     FILE *f;
-    uint32_t crc;   /* running CRC of the current chunk */
+    uint32_t crc;    /* running CRC of the current chunk */
     uint32_t a1, a2; /* Adler-32 of the zlib stream */
     int err;
 } png_out;
@@ -105,18 +105,17 @@ int sc_png_write(const char *path, uint32_t width, uint32_t height, uint32_t cha
     const uint8_t zhdr[2] = {0x78, 0x01}; /* deflate, 32 KiB window, no dictionary */
     put(&o, zhdr, 2u);
     /* Stream rows into stored blocks of at most 65535 bytes. */
-    uint64_t left = raw;    /* raw bytes still to emit */
-    uint32_t in_block = 0;  /* bytes left in the open block */
+    uint64_t left = raw;   /* raw bytes still to emit */
+    uint32_t in_block = 0; /* bytes left in the open block */
     for (uint32_t y = 0; y < height; y++) {
         const uint8_t *src = pixels + (size_t)y * stride;
-        size_t pos = 0;          /* 0 = the filter byte, then pixel bytes */
+        size_t pos = 0; /* 0 = the filter byte, then pixel bytes */
         const size_t n_row = (size_t)row;
         while (pos < n_row) {
             if (in_block == 0u) {
                 const uint32_t len = left > 65535u ? 65535u : (uint32_t)left;
                 const uint8_t bh[5] = {(uint8_t)(left <= 65535u ? 1u : 0u), (uint8_t)len,
-                                       (uint8_t)(len >> 8), (uint8_t)~len,
-                                       (uint8_t)((~len) >> 8)};
+                                       (uint8_t)(len >> 8), (uint8_t)~len, (uint8_t)((~len) >> 8)};
                 put(&o, bh, 5u);
                 in_block = len;
             }

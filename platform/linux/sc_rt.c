@@ -59,8 +59,11 @@ sc_clock_dev sc_rt_clock_dev(void)
 
 sc_rt_def sc_rt_default_def(void)
 {
-    sc_rt_def d = {.mlock = 1, .prefault_stack_bytes = 256u * 1024u, .sched_fifo = 1,
-                   .priority = 80, .cpu = -1};
+    sc_rt_def d = {.mlock = 1,
+                   .prefault_stack_bytes = 256u * 1024u,
+                   .sched_fifo = 1,
+                   .priority = 80,
+                   .cpu = -1};
     return d;
 }
 

@@ -37,19 +37,19 @@ sc_clock_dev sc_rt_clock_dev(void);
 
 /* ---- process set-up --------------------------------------------------------------------- */
 typedef struct sc_rt_def {
-    int mlock;             /* mlockall + stack pre-fault */
+    int mlock;                   /* mlockall + stack pre-fault */
     size_t prefault_stack_bytes; /* stack touched after mlockall (default 256 KiB) */
-    int sched_fifo;        /* try SCHED_FIFO */
-    int priority;          /* 1..99 */
-    int cpu;               /* -1: no pinning */
+    int sched_fifo;              /* try SCHED_FIFO */
+    int priority;                /* 1..99 */
+    int cpu;                     /* -1: no pinning */
 } sc_rt_def;
 
 typedef struct sc_rt_report {
-    int locked;      /* mlockall succeeded */
+    int locked; /* mlockall succeeded */
     int lock_errno;
-    int fifo;        /* running SCHED_FIFO */
+    int fifo; /* running SCHED_FIFO */
     int fifo_errno;
-    int pinned;      /* pinned to def.cpu */
+    int pinned; /* pinned to def.cpu */
     int pin_errno;
 } sc_rt_report;
 

@@ -12,8 +12,11 @@
 
 sc_udp_display_def sc_udp_display_default_def(void)
 {
-    sc_udp_display_def d = {.host = "127.0.0.1", .port = 5600u, .sndbuf_bytes = 0u,
-                            .inject_drop_permille = 0u, .inject_seed = 0x9E3779B9u};
+    sc_udp_display_def d = {.host = "127.0.0.1",
+                            .port = 5600u,
+                            .sndbuf_bytes = 0u,
+                            .inject_drop_permille = 0u,
+                            .inject_seed = 0x9E3779B9u};
     return d;
 }
 
@@ -170,8 +173,7 @@ static int udp_link_state(void *ctx, sc_display_link_state *st)
     return 0;
 }
 
-static const sc_display_ops k_udp_ops = {udp_frame_begin, udp_line, udp_frame_end,
-                                         udp_link_state};
+static const sc_display_ops k_udp_ops = {udp_frame_begin, udp_line, udp_frame_end, udp_link_state};
 
 sc_display_dev sc_udp_display_dev(sc_udp_display *u)
 {

@@ -26,9 +26,9 @@
 #include "sc_hal_display.h"
 
 typedef struct sc_udp_display_def {
-    const char *host;      /* name or IPv4 address */
+    const char *host; /* name or IPv4 address */
     uint16_t port;
-    uint32_t sndbuf_bytes; /* SO_SNDBUF request; 0: 1 MiB (room for a few whole frames) */
+    uint32_t sndbuf_bytes;         /* SO_SNDBUF request; 0: 1 MiB (room for a few whole frames) */
     uint32_t inject_drop_permille; /* 0..1000 */
     uint32_t inject_seed;          /* non-zero */
 } sc_udp_display_def;
@@ -49,7 +49,7 @@ typedef struct sc_udp_display {
     uint64_t lines_dropped;  /* socket full or error */
     uint64_t lines_injected; /* injected losses */
     uint64_t packets_sent;
-    uint64_t send_errors;    /* sends that failed (any packet type) */
+    uint64_t send_errors;     /* sends that failed (any packet type) */
     uint64_t protocol_errors; /* calls out of order or with bad arguments */
     uint8_t pkt[SC_DLINK_MAX_PACKET];
 } sc_udp_display;

@@ -123,9 +123,8 @@ int main(int argc, char **argv)
             double m2 = mean_sq(&im, atol(argv[a + 3]), atol(argv[a + 4]), r);
             double min = atof(argv[a + 6]);
             int ok = m2 - m1 >= min;
-            printf("contrast (%s,%s) %.1f vs (%s,%s) %.1f: %.1f, at least %.1f: %s\n",
-                   argv[a + 1], argv[a + 2], m1, argv[a + 3], argv[a + 4], m2, m2 - m1, min,
-                   ok ? "ok" : "FAIL");
+            printf("contrast (%s,%s) %.1f vs (%s,%s) %.1f: %.1f, at least %.1f: %s\n", argv[a + 1],
+                   argv[a + 2], m1, argv[a + 3], argv[a + 4], m2, m2 - m1, min, ok ? "ok" : "FAIL");
             fails += !ok;
             a += 7;
         } else if (strcmp(c, "text") == 0 && a + 5 < argc) {
@@ -138,8 +137,8 @@ int main(int argc, char **argv)
                 }
             }
             int ok = n >= need;
-            printf("text box (%ld,%ld)-(%ld,%ld): %ld white pixels, at least %ld: %s\n", x0, y0,
-                   x1, y1, n, need, ok ? "ok" : "FAIL");
+            printf("text box (%ld,%ld)-(%ld,%ld): %ld white pixels, at least %ld: %s\n", x0, y0, x1,
+                   y1, n, need, ok ? "ok" : "FAIL");
             fails += !ok;
             a += 6;
         } else {

@@ -82,12 +82,15 @@ static void wire_bytes_match_the_documented_layout(void **state)
     (void)state;
     uint8_t buf[SC_DLINK_MAX_PACKET];
     uint8_t s[4] = {10, 20, 30, 40};
-    const sc_dlink_frame f = {
-        .frame_no = 0xA1B2C3D4u, .flags = 0x0201u, .line_count = 9u, .samples = 4u, .geometry_id = 0u};
+    const sc_dlink_frame f = {.frame_no = 0xA1B2C3D4u,
+                              .flags = 0x0201u,
+                              .line_count = 9u,
+                              .samples = 4u,
+                              .geometry_id = 0u};
     int n = sc_dlink_encode_line(buf, sizeof buf, &f, 5u, s, 4u);
     assert_int_equal(n, 32);
     const uint8_t expect[24] = {'S', 'C', 'D', 'L', 1, 2, 0x01, 0x02, 0xD4, 0xC3, 0xB2, 0xA1,
-                                5, 0, 9, 0, 4, 0, 0, 0, 4, 0, 0, 0};
+                                5,   0,   9,   0,   4, 0, 0,    0,    4,    0,    0,    0};
     assert_memory_equal(buf, expect, 24u);
     assert_memory_equal(buf + 28, s, 4u);
     uint32_t crc = sc_crc32_final(sc_crc32_update(sc_crc32_update(SC_CRC32_INIT, buf, 24u), s, 4u));
@@ -168,15 +171,16 @@ static void valid_crc_with_bad_type_or_fields_is_still_rejected(void **state)
         uint8_t value;
         int err;
     } cases[] = {
-        {5u, 0u, SC_ERR_DLINK_TYPE},    {5u, 4u, SC_ERR_DLINK_TYPE},
+        {5u, 0u, SC_ERR_DLINK_TYPE},
+        {5u, 4u, SC_ERR_DLINK_TYPE},
         {5u, 0xFFu, SC_ERR_DLINK_TYPE},
-        {5u, 1u, SC_ERR_DLINK_LENGTH},  /* a line's payload is not a FRAME_BEGIN payload */
-        {12u, 128u, SC_ERR_DLINK_FIELD}, /* line index == line count */
-        {13u, 1u, SC_ERR_DLINK_FIELD},   /* line index 259 */
-        {14u, 0u, SC_ERR_DLINK_FIELD},   /* line count 0 (index 3 too) */
+        {5u, 1u, SC_ERR_DLINK_LENGTH},    /* a line's payload is not a FRAME_BEGIN payload */
+        {12u, 128u, SC_ERR_DLINK_FIELD},  /* line index == line count */
+        {13u, 1u, SC_ERR_DLINK_FIELD},    /* line index 259 */
+        {14u, 0u, SC_ERR_DLINK_FIELD},    /* line count 0 (index 3 too) */
         {15u, 0x7Fu, SC_ERR_DLINK_FIELD}, /* line count above the limit */
-        {18u, 2u, SC_ERR_DLINK_FIELD},   /* geometry 2 */
-        {22u, 1u, SC_ERR_DLINK_FIELD},   /* reserved not zero */
+        {18u, 2u, SC_ERR_DLINK_FIELD},    /* geometry 2 */
+        {22u, 1u, SC_ERR_DLINK_FIELD},    /* reserved not zero */
         {23u, 0x80u, SC_ERR_DLINK_FIELD},
     };
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {

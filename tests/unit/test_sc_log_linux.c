@@ -13,8 +13,11 @@
 static void a_record_formats_as_one_logfmt_line(void **state)
 {
     (void)state;
-    const sc_log_linux_rec r = {.wall_ns = INT64_C(1700000000123456789), .level = SC_LOG_WARN,
-                                .event = "tracker_timeout", .err = SC_ERR_TIMEOUT, .a = -3,
+    const sc_log_linux_rec r = {.wall_ns = INT64_C(1700000000123456789),
+                                .level = SC_LOG_WARN,
+                                .event = "tracker_timeout",
+                                .err = SC_ERR_TIMEOUT,
+                                .a = -3,
                                 .b = 42};
     char buf[256];
     size_t n = sc_log_linux_format(buf, sizeof buf, &r);

@@ -107,9 +107,9 @@ static void frames_while_the_writer_is_busy_are_skipped_not_waited_for(void **st
 static void protocol_violations_are_refused(void **state)
 {
     (void)state;
-    assert_int_equal(sc_png_sink_open(&(sc_png_sink *){NULL},
-                                      &(sc_png_sink_def){.dir = "/nonexistent-dir"}),
-                     SC_ERR_NOT_FOUND);
+    assert_int_equal(
+        sc_png_sink_open(&(sc_png_sink *){NULL}, &(sc_png_sink_def){.dir = "/nonexistent-dir"}),
+        SC_ERR_NOT_FOUND);
     sc_png_sink *s = NULL;
     assert_int_equal(sc_png_sink_open(&s, &(sc_png_sink_def){.dir = "/tmp", .max_frames = 1u}), 0);
     sc_display_dev d = sc_png_sink_dev(s);

@@ -290,14 +290,14 @@ static void every_class_of_bad_value_is_refused_with_a_reason(void **state)
         memset(&e, 0, sizeof e);
         int rc = sc_rtcfg_set(&c, cases[i].key, cases[i].value, &e);
         if (rc != cases[i].err) {
-            print_error("%s = \"%s\": got %s (%s)\n", cases[i].key, cases[i].value,
-                        sc_err_name(rc), e.reason);
+            print_error("%s = \"%s\": got %s (%s)\n", cases[i].key, cases[i].value, sc_err_name(rc),
+                        e.reason);
         }
         assert_int_equal(rc, cases[i].err);
         assert_int_equal(e.err, cases[i].err);
         assert_string_equal(e.key, cases[i].key);
-        assert_true(strlen(e.reason) > 5u);           /* a reason in words */
-        assert_memory_equal(&c, &def, sizeof c);      /* nothing changed */
+        assert_true(strlen(e.reason) > 5u);      /* a reason in words */
+        assert_memory_equal(&c, &def, sizeof c); /* nothing changed */
     }
     /* the reason names the value and the range */
     sc_rtcfg c = def;
@@ -320,19 +320,19 @@ static void every_class_of_bad_value_is_refused_with_a_reason(void **state)
 static void syntax_errors_report_their_line_numbers_and_parsing_goes_on(void **state)
 {
     (void)state;
-    const char *text = "# comment\n"                   /* 1 */
-                       "\n"                            /* 2 */
-                       "frame_rate_hz = 30\n"          /* 3 ok */
-                       "this line has no equals\n"     /* 4 syntax */
-                       " = 5\n"                        /* 5 syntax: no key */
-                       "image.depht_mm = 50\n"         /* 6 unknown key */
-                       "frame_rate_hz = 50\n"          /* 7 duplicate of line 3 */
-                       "image.lines =\n"               /* 8 empty value */
-                       "image.samples = 1\x01\n"       /* 9 control character */
-                       "image.depth_mm = 500\n"        /* 10 range */
+    const char *text = "# comment\n"                             /* 1 */
+                       "\n"                                      /* 2 */
+                       "frame_rate_hz = 30\n"                    /* 3 ok */
+                       "this line has no equals\n"               /* 4 syntax */
+                       " = 5\n"                                  /* 5 syntax: no key */
+                       "image.depht_mm = 50\n"                   /* 6 unknown key */
+                       "frame_rate_hz = 50\n"                    /* 7 duplicate of line 3 */
+                       "image.lines =\n"                         /* 8 empty value */
+                       "image.samples = 1\x01\n"                 /* 9 control character */
+                       "image.depth_mm = 500\n"                  /* 10 range */
                        "   image.gain_db   =   6   # six dB\r\n" /* 11 ok, CRLF, comment */
                        "display.target = png:/tmp/a#b\n"         /* 12 ok: '#' inside value */
-                       "rt.cpu = 0";                              /* 13 ok, no final newline */
+                       "rt.cpu = 0";                             /* 13 ok, no final newline */
     sc_rtcfg c;
     sc_rtcfg_default(&c);
     sc_rtcfg_error errs[16];
@@ -343,8 +343,8 @@ static void syntax_errors_report_their_line_numbers_and_parsing_goes_on(void **s
     const struct {
         uint32_t line;
         int err;
-    } expect[] = {{4, SC_ERR_CFG_SYNTAX}, {5, SC_ERR_CFG_SYNTAX},     {6, SC_ERR_CFG_KEY},
-                  {7, SC_ERR_CFG_DUPLICATE}, {8, SC_ERR_CFG_VALUE}, {9, SC_ERR_CFG_SYNTAX},
+    } expect[] = {{4, SC_ERR_CFG_SYNTAX},    {5, SC_ERR_CFG_SYNTAX}, {6, SC_ERR_CFG_KEY},
+                  {7, SC_ERR_CFG_DUPLICATE}, {8, SC_ERR_CFG_VALUE},  {9, SC_ERR_CFG_SYNTAX},
                   {10, SC_ERR_CFG_RANGE}};
     for (uint32_t i = 0; i < 7u; i++) {
         assert_int_equal(errs[i].line, expect[i].line);

@@ -163,7 +163,7 @@ static void written_frames_decode_back_exactly(void **state)
                 assert_int_equal(get8(&r), 4);
                 r.pos += 1;
                 assert_int_equal(get16(&r), 5 + frame); /* delay, 1/100 s */
-                r.pos += 1;                               /* transparent index */
+                r.pos += 1;                             /* transparent index */
             } else {
                 assert_int_equal(label, 0xFF); /* application extension: NETSCAPE2.0 loop */
                 const uint8_t bs = get8(&r);

@@ -72,12 +72,16 @@ int main(int argc, char **argv)
     unsigned long long frames = 300u;
     double rate = 60.0;
     int curvilinear = 0;
-    static const struct option lo[] = {
-        {"target", required_argument, NULL, 'T'},  {"frames", required_argument, NULL, 'n'},
-        {"rate", required_argument, NULL, 'r'},    {"lines", required_argument, NULL, 'l'},
-        {"samples", required_argument, NULL, 's'}, {"geometry", required_argument, NULL, 'g'},
-        {"drop-permille", required_argument, NULL, 'd'}, {"seed", required_argument, NULL, 'S'},
-        {"help", no_argument, NULL, 'h'},          {NULL, 0, NULL, 0}};
+    static const struct option lo[] = {{"target", required_argument, NULL, 'T'},
+                                       {"frames", required_argument, NULL, 'n'},
+                                       {"rate", required_argument, NULL, 'r'},
+                                       {"lines", required_argument, NULL, 'l'},
+                                       {"samples", required_argument, NULL, 's'},
+                                       {"geometry", required_argument, NULL, 'g'},
+                                       {"drop-permille", required_argument, NULL, 'd'},
+                                       {"seed", required_argument, NULL, 'S'},
+                                       {"help", no_argument, NULL, 'h'},
+                                       {NULL, 0, NULL, 0}};
     int c;
     while ((c = getopt_long(argc, argv, "T:n:r:l:s:g:d:S:h", lo, NULL)) != -1) {
         int ok = 1;
@@ -154,10 +158,14 @@ int main(int argc, char **argv)
         const double t = (double)f / rate;
         const float comp = (float)(0.5 - 0.5 * cos(t * M_PI));
         sc_udp_display_set_compression(&u, (uint16_t)(comp * 1000.0f + 0.5f));
-        const sc_display_frame_info info = {
-            (uint32_t)f,          (uint16_t)lines, (uint16_t)samples, (uint16_t)curvilinear,
-            (uint16_t)(comp > 0.05f ? 1u : 0u),    curvilinear ? 80.0f : 40.0f,
-            curvilinear ? 60.0f : 38.0f,           curvilinear ? 40.0f : 0.0f};
+        const sc_display_frame_info info = {(uint32_t)f,
+                                            (uint16_t)lines,
+                                            (uint16_t)samples,
+                                            (uint16_t)curvilinear,
+                                            (uint16_t)(comp > 0.05f ? 1u : 0u),
+                                            curvilinear ? 80.0f : 40.0f,
+                                            curvilinear ? 60.0f : 38.0f,
+                                            curvilinear ? 40.0f : 0.0f};
         sc_display_frame_begin(&dev, &info);
         for (unsigned l = 0; l < lines; l++) {
             make_line(buf, (uint32_t)f, l, lines, samples, comp);

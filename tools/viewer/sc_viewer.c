@@ -42,16 +42,16 @@
 #include "vw_gif.h"
 #include "vw_overlay.h"
 
-#define VW_QUEUE 4u
+#define VW_QUEUE   4u
 #define VW_VERSION "1.0"
 
 typedef struct vw_opts {
     const char *bind_addr;
     uint16_t port;
     int headless;
-    uint64_t frames;   /* 0: no limit */
-    double seconds;    /* 0: no limit */
-    double idle_s;     /* 0: no limit; counted from the first packet */
+    uint64_t frames; /* 0: no limit */
+    double seconds;  /* 0: no limit */
+    double idle_s;   /* 0: no limit; counted from the first packet */
     const char *png_dir;
     uint32_t png_every;
     const char *gif_path;
@@ -74,8 +74,8 @@ typedef struct vw_shared {
     vw_slot slots[VW_QUEUE];
     uint32_t q_head, q_tail; /* q_head - q_tail frames waiting */
     uint64_t frames_not_shown;
-    uint64_t frames_target;  /* 0: none; the receiver stops taking packets once reached */
-    double first_packet_s;   /* 0 until the first datagram */
+    uint64_t frames_target; /* 0: none; the receiver stops taking packets once reached */
+    double first_packet_s;  /* 0 until the first datagram */
     double last_packet_s;
     atomic_int stop_rx;
     int fd;
@@ -221,10 +221,9 @@ static void render_free(vw_render *r)
 
 static void render_frame(vw_render *r, const sc_dlink_done *d, double fps, uint64_t lost_total)
 {
-    const sc_display_frame_info info = {d->frame.frame_no,  d->frame.line_count,
-                                        d->frame.samples,   d->frame.geometry_id,
-                                        d->frame.flags,     d->begin.depth_mm,
-                                        d->begin.width_mm,  d->begin.radius_mm};
+    const sc_display_frame_info info = {
+        d->frame.frame_no, d->frame.line_count, d->frame.samples,  d->frame.geometry_id,
+        d->frame.flags,    d->begin.depth_mm,   d->begin.width_mm, d->begin.radius_mm};
     sc_scanconv_render(&r->conv, &info, d->image, SC_MAX_SCAN_SAMPLES, r->grey);
     const size_t n = (size_t)r->w * r->h;
     for (size_t i = 0; i < n; i++) {
@@ -243,7 +242,8 @@ static void render_frame(vw_render *r, const sc_dlink_done *d, double fps, uint6
     x = vw_text(r->index, r->w, r->h, 4, 2 + lh, sc, contact ? VW_COL_OK : VW_COL_BAD,
                 contact ? "CONTACT" : "NO CONTACT");
     if (d->begin.compression_pm <= 1000u) {
-        snprintf(t, sizeof t, "  VEIN COMPRESSION %u%%", (unsigned)(d->begin.compression_pm + 5u) / 10u);
+        snprintf(t, sizeof t, "  VEIN COMPRESSION %u%%",
+                 (unsigned)(d->begin.compression_pm + 5u) / 10u);
     } else {
         snprintf(t, sizeof t, "  VEIN COMPRESSION --");
     }
@@ -265,27 +265,26 @@ static void render_frame(vw_render *r, const sc_dlink_done *d, double fps, uint6
 
 static void usage(FILE *f)
 {
-    fprintf(f,
-            "usage: sc-viewer [options]\n"
-            "Receive the sonocomp display link (docs/display-link.md), show and record it.\n\n"
-            "  -p, --port N          UDP port (default 5600)\n"
-            "  -b, --bind ADDR       local address (default 0.0.0.0)\n"
-            "      --headless        no window (tests, recording on a server)\n"
-            "  -n, --frames N        exit after N closed frames\n"
-            "  -t, --seconds S       exit after S seconds\n"
-            "      --idle S          exit S seconds after the last packet (once one arrived)\n"
-            "      --record-png DIR  write frames as DIR/view_<frame>.png (DIR must exist)\n"
-            "      --png-every N     record every N-th shown frame (default 1)\n"
-            "      --gif FILE        record an animated GIF of the session\n"
-            "      --gif-every N     every N-th shown frame goes into the GIF (default 2)\n"
-            "      --screenshot FILE PNG of the window content at exit\n"
-            "      --size WxH        raster / window size (default 640x640)\n"
-            "      --hold S          keep the window open S seconds after the end\n"
-            "  -q, --quiet           no per-second status on stderr\n"
-            "  -h, --help            this help\n"
-            "  -V, --version         version\n\n"
-            "At exit prints one line of key=value statistics on stdout.\n"
-            "Exit status: 0 ok, 1 runtime error, 2 usage error.\n");
+    fprintf(f, "usage: sc-viewer [options]\n"
+               "Receive the sonocomp display link (docs/display-link.md), show and record it.\n\n"
+               "  -p, --port N          UDP port (default 5600)\n"
+               "  -b, --bind ADDR       local address (default 0.0.0.0)\n"
+               "      --headless        no window (tests, recording on a server)\n"
+               "  -n, --frames N        exit after N closed frames\n"
+               "  -t, --seconds S       exit after S seconds\n"
+               "      --idle S          exit S seconds after the last packet (once one arrived)\n"
+               "      --record-png DIR  write frames as DIR/view_<frame>.png (DIR must exist)\n"
+               "      --png-every N     record every N-th shown frame (default 1)\n"
+               "      --gif FILE        record an animated GIF of the session\n"
+               "      --gif-every N     every N-th shown frame goes into the GIF (default 2)\n"
+               "      --screenshot FILE PNG of the window content at exit\n"
+               "      --size WxH        raster / window size (default 640x640)\n"
+               "      --hold S          keep the window open S seconds after the end\n"
+               "  -q, --quiet           no per-second status on stderr\n"
+               "  -h, --help            this help\n"
+               "  -V, --version         version\n\n"
+               "At exit prints one line of key=value statistics on stdout.\n"
+               "Exit status: 0 ok, 1 runtime error, 2 usage error.\n");
 }
 
 static int parse_u64(const char *s, uint64_t *out)
@@ -314,23 +313,40 @@ static int parse_double(const char *s, double *out)
 
 int main(int argc, char **argv)
 {
-    vw_opts o = {.bind_addr = "0.0.0.0", .port = 5600u, .png_every = 1u, .gif_every = 2u,
-                 .width = 640u, .height = 640u};
-    enum { OPT_HEADLESS = 1000, OPT_IDLE, OPT_PNG, OPT_PNG_EVERY, OPT_GIF, OPT_GIF_EVERY,
-           OPT_SHOT, OPT_SIZE, OPT_HOLD };
-    static const struct option lo[] = {
-        {"port", required_argument, NULL, 'p'},      {"bind", required_argument, NULL, 'b'},
-        {"headless", no_argument, NULL, OPT_HEADLESS}, {"frames", required_argument, NULL, 'n'},
-        {"seconds", required_argument, NULL, 't'},   {"idle", required_argument, NULL, OPT_IDLE},
-        {"record-png", required_argument, NULL, OPT_PNG},
-        {"png-every", required_argument, NULL, OPT_PNG_EVERY},
-        {"gif", required_argument, NULL, OPT_GIF},
-        {"gif-every", required_argument, NULL, OPT_GIF_EVERY},
-        {"screenshot", required_argument, NULL, OPT_SHOT},
-        {"size", required_argument, NULL, OPT_SIZE}, {"quiet", no_argument, NULL, 'q'},
-        {"hold", required_argument, NULL, OPT_HOLD},
-        {"help", no_argument, NULL, 'h'},            {"version", no_argument, NULL, 'V'},
-        {NULL, 0, NULL, 0}};
+    vw_opts o = {.bind_addr = "0.0.0.0",
+                 .port = 5600u,
+                 .png_every = 1u,
+                 .gif_every = 2u,
+                 .width = 640u,
+                 .height = 640u};
+    enum {
+        OPT_HEADLESS = 1000,
+        OPT_IDLE,
+        OPT_PNG,
+        OPT_PNG_EVERY,
+        OPT_GIF,
+        OPT_GIF_EVERY,
+        OPT_SHOT,
+        OPT_SIZE,
+        OPT_HOLD
+    };
+    static const struct option lo[] = {{"port", required_argument, NULL, 'p'},
+                                       {"bind", required_argument, NULL, 'b'},
+                                       {"headless", no_argument, NULL, OPT_HEADLESS},
+                                       {"frames", required_argument, NULL, 'n'},
+                                       {"seconds", required_argument, NULL, 't'},
+                                       {"idle", required_argument, NULL, OPT_IDLE},
+                                       {"record-png", required_argument, NULL, OPT_PNG},
+                                       {"png-every", required_argument, NULL, OPT_PNG_EVERY},
+                                       {"gif", required_argument, NULL, OPT_GIF},
+                                       {"gif-every", required_argument, NULL, OPT_GIF_EVERY},
+                                       {"screenshot", required_argument, NULL, OPT_SHOT},
+                                       {"size", required_argument, NULL, OPT_SIZE},
+                                       {"quiet", no_argument, NULL, 'q'},
+                                       {"hold", required_argument, NULL, OPT_HOLD},
+                                       {"help", no_argument, NULL, 'h'},
+                                       {"version", no_argument, NULL, 'V'},
+                                       {NULL, 0, NULL, 0}};
     int c;
     uint64_t u;
     while ((c = getopt_long(argc, argv, "p:b:n:t:qhV", lo, NULL)) != -1) {
@@ -397,8 +413,8 @@ int main(int argc, char **argv)
         case OPT_SIZE: {
             unsigned w = 0, h = 0;
             char extra;
-            if (sscanf(optarg, "%ux%u%c", &w, &h, &extra) != 2 || w < 64u || h < 64u ||
-                w > 4096u || h > 4096u) {
+            if (sscanf(optarg, "%ux%u%c", &w, &h, &extra) != 2 || w < 64u || h < 64u || w > 4096u ||
+                h > 4096u) {
                 fprintf(stderr, "sc-viewer: --size %s: expected WxH, 64..4096\n", optarg);
                 return 2;
             }
@@ -587,8 +603,8 @@ int main(int argc, char **argv)
             SDL_Event ev;
             while (SDL_PollEvent(&ev)) {
                 if (ev.type == SDL_QUIT ||
-                    (ev.type == SDL_KEYDOWN && (ev.key.keysym.sym == SDLK_ESCAPE ||
-                                                ev.key.keysym.sym == SDLK_q))) {
+                    (ev.type == SDL_KEYDOWN &&
+                     (ev.key.keysym.sym == SDLK_ESCAPE || ev.key.keysym.sym == SDLK_q))) {
                     g_signal = SIGINT;
                 }
             }
@@ -625,8 +641,8 @@ int main(int argc, char **argv)
             uint8_t *buf = malloc((size_t)o.width * o.height * 3u);
             if (buf && SDL_RenderReadPixels(ren, NULL, SDL_PIXELFORMAT_RGB24, buf,
                                             (int)(o.width * 3u)) == 0) {
-                shot_rc = sc_png_write(o.screenshot, o.width, o.height, 3u, buf,
-                                       (size_t)o.width * 3u);
+                shot_rc =
+                    sc_png_write(o.screenshot, o.width, o.height, 3u, buf, (size_t)o.width * 3u);
             }
             free(buf);
         } else

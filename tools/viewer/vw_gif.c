@@ -73,7 +73,7 @@ int vw_gif_open(vw_gif *g, const char *path, uint16_t width, uint16_t height,
     put_bytes(g, lsd, 3);
     put_bytes(g, palette, 768);
     /* NETSCAPE2.0 application extension: loop forever */
-    const uint8_t loop[19] = {0x21, 0xFF, 0x0B, 'N', 'E', 'T', 'S', 'C', 'A', 'P',
+    const uint8_t loop[19] = {0x21, 0xFF, 0x0B, 'N', 'E',  'T',  'S',  'C',  'A', 'P',
                               'E',  '2',  '.',  '0', 0x03, 0x01, 0x00, 0x00, 0x00};
     put_bytes(g, loop, sizeof loop);
     return g->err ? -1 : 0;

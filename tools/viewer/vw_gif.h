@@ -12,7 +12,7 @@ typedef struct vw_gif {
     FILE *f;
     uint16_t width, height;
     uint32_t frames;
-    uint16_t *dict; /* 4096 x 256 trie: child code of (code, byte), 0 = none */
+    uint16_t *dict;      /* 4096 x 256 trie: child code of (code, byte), 0 = none */
     uint32_t used[4096]; /* dict slots set since the last clear (cleared one by one) */
     uint32_t used_n;
     /* bit packer */

@@ -30,9 +30,12 @@ static const struct {
     char c;
     uint8_t rows[7];
 } k_punct[] = {
-    {'.', {0, 0, 0, 0, 0, 0x0C, 0x0C}},       {'%', {0x18, 0x19, 0x02, 0x04, 0x08, 0x13, 0x03}},
-    {':', {0, 0x0C, 0x0C, 0, 0x0C, 0x0C, 0}}, {'/', {0, 0x01, 0x02, 0x04, 0x08, 0x10, 0}},
-    {'-', {0, 0, 0, 0x1F, 0, 0, 0}},          {'=', {0, 0, 0x1F, 0, 0x1F, 0, 0}},
+    {'.', {0, 0, 0, 0, 0, 0x0C, 0x0C}},
+    {'%', {0x18, 0x19, 0x02, 0x04, 0x08, 0x13, 0x03}},
+    {':', {0, 0x0C, 0x0C, 0, 0x0C, 0x0C, 0}},
+    {'/', {0, 0x01, 0x02, 0x04, 0x08, 0x10, 0}},
+    {'-', {0, 0, 0, 0x1F, 0, 0, 0}},
+    {'=', {0, 0, 0x1F, 0, 0x1F, 0, 0}},
     {'(', {0x02, 0x04, 0x08, 0x08, 0x08, 0x04, 0x02}},
     {')', {0x08, 0x04, 0x02, 0x02, 0x02, 0x04, 0x08}},
 };
@@ -60,7 +63,8 @@ void vw_palette(uint8_t rgb[768])
 {
     memset(rgb, 0, 768);
     for (uint32_t i = 0; i < VW_GREY_LEVELS; i++) {
-        const uint8_t v = (uint8_t)((i * 255u + (VW_GREY_LEVELS - 1u) / 2u) / (VW_GREY_LEVELS - 1u));
+        const uint8_t v =
+            (uint8_t)((i * 255u + (VW_GREY_LEVELS - 1u) / 2u) / (VW_GREY_LEVELS - 1u));
         rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = v;
     }
     const uint8_t extra[][3] = {{16, 16, 24},  {255, 255, 255}, {40, 220, 60},
@@ -70,8 +74,7 @@ void vw_palette(uint8_t rgb[768])
     }
 }
 
-void vw_fill_rect(uint8_t *img, uint32_t w, uint32_t h, int x, int y, int rw, int rh,
-                  uint8_t col)
+void vw_fill_rect(uint8_t *img, uint32_t w, uint32_t h, int x, int y, int rw, int rh, uint8_t col)
 {
     for (int j = y; j < y + rh; j++) {
         if (j < 0 || (uint32_t)j >= h) {

@@ -11,11 +11,11 @@
 /* Palette indices: 0..VW_GREY_LEVELS-1 are a grey ramp, the rest overlay colours. */
 #define VW_GREY_LEVELS 248u
 enum {
-    VW_COL_BAND = 248,  /* dark band behind text */
-    VW_COL_TEXT = 249,  /* white */
-    VW_COL_OK = 250,    /* green */
-    VW_COL_BAD = 251,   /* red */
-    VW_COL_WARN = 252,  /* yellow */
+    VW_COL_BAND = 248,   /* dark band behind text */
+    VW_COL_TEXT = 249,   /* white */
+    VW_COL_OK = 250,     /* green */
+    VW_COL_BAD = 251,    /* red */
+    VW_COL_WARN = 252,   /* yellow */
     VW_COL_VESSEL = 253, /* cyan */
 };
 
@@ -26,8 +26,7 @@ static inline uint8_t vw_grey_index(uint8_t v)
     return (uint8_t)((v * (VW_GREY_LEVELS - 1u) + 127u) / 255u);
 }
 
-void vw_fill_rect(uint8_t *img, uint32_t w, uint32_t h, int x, int y, int rw, int rh,
-                  uint8_t col);
+void vw_fill_rect(uint8_t *img, uint32_t w, uint32_t h, int x, int y, int rw, int rh, uint8_t col);
 /* Text at (x, y), glyph cell 6x8 times scale. Unknown characters draw as blanks. Returns the
  * x after the text. */
 int vw_text(uint8_t *img, uint32_t w, uint32_t h, int x, int y, int scale, uint8_t col,
