@@ -191,7 +191,8 @@ static void *soft_wdg_main(void *arg)
         }
         const uint64_t now = sc_rt_now_ns();
         const uint64_t last = atomic_load(&w->last_kick_ns);
-        if (now > last && now - last > (uint64_t)tmo * 1000000u) {
+        const uint64_t limit_ns = (uint64_t)tmo * 1000000u * (atomic_load(&w->kicked) ? 1u : 10u);
+        if (now > last && now - last > limit_ns) {
             atomic_fetch_add(&w->expiries, 1u);
             if (w->abort_on_expiry) {
                 char msg[160];
@@ -218,6 +219,7 @@ static int soft_wdg_start(void *ctx, uint32_t timeout_ms)
         return SC_ERR_RANGE;
     }
     atomic_store(&w->timeout_ms, timeout_ms);
+    atomic_store(&w->kicked, 0);
     atomic_store(&w->last_kick_ns, sc_rt_now_ns());
     if (w->thread_started) {
         return 0;
@@ -235,6 +237,7 @@ static int soft_wdg_kick(void *ctx)
 {
     sc_soft_watchdog *w = ctx;
     atomic_store(&w->last_kick_ns, sc_rt_now_ns());
+    atomic_store(&w->kicked, 1);
     return 0;
 }
 
@@ -247,6 +250,7 @@ void sc_soft_watchdog_init(sc_soft_watchdog *w, int abort_on_expiry)
     atomic_init(&w->timeout_ms, 1000u);
     atomic_init(&w->running, 0);
     atomic_init(&w->expiries, 0u);
+    atomic_init(&w->kicked, 0);
     w->abort_on_expiry = abort_on_expiry;
 }
 

@@ -14,7 +14,9 @@
  * - Watchdogs (sc_watchdog_dev, hal/sc_hal_watchdog.h): the kernel watchdog device
  *   (/dev/watchdog: WDIOC_SETTIMEOUT, WDIOC_KEEPALIVE, magic close 'V' on a clean stop), and a
  *   software watchdog for hosts: a thread that checks the last kick and, on expiry, reports
- *   and aborts the process (or only counts, for tests).
+ *   and aborts the process (or only counts, for tests). Between start and the first kick it
+ *   allows 10 timeouts (the engine arms it at init, then loads its case before the first
+ *   frame); the kernel device has no such grace: there the case load must fit the timeout.
  *
  * Allocation: none after set-up. Threads: the clock is reentrant; the soft watchdog owns one
  * thread; kick is wait-free.
@@ -76,6 +78,7 @@ typedef struct sc_soft_watchdog {
     atomic_uint timeout_ms;
     atomic_int running;
     atomic_uint expiries;
+    atomic_int kicked; /* fed at least once since start */
     int abort_on_expiry;
     int thread_started;
     pthread_t thread;
