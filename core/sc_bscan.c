@@ -121,6 +121,10 @@ int sc_bscan_init(sc_bscan *b, const sc_bscan_def *def)
     b->mesh_tets = 0u;
     b->seg_count = 0u;
     b->ptet_count = 0u;
+    b->epoch = 1u;
+    for (uint32_t i = 0; i < SC_BSCAN_TET_CACHE; i++) {
+        b->tcache[i].epoch = 0u;
+    }
     memset(&b->status, 0, sizeof b->status);
     return sc_bscan_set_def(b, def);
 }
@@ -420,6 +424,41 @@ static int32_t locate_brute(const sc_bscan *b, const sc_mesh *m, float x, float 
     return best;
 }
 
+/* The plane-affine maps of tet t for this frame, from a direct-mapped cache (adjacent scan
+ * lines cross the same tets). Hit or miss, the values are the same: computed by one function
+ * from the same inputs. */
+static const sc_bscan_tcache *tet_cached(sc_bscan *b, const sc_mesh *m, uint32_t t)
+{
+    sc_bscan_tcache *tc = &b->tcache[t & (SC_BSCAN_TET_CACHE - 1u)];
+    if (tc->epoch == b->epoch && tc->tet == t) {
+        return tc;
+    }
+    tc->epoch = b->epoch;
+    tc->tet = t;
+    const uint32_t *tv = m->tet[t];
+    float al[4], g[4][3];
+    tc->ok = (uint32_t)tet_affine(b, tv, al, g);
+    if (!tc->ok) {
+        return tc;
+    }
+    for (uint32_t i = 0; i < 4u; i++) {
+        tc->lam[i][0] = al[i];
+        tc->lam[i][1] = g[i][0];
+        tc->lam[i][2] = g[i][2];
+    }
+    for (uint32_t j = 0; j < 3u; j++) {
+        tc->rest[0][j] = 0.0f;
+        tc->rest[1][j] = 0.0f;
+        tc->rest[2][j] = 0.0f;
+        for (uint32_t i = 0; i < 4u; i++) {
+            tc->rest[0][j] += tc->lam[i][j] * m->rest_x[tv[i]];
+            tc->rest[1][j] += tc->lam[i][j] * m->rest_y[tv[i]];
+            tc->rest[2][j] += tc->lam[i][j] * m->rest_z[tv[i]];
+        }
+    }
+    return tc;
+}
+
 /* Walk the current line from tet t, entered through local face f_in (4: none) at line
  * parameter s_in, writing the rest positions of the samples from *k on. Returns the parameter
  * where the walk left the mesh (or >= n when it reached the end of the line). */
@@ -433,30 +472,28 @@ static float walk(sc_bscan *b, const sc_mesh *m, const frame_ctx *c, uint32_t t,
             return (float)n; /* the rest of the line stays rigid */
         }
         (*steps)++;
-        const uint32_t *tv = m->tet[t];
-        float al[4], g[4][3];
-        if (!tet_affine(b, tv, al, g)) {
-            return s_in; /* flat tet: leave the mesh here (counted as exit) */
+        const sc_bscan_tcache *tc = tet_cached(b, m, t);
+        if (!tc->ok) {
+            return s_in; /* flat tet: leave the mesh here */
         }
         float a[4], be[4];
         for (uint32_t i = 0; i < 4u; i++) {
-            a[i] = al[i] + g[i][0] * c->ox + g[i][2] * c->oz;
-            be[i] = g[i][0] * c->dx + g[i][2] * c->dz;
+            a[i] = tc->lam[i][0] + tc->lam[i][1] * c->ox + tc->lam[i][2] * c->oz;
+            be[i] = tc->lam[i][1] * c->dx + tc->lam[i][2] * c->dz;
         }
-        float s_out = INFINITY;
+        /* exit: the face whose coordinate reaches 0 first, s_i = -a_i / be_i over be_i < 0;
+         * compared by cross-multiplication (be_i be_j > 0), one division at the end */
         uint32_t f_out = 4u;
         for (uint32_t i = 0; i < 4u; i++) {
-            if (i != f_in && be[i] < 0.0f) {
-                const float si = -a[i] / be[i];
-                if (si < s_out) {
-                    s_out = si;
-                    f_out = i;
-                }
+            if (i != f_in && be[i] < 0.0f &&
+                (f_out == 4u || a[i] * be[f_out] > a[f_out] * be[i])) {
+                f_out = i;
             }
         }
         if (f_out == 4u) {
             return s_in; /* no way out along the ray: degenerate, leave */
         }
+        float s_out = -a[f_out] / be[f_out];
         if (s_out < s_in) {
             s_out = s_in;
         }
@@ -467,21 +504,12 @@ static float walk(sc_bscan *b, const sc_mesh *m, const frame_ctx *c, uint32_t t,
         const uint32_t k1 = first_k(s_out, n);
         if (k1 > k0) {
             /* rest position along the ray inside this tet: A + s B (mm), then voxel units */
-            float ra[3] = {0.0f, 0.0f, 0.0f}, rb[3] = {0.0f, 0.0f, 0.0f};
-            for (uint32_t i = 0; i < 4u; i++) {
-                const uint32_t nd = tv[i];
-                ra[0] += a[i] * m->rest_x[nd];
-                ra[1] += a[i] * m->rest_y[nd];
-                ra[2] += a[i] * m->rest_z[nd];
-                rb[0] += be[i] * m->rest_x[nd];
-                rb[1] += be[i] * m->rest_y[nd];
-                rb[2] += be[i] * m->rest_z[nd];
-            }
-            float va[3], vb[3];
-            to_vox(c, ra, va);
+            float ra[3], vb[3], va[3];
             for (uint32_t d = 0; d < 3u; d++) {
-                vb[d] = rb[d] * c->inv_sp[d];
+                ra[d] = tc->rest[d][0] + tc->rest[d][1] * c->ox + tc->rest[d][2] * c->oz;
+                vb[d] = (tc->rest[d][1] * c->dx + tc->rest[d][2] * c->dz) * c->inv_sp[d];
             }
+            to_vox(c, ra, va);
             emit_run(b, k0, k1, va, vb);
             *k = k1;
         }
@@ -864,6 +892,15 @@ static void count_labels(const uint8_t *lab, uint32_t n, uint32_t *cnt, uint32_t
     while (k0 < n) {
         const uint8_t l = lab[k0];
         uint32_t k1 = k0 + 1u;
+        const uint64_t pat = (uint64_t)l * UINT64_C(0x0101010101010101);
+        while (k1 + 8u <= n) { /* 8 labels at a time */
+            uint64_t w;
+            memcpy(&w, lab + k1, sizeof w);
+            if (w != pat) {
+                break;
+            }
+            k1 += 8u;
+        }
         while (k1 < n && lab[k1] == l) {
             k1++;
         }
@@ -879,7 +916,7 @@ typedef struct vol_ctx {
     const uint8_t *vox, *lab;
     float hi[3];        /* dim - 1/2: the volume's extent in voxel units is [-1/2, hi) */
     int64_t xmax[3];    /* largest 32.32 position kept: just below the last voxel centre */
-    size_t step[3];     /* to the +1 neighbour (0 on a single-voxel axis) */
+    uint32_t sy32, sz32; /* strides of y and z (a volume has < 2^32 voxels) */
     size_t stride[3];   /* 1, dim0, dim0 * dim1 */
     int64_t la;         /* display gain lut_a in 16.16 */
 } vol_ctx;
@@ -888,14 +925,10 @@ typedef struct vol_ctx {
  * rounding drifts by less than 1e-7 voxel over a line. */
 #define SC_FX_ONE 4294967296.0f
 
+/* v * 2^32 is exact in float (a power of two) and |v| < 2^31 here: the conversion keeps
+ * every bit of v (truncation only below 2^-32). */
 static int64_t to_fx32(float v)
 {
-    return (int64_t)floorf(v * 65536.0f + 0.5f) * 65536; /* float has 24 bits: no loss */
-}
-
-static int64_t step_fx32(float v)
-{
-    /* the step keeps every bit float has (v * 2^32 is exact in float) */
     return (int64_t)(v * SC_FX_ONE);
 }
 
@@ -906,8 +939,25 @@ static int64_t step_fx32(float v)
 #define SC_W_ONE (1 << SC_W_BITS)
 #define SC_W_HALF ((int64_t)1 << (31 - SC_W_BITS)) /* half a weight step in 32.32 */
 
-static inline void sample_fx(const vol_ctx *vc, const int64_t *lut_b_fx, uint32_t k, int64_t X,
-                             int64_t Y, int64_t Z, uint8_t *out, uint8_t *lab_out)
+/* One sample at 32.32 position (X, Y, Z), clamped into [0, xmax]: trilinear with 10-bit
+ * weights rounded to nearest (within 0.2 grey level of the exact value for neighbour
+ * differences up to 128), nearest label, display table. The volume has at least 2 voxels
+ * along every axis (checked per frame), so the +1 neighbours are 1, sy and sz away. The
+ * volume's values are passed by value so that the byte stores (which may alias anything) do
+ * not force reloads. */
+#define SC_W_BITS 10
+#define SC_W_ONE (1 << SC_W_BITS)
+#define SC_W_HALF ((int64_t)1 << (31 - SC_W_BITS)) /* half a weight step in 32.32 */
+
+typedef struct vol_regs {
+    const uint8_t *vox, *lab;
+    size_t sy, sz;
+    int64_t la;
+} vol_regs;
+
+static inline void sample_fx(const vol_regs v, const int64_t *restrict lut_b_fx, uint32_t k,
+                             int64_t X, int64_t Y, int64_t Z, uint8_t *restrict out,
+                             uint8_t *restrict lab_out)
 {
     X += SC_W_HALF;
     Y += SC_W_HALF;
@@ -915,29 +965,26 @@ static inline void sample_fx(const vol_ctx *vc, const int64_t *lut_b_fx, uint32_
     const int32_t tx = (int32_t)((X >> (32 - SC_W_BITS)) & (SC_W_ONE - 1));
     const int32_t ty = (int32_t)((Y >> (32 - SC_W_BITS)) & (SC_W_ONE - 1));
     const int32_t tz = (int32_t)((Z >> (32 - SC_W_BITS)) & (SC_W_ONE - 1));
-    const size_t base = (size_t)(X >> 32) + vc->stride[1] * (size_t)(Y >> 32) +
-                        vc->stride[2] * (size_t)(Z >> 32);
-    const size_t ox = vc->step[0], oy = vc->step[1], oz = vc->step[2];
-    const uint8_t *q = vc->vox + base;
-    const int32_t q000 = q[0], q100 = q[ox], q010 = q[oy], q110 = q[oy + ox];
-    const int32_t q001 = q[oz], q101 = q[oz + ox], q011 = q[oz + oy], q111 = q[oz + oy + ox];
+    const size_t base = (size_t)(X >> 32) + v.sy * (size_t)(Y >> 32) + v.sz * (size_t)(Z >> 32);
+    const uint8_t *r00 = v.vox + base, *r10 = r00 + v.sy, *r01 = r00 + v.sz,
+                  *r11 = r01 + v.sy;
     /* 18 bits after the first level, 28 bits inside the later ones: int32 is enough */
-    const int32_t c00 = q000 * SC_W_ONE + tx * (q100 - q000);
-    const int32_t c10 = q010 * SC_W_ONE + tx * (q110 - q010);
-    const int32_t c01 = q001 * SC_W_ONE + tx * (q101 - q001);
-    const int32_t c11 = q011 * SC_W_ONE + tx * (q111 - q011);
+    const int32_t c00 = r00[0] * SC_W_ONE + tx * (r00[1] - r00[0]);
+    const int32_t c10 = r10[0] * SC_W_ONE + tx * (r10[1] - r10[0]);
+    const int32_t c01 = r01[0] * SC_W_ONE + tx * (r01[1] - r01[0]);
+    const int32_t c11 = r11[0] * SC_W_ONE + tx * (r11[1] - r11[0]);
     const int32_t c0 = (c00 * SC_W_ONE + ty * (c10 - c00) + SC_W_ONE / 2) >> SC_W_BITS;
     const int32_t c1 = (c01 * SC_W_ONE + ty * (c11 - c01) + SC_W_ONE / 2) >> SC_W_BITS;
     const int32_t ifx = (c0 * SC_W_ONE + tz * (c1 - c0) + SC_W_ONE / 2) >> SC_W_BITS;
-    uint8_t label = (uint8_t)SC_LABEL_MUSCLE;
-    if (vc->lab != NULL) {
-        label = vc->lab[base + (tx >= SC_W_ONE / 2 ? ox : 0u) + (ty >= SC_W_ONE / 2 ? oy : 0u) +
-                        (tz >= SC_W_ONE / 2 ? oz : 0u)];
+    uint8_t label = (uint8_t)SC_LABEL_MUSCLE; /* volumes without a label map */
+    if (v.lab != NULL) { /* nearest voxel's label */
+        label = v.lab[base + (size_t)(tx >> (SC_W_BITS - 1)) +
+                      (ty >= SC_W_ONE / 2 ? v.sy : 0u) + (tz >= SC_W_ONE / 2 ? v.sz : 0u)];
     }
     lab_out[k] = label;
     /* display: out = (A * I + B[k]) >> 26 with I in 1/1024 grey, A = lut_a in 16.16 and
      * B = lut_b in 38.26 with the rounding half folded in */
-    const int64_t sum = vc->la * (int64_t)ifx + lut_b_fx[k];
+    const int64_t sum = v.la * (int64_t)ifx + lut_b_fx[k];
     out[k] = (uint8_t)(label == (uint8_t)SC_LABEL_OUTSIDE || sum < ((int64_t)1 << 26)
                            ? 0
                            : (sum >= ((int64_t)255 << 26) ? 255 : (sum >> 26)));
@@ -963,18 +1010,22 @@ static void sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1
         p0[d] = a[d] + (float)k0 * bb[d];
         p1[d] = a[d] + (float)(k1 - 1u) * bb[d];
     }
+    const vol_regs vr = {vc->vox, vc->lab, vc->stride[1], vc->stride[2], vc->la};
+    const int64_t *restrict lut = b->lut_b_fx;
+    const int64_t xm0 = vc->xmax[0], xm1 = vc->xmax[1], xm2 = vc->xmax[2];
+    uint8_t *restrict out = b->line_out;
+    uint8_t *restrict lab = b->line_label;
     if (in_volume(vc, p0) && in_volume(vc, p1)) {
         /* the volume box is convex: every sample between is inside */
         int64_t X = to_fx32(p0[0]), Y = to_fx32(p0[1]), Z = to_fx32(p0[2]);
-        const int64_t DX = step_fx32(bb[0]), DY = step_fx32(bb[1]), DZ = step_fx32(bb[2]);
+        const int64_t DX = to_fx32(bb[0]), DY = to_fx32(bb[1]), DZ = to_fx32(bb[2]);
         const int64_t j1 = (int64_t)(k1 - 1u - k0);
         const int64_t xe = X + j1 * DX, ye = Y + j1 * DY, ze = Z + j1 * DZ;
-        if (X >= 0 && xe >= 0 && Y >= 0 && ye >= 0 && Z >= 0 && ze >= 0 && X <= vc->xmax[0] &&
-            xe <= vc->xmax[0] && Y <= vc->xmax[1] && ye <= vc->xmax[1] && Z <= vc->xmax[2] &&
-            ze <= vc->xmax[2]) {
+        if (X >= 0 && xe >= 0 && Y >= 0 && ye >= 0 && Z >= 0 && ze >= 0 && X <= xm0 &&
+            xe <= xm0 && Y <= xm1 && ye <= xm1 && Z <= xm2 && ze <= xm2) {
             /* clear of the half-voxel border at both ends, so everywhere: no clamping */
             for (uint32_t k = k0; k < k1; k++) {
-                sample_fx(vc, b->lut_b_fx, k, X, Y, Z, b->line_out, b->line_label);
+                sample_fx(vr, lut, k, X, Y, Z, out, lab);
                 X += DX;
                 Y += DY;
                 Z += DZ;
@@ -982,8 +1033,8 @@ static void sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1
             return;
         }
         for (uint32_t k = k0; k < k1; k++) {
-            sample_fx(vc, b->lut_b_fx, k, clamp_fx(X, vc->xmax[0]), clamp_fx(Y, vc->xmax[1]),
-                      clamp_fx(Z, vc->xmax[2]), b->line_out, b->line_label);
+            sample_fx(vr, lut, k, clamp_fx(X, xm0), clamp_fx(Y, xm1), clamp_fx(Z, xm2), out,
+                      lab);
             X += DX;
             Y += DY;
             Z += DZ;
@@ -994,14 +1045,12 @@ static void sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1
         const float p[3] = {a[0] + (float)k * bb[0], a[1] + (float)k * bb[1],
                             a[2] + (float)k * bb[2]};
         if (!in_volume(vc, p)) {
-            /* outside the case volume: nothing to image */
-            b->line_out[k] = 0u;
-            b->line_label[k] = (uint8_t)SC_LABEL_OUTSIDE;
+            out[k] = 0u; /* outside the case volume: nothing to image */
+            lab[k] = (uint8_t)SC_LABEL_OUTSIDE;
             continue;
         }
-        sample_fx(vc, b->lut_b_fx, k, clamp_fx(to_fx32(p[0]), vc->xmax[0]),
-                  clamp_fx(to_fx32(p[1]), vc->xmax[1]), clamp_fx(to_fx32(p[2]), vc->xmax[2]),
-                  b->line_out, b->line_label);
+        sample_fx(vr, lut, k, clamp_fx(to_fx32(p[0]), xm0), clamp_fx(to_fx32(p[1]), xm1),
+                  clamp_fx(to_fx32(p[2]), xm2), out, lab);
     }
 }
 
@@ -1038,8 +1087,8 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
             /* nearest voxel: 16.16 positions offset by a half */
             int64_t X = to_fx32(p0[0] + 0.5f), Y = to_fx32(p0[1] + 0.5f),
                     Z = to_fx32(p0[2] + 0.5f);
-            const int64_t DX = step_fx32(c->fd[0]), DY = step_fx32(c->fd[1]),
-                          DZ = step_fx32(c->fd[2]);
+            const int64_t DX = to_fx32(c->fd[0]), DY = to_fx32(c->fd[1]),
+                          DZ = to_fx32(c->fd[2]);
             const int64_t lx = (int64_t)v->dim[0] - 1, ly = (int64_t)v->dim[1] - 1,
                           lz = (int64_t)v->dim[2] - 1;
             for (uint32_t kk = k0; kk < k1; kk++) {
@@ -1073,7 +1122,7 @@ static int volume_ok(const sc_volume *v)
         return 0;
     }
     for (uint32_t d = 0; d < 3u; d++) {
-        if (v->dim[d] < 1u || v->dim[d] > SC_MAX_VOLUME_DIM || !isfinite(v->spacing_mm[d]) ||
+        if (v->dim[d] < 2u || v->dim[d] > SC_MAX_VOLUME_DIM || !isfinite(v->spacing_mm[d]) ||
             !(v->spacing_mm[d] > 0.0f) || !isfinite(v->origin_mm[d])) {
             return 0;
         }
@@ -1178,6 +1227,12 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes,
             }
         }
         if (mapper == SC_BSCAN_MAP_WALK) {
+            if (++b->epoch == 0u) { /* wrapped: forget every entry */
+                for (uint32_t i = 0; i < SC_BSCAN_TET_CACHE; i++) {
+                    b->tcache[i].epoch = 0u;
+                }
+                b->epoch = 1u;
+            }
             build_segments(b, mesh);
             st->plane_hull_segments = b->seg_count;
         }
@@ -1194,8 +1249,9 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes,
         vc.xmax[d] = dim > 1u ? ((int64_t)(dim - 1u) << 32) - 1 - SC_W_HALF : 0;
         vc.stride[d] = d == 0u ? 1u : (d == 1u ? volume->dim[0]
                                                : (size_t)volume->dim[0] * volume->dim[1]);
-        vc.step[d] = dim > 1u ? vc.stride[d] : 0u;
     }
+    vc.sy32 = volume->dim[0];
+    vc.sz32 = volume->dim[0] * volume->dim[1];
     area_acc acc;
     memset(&acc, 0, sizeof acc);
     uint32_t active_n = 0;

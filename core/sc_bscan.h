@@ -114,6 +114,21 @@ typedef struct sc_bscan_run {
     float a[3], b[3];
 } sc_bscan_run;
 
+/* Walker cache: a tet's barycentric coordinates and rest position as affine functions of
+ * the image-frame (x, z), valid for the frame `epoch`. */
+typedef struct sc_bscan_tcache {
+    uint32_t epoch, tet, ok;
+    float lam[4][3];
+    float rest[3][3];
+} sc_bscan_tcache;
+
+/* Entries of the walker's tet cache (power of two). */
+#ifndef SC_BSCAN_TET_CACHE
+#define SC_BSCAN_TET_CACHE 4096u
+#endif
+_Static_assert((SC_BSCAN_TET_CACHE & (SC_BSCAN_TET_CACHE - 1u)) == 0u,
+               "SC_BSCAN_TET_CACHE must be a power of two");
+
 typedef struct sc_bscan_event {
     float s;        /* line parameter, samples */
     uint32_t seg;   /* index into segs */
@@ -141,6 +156,8 @@ typedef struct sc_bscan {
     uint32_t seg_sorted[SC_BSCAN_MAX_HULL_FACES];
     uint32_t active[SC_BSCAN_MAX_HULL_FACES];
     sc_bscan_event events[SC_BSCAN_MAX_LINE_EVENTS];
+    uint32_t epoch;
+    sc_bscan_tcache tcache[SC_BSCAN_TET_CACHE];
     /* region path */
     uint32_t ptet_count;
     sc_bscan_ptet ptets[SC_BSCAN_MAX_PLANE_TETS];
