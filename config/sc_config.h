@@ -58,11 +58,12 @@
 #ifndef SC_PHYS_DT_DEFAULT_S
 #define SC_PHYS_DT_DEFAULT_S 0.01f
 #endif
-/* FEM 3x3 blocks (sc_fem.h): in the 5-tet grid a node of odd i+j+k has at most 18 neighbours
- * (6 axis + 12 face diagonals) plus itself: 19 blocks; an even node 7; at most (N + 1) / 2
- * nodes are odd: 19 (N + 1) / 2 + 7 (N + 1) / 2 = 13 (N + 1). */
+/* FEM 3x3 blocks (sc_fem.h, upper triangle): in the 5-tet grid a node of odd i+j+k has at
+ * most 18 neighbours (6 axis + 12 face diagonals), 9 of them with a larger index, plus itself:
+ * 10 blocks; an even node 6 neighbours: 4 blocks; at most (N + 1) / 2 nodes are odd:
+ * 10 (N + 1) / 2 + 4 (N + 1) / 2 = 7 (N + 1). */
 #ifndef SC_MAX_FEM_NNZ_BLOCKS
-#define SC_MAX_FEM_NNZ_BLOCKS (13u * (SC_MAX_NODES + 1u))
+#define SC_MAX_FEM_NNZ_BLOCKS (7u * (SC_MAX_NODES + 1u))
 #endif
 /* MSDS springs (sc_springs.h, Algorithm 1): the 5-tet grid has one spring per grid edge
  * (3 per node) and one per grid face diagonal (3 per node): at most 6 N. */

@@ -12,17 +12,20 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 
 #include "sc_assert.h"
 #include "sc_err.h"
 
-/* Ordered vertex pairs of a tet: pairs 0..5 have a < b, pair p + 6 is pair p reversed, so
- * block p + 6 is the transpose of block p. tet_blk[e][p] is the CSR index of (tet[a], tet[b]). */
-static const uint8_t k_pair_a[12] = {0u, 0u, 0u, 1u, 1u, 2u, 1u, 2u, 3u, 2u, 3u, 3u};
-static const uint8_t k_pair_b[12] = {1u, 2u, 3u, 2u, 3u, 3u, 0u, 0u, 0u, 1u, 1u, 2u};
+/* Vertex pairs (a < b) of a tet. tet_blk[e][p] is the index of the stored block of the node
+ * pair: block (tet[a], tet[b]) if tet[a] < tet[b], else block (tet[b], tet[a]) with
+ * SC_FEM_BLK_TRANSPOSED set (it holds K_ba = K_ab^T). */
+static const uint8_t k_pair_a[6] = {0u, 0u, 0u, 1u, 1u, 2u};
+static const uint8_t k_pair_b[6] = {1u, 2u, 3u, 2u, 3u, 3u};
+#define SC_FEM_BLK_TRANSPOSED 0x80000000u
 
 /* E in Pa -> N/mm^2; density kg/m^3 * mm^3 -> kg (1e-9) -> N s^2/mm (1e-3). */
-#define SC_FEM_PA_TO_NMM2 1.0e-6f
+#define SC_FEM_PA_TO_NMM2      1.0e-6f
 #define SC_FEM_RHO_VOL_TO_MASS 1.0e-12f
 /* Newton iterations of the polar decomposition at most (quadratic convergence: a stretch of
  * 3:1 converges to float precision in about 6 scaled iterations). */
@@ -127,19 +130,19 @@ static void tet_grads(const float dmi[9], float n[4][3])
 }
 
 /* Add the element blocks built from gradients g (rest or rotated) into the matrix. */
-static void add_tet_blocks(sc_fem *f, const uint32_t tet[4], const uint32_t blk_idx[12],
+static void add_tet_blocks(sc_fem *f, const uint32_t tet[4], const uint32_t blk_idx[6],
                            const float g[4][3], float lam_v, float mu_v)
 {
     for (uint32_t a = 0; a < 4u; a++) {
-        float *B = f->blk[f->diag_blk[tet[a]]];
+        float *B = f->blk[f->row_start[tet[a]]]; /* the diagonal block leads its row */
         const float dd = mu_v * (g[a][0] * g[a][0] + g[a][1] * g[a][1] + g[a][2] * g[a][2]);
         const float lm = lam_v + mu_v;
         for (uint32_t r = 0; r < 3u; r++) {
-            B[4u * r] += lm * g[a][r] * g[a][r] + dd;
+            B[5u * r] += lm * g[a][r] * g[a][r] + dd;
             for (uint32_t c = r + 1u; c < 3u; c++) {
                 const float v = lm * g[a][r] * g[a][c]; /* mirrored: exactly symmetric */
-                B[3u * r + c] += v;
-                B[3u * c + r] += v;
+                B[4u * r + c] += v;
+                B[4u * c + r] += v;
             }
         }
     }
@@ -153,12 +156,19 @@ static void add_tet_blocks(sc_fem *f, const uint32_t tet[4], const uint32_t blk_
             }
             kab[4u * r] += dd;
         }
-        float *Bab = f->blk[blk_idx[p]];
-        float *Bba = f->blk[blk_idx[p + 6u]];
-        for (uint32_t r = 0; r < 3u; r++) {
-            for (uint32_t c = 0; c < 3u; c++) {
-                Bab[3u * r + c] += kab[3u * r + c];
-                Bba[3u * c + r] += kab[3u * r + c];
+        const uint32_t bi = blk_idx[p];
+        float *B = f->blk[bi & ~SC_FEM_BLK_TRANSPOSED];
+        if ((bi & SC_FEM_BLK_TRANSPOSED) == 0u) {
+            for (uint32_t r = 0; r < 3u; r++) {
+                for (uint32_t c = 0; c < 3u; c++) {
+                    B[4u * r + c] += kab[3u * r + c];
+                }
+            }
+        } else {
+            for (uint32_t r = 0; r < 3u; r++) {
+                for (uint32_t c = 0; c < 3u; c++) {
+                    B[4u * c + r] += kab[3u * r + c];
+                }
             }
         }
     }
@@ -174,7 +184,7 @@ static void zero_floats(float *p, uint32_t count)
 /* Rest stiffness K (R = I). O(T). */
 static void assemble_rest(sc_fem *f, const sc_mesh *m)
 {
-    zero_floats(&f->blk[0][0], 9u * f->nnz_blocks);
+    zero_floats(&f->blk[0][0], SC_FEM_BLK_FLOATS * f->nnz_blocks);
     for (uint32_t e = 0; e < f->tet_count; e++) {
         float n[4][3];
         tet_grads(f->dm_inv[e], n);
@@ -188,17 +198,17 @@ static void assemble_rest(sc_fem *f, const sc_mesh *m)
 /* Corotated: warped K into blk and the elastic force -f_int into fel (3N). O(T). */
 static void assemble_corotated(sc_fem *f, const sc_mesh *m, float *restrict fel)
 {
-    zero_floats(&f->blk[0][0], 9u * f->nnz_blocks);
-    zero_floats(fel, 3u * f->node_count);
+    zero_floats(&f->blk[0][0], SC_FEM_BLK_FLOATS * f->nnz_blocks);
+    zero_floats(fel, 4u * f->node_count);
     uint32_t degenerate = 0;
     const float *x3 = f->x3;
     for (uint32_t e = 0; e < f->tet_count; e++) {
         const uint32_t *t = m->tet[e];
         const float *dmi = f->dm_inv[e];
-        const float *p0 = &x3[3u * t[0]];
+        const float *p0 = &x3[4u * t[0]];
         float ds[3][3]; /* ds[k] = x_{k+1} - x_0 (columns of Ds) */
         for (uint32_t k = 0; k < 3u; k++) {
-            const float *pk = &x3[3u * t[k + 1u]];
+            const float *pk = &x3[4u * t[k + 1u]];
             for (uint32_t d = 0; d < 3u; d++) {
                 ds[k][d] = pk[d] - p0[d];
             }
@@ -236,9 +246,10 @@ static void assemble_corotated(sc_fem *f, const sc_mesh *m, float *restrict fel)
         for (uint32_t a = 0; a < 4u; a++) {
             float s[3];
             for (uint32_t r = 0; r < 3u; r++) {
-                s[r] = sig[3u * r] * n[a][0] + sig[3u * r + 1u] * n[a][1] + sig[3u * r + 2u] * n[a][2];
+                s[r] =
+                    sig[3u * r] * n[a][0] + sig[3u * r + 1u] * n[a][1] + sig[3u * r + 2u] * n[a][2];
             }
-            float *fa = &fel[3u * t[a]];
+            float *fa = &fel[4u * t[a]];
             for (uint32_t r = 0; r < 3u; r++) {
                 fa[r] -= vol * (R[3u * r] * s[0] + R[3u * r + 1u] * s[1] + R[3u * r + 2u] * s[2]);
                 g[a][r] = R[3u * r] * n[a][0] + R[3u * r + 1u] * n[a][1] + R[3u * r + 2u] * n[a][2];
@@ -250,27 +261,96 @@ static void assemble_corotated(sc_fem *f, const sc_mesh *m, float *restrict fel)
     f->matrix_is_rest = 0u;
 }
 
-/* q = cm M p + ck K p over the block CSR. O(B). */
+/* 4-lane float vectors: GCC/Clang vector extension (plain SIMD on SSE2 / NEON, lowered to
+ * scalar code on targets without SIMD); other compilers take the scalar loops. Both do the
+ * same IEEE operations per lane in the same order: results are bitwise identical. */
+#if defined(__GNUC__)
+#define SC_FEM_VEC 1
+typedef float sc_fem_v4 __attribute__((vector_size(16)));
+static inline sc_fem_v4 v4_load(const float *p)
+{
+    sc_fem_v4 v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
+static inline void v4_store(float *p, sc_fem_v4 v)
+{
+    memcpy(p, &v, sizeof v);
+}
+static inline sc_fem_v4 v4_splat(float x)
+{
+    const sc_fem_v4 v = {x, x, x, x};
+    return v;
+}
+#endif
+
+/* q = cm M p + ck K p over the symmetric block CSR (upper triangle stored: each row is its
+ * diagonal block, then the blocks (i, j > i); block (i, j) also acts as (j, i)^T). Vectors and
+ * block rows have 4 lanes (the 4th is 0): per block 3 row loads, one load of p_j and one
+ * load/store of q_j, 6 SIMD multiplies and 6 adds. Row i's products B p_j are accumulated
+ * lane-wise and summed once at the end of the row. O(B). */
 static void matvec(const sc_fem *f, const float *restrict p, float *restrict q, float cm, float ck)
 {
     const uint32_t nn = f->node_count;
     const uint32_t *rs = f->row_start;
     const uint32_t *col = f->col;
     for (uint32_t i = 0; i < nn; i++) {
-        float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
-        const uint32_t end = rs[i + 1u];
-        for (uint32_t b = rs[i]; b < end; b++) {
-            const float *B = f->blk[b];
-            const float *pc = &p[3u * col[b]];
-            const float px = pc[0], py = pc[1], pz = pc[2];
-            s0 += B[0] * px + B[1] * py + B[2] * pz;
-            s1 += B[3] * px + B[4] * py + B[5] * pz;
-            s2 += B[6] * px + B[7] * py + B[8] * pz;
-        }
         const float mi = cm * f->mass[i];
-        q[3u * i] = mi * p[3u * i] + ck * s0;
-        q[3u * i + 1u] = mi * p[3u * i + 1u] + ck * s1;
-        q[3u * i + 2u] = mi * p[3u * i + 2u] + ck * s2;
+        for (uint32_t k = 0; k < 4u; k++) {
+            q[4u * i + k] = mi * p[4u * i + k];
+        }
+    }
+    for (uint32_t i = 0; i < nn; i++) {
+        const uint32_t beg = rs[i], end = rs[i + 1u];
+        const float *pi = &p[4u * i];
+        const float *D = f->blk[beg];
+        const float ci0 = ck * pi[0], ci1 = ck * pi[1], ci2 = ck * pi[2];
+        float s0, s1, s2;
+#if defined(SC_FEM_VEC)
+        const sc_fem_v4 vpi = v4_load(pi);
+        const sc_fem_v4 c0 = v4_splat(ci0), c1 = v4_splat(ci1), c2 = v4_splat(ci2);
+        sc_fem_v4 a0 = v4_load(D) * vpi;
+        sc_fem_v4 a1 = v4_load(D + 4) * vpi;
+        sc_fem_v4 a2 = v4_load(D + 8) * vpi;
+        for (uint32_t b = beg + 1u; b < end; b++) {
+            const float *B = f->blk[b];
+            const uint32_t j4 = 4u * col[b];
+            const sc_fem_v4 b0 = v4_load(B), b1 = v4_load(B + 4), b2 = v4_load(B + 8);
+            const sc_fem_v4 pj = v4_load(&p[j4]);
+            a0 += b0 * pj;
+            a1 += b1 * pj;
+            a2 += b2 * pj;
+            v4_store(&q[j4], v4_load(&q[j4]) + ((b0 * c0 + b1 * c1) + b2 * c2));
+        }
+        s0 = (a0[0] + a0[1]) + (a0[2] + a0[3]);
+        s1 = (a1[0] + a1[1]) + (a1[2] + a1[3]);
+        s2 = (a2[0] + a2[1]) + (a2[2] + a2[3]);
+#else
+        float a0[4], a1[4], a2[4];
+        for (uint32_t k = 0; k < 4u; k++) {
+            a0[k] = D[k] * pi[k];
+            a1[k] = D[4u + k] * pi[k];
+            a2[k] = D[8u + k] * pi[k];
+        }
+        for (uint32_t b = beg + 1u; b < end; b++) {
+            const float *B = f->blk[b];
+            const uint32_t j4 = 4u * col[b];
+            const float *pj = &p[j4];
+            float *qj = &q[j4];
+            for (uint32_t k = 0; k < 4u; k++) {
+                a0[k] += B[k] * pj[k];
+                a1[k] += B[4u + k] * pj[k];
+                a2[k] += B[8u + k] * pj[k];
+                qj[k] += (B[k] * ci0 + B[4u + k] * ci1) + B[8u + k] * ci2;
+            }
+        }
+        s0 = (a0[0] + a0[1]) + (a0[2] + a0[3]);
+        s1 = (a1[0] + a1[1]) + (a1[2] + a1[3]);
+        s2 = (a2[0] + a2[1]) + (a2[2] + a2[3]);
+#endif
+        q[4u * i] += ck * s0;
+        q[4u * i + 1u] += ck * s1;
+        q[4u * i + 2u] += ck * s2;
     }
 }
 
@@ -320,23 +400,17 @@ static uint32_t find_block(const sc_fem *f, uint32_t a, uint32_t b)
 }
 
 #ifdef SC_ENABLE_VALIDATE
-/* Expensive invariant: K is symmetric (block (i,j) = block (j,i)^T), exactly. */
-static int matrix_is_symmetric(const sc_fem *f)
+/* Expensive invariant: every row starts with its diagonal block, then strictly increasing
+ * columns above the diagonal. */
+static int pattern_is_upper_sorted(const sc_fem *f)
 {
     for (uint32_t i = 0; i < f->node_count; i++) {
-        for (uint32_t b = f->row_start[i]; b < f->row_start[i + 1u]; b++) {
-            const uint32_t t = find_block(f, f->col[b], i);
-            if (t == UINT32_MAX) {
+        if (f->row_start[i] >= f->row_start[i + 1u] || f->col[f->row_start[i]] != i) {
+            return 0;
+        }
+        for (uint32_t b = f->row_start[i] + 1u; b < f->row_start[i + 1u]; b++) {
+            if (f->col[b] <= f->col[b - 1u]) {
                 return 0;
-            }
-            for (uint32_t r = 0; r < 3u; r++) {
-                for (uint32_t c = 0; c < 3u; c++) {
-                    /* assembled from identical products in the same order: bitwise */
-                    const float u = f->blk[b][3u * r + c], w = f->blk[t][3u * c + r];
-                    if (u < w || u > w) {
-                        return 0;
-                    }
-                }
             }
         }
     }
@@ -344,8 +418,7 @@ static int matrix_is_symmetric(const sc_fem *f)
 }
 #endif
 
-int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat,
-                const sc_fem_def *def)
+int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat, const sc_fem_def *def)
 {
     if (f == NULL || m == NULL || mat == NULL || def == NULL) {
         return SC_ERR_INVALID_ARG;
@@ -396,19 +469,26 @@ int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat,
     f->stats.degenerate_tets = 0u;
     f->stats.unstable_steps = 0u;
 
-    /* Pattern: a 27-bit stencil mask per node, kept in diag_blk until the rows are built. */
+    /* Pattern: a 27-bit stencil mask per node (bit 13: itself; bits above: neighbours with a
+     * larger index), kept in row_start until the rows are built. */
     for (uint32_t i = 0; i < nn; i++) {
-        f->diag_blk[i] = 1u << 13; /* self */
+        f->row_start[i] = 1u << 13;
         f->node_used[i] = 0u;
     }
     for (uint32_t e = 0; e < nt; e++) {
         const uint32_t *t = m->tet[e];
-        for (uint32_t p = 0; p < 12u; p++) {
-            const int32_t code = stencil_code(m, t[k_pair_a[p]], t[k_pair_b[p]]);
-            if (code < 0 || code == 13) {
+        for (uint32_t p = 0; p < 6u; p++) {
+            uint32_t a = t[k_pair_a[p]], b = t[k_pair_b[p]];
+            if (a > b) {
+                const uint32_t tmp = a;
+                a = b;
+                b = tmp;
+            }
+            const int32_t code = stencil_code(m, a, b);
+            if (code <= 13) { /* not neighbours (or a < b not above the diagonal) */
                 return SC_ERR_FEM_PATTERN;
             }
-            f->diag_blk[t[k_pair_a[p]]] |= 1u << (uint32_t)code;
+            f->row_start[a] |= 1u << (uint32_t)code;
         }
         for (uint32_t v = 0; v < 4u; v++) {
             f->node_used[t[v]] = 1u;
@@ -417,7 +497,7 @@ int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat,
     uint32_t nnz = 0;
     const int32_t sx = 1, sy = (int32_t)m->nx, sz = (int32_t)(m->nx * m->ny);
     for (uint32_t i = 0; i < nn; i++) {
-        const uint32_t mask = f->diag_blk[i];
+        const uint32_t mask = f->row_start[i];
         f->row_start[i] = nnz;
         uint32_t prev = 0;
         for (uint32_t code = 0; code < 27u; code++) {
@@ -436,9 +516,6 @@ int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat,
             }
             prev = c;
             f->col[nnz] = c;
-            if (code == 13u) {
-                f->diag_blk[i] = nnz;
-            }
             nnz++;
         }
     }
@@ -448,9 +525,10 @@ int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat,
     /* Per-tet rest data, block indices and lumped masses. */
     for (uint32_t i = 0; i < nn; i++) {
         f->mass[i] = 0.0f;
-        f->rest3[3u * i] = m->rest_x[i];
-        f->rest3[3u * i + 1u] = m->rest_y[i];
-        f->rest3[3u * i + 2u] = m->rest_z[i];
+        f->rest3[4u * i] = m->rest_x[i];
+        f->rest3[4u * i + 1u] = m->rest_y[i];
+        f->rest3[4u * i + 2u] = m->rest_z[i];
+        f->rest3[4u * i + 3u] = 0.0f;
     }
     for (uint32_t e = 0; e < nt; e++) {
         const uint32_t *t = m->tet[e];
@@ -478,10 +556,11 @@ int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat,
             }
         }
         f->vol_mm3[e] = det / 6.0f;
-        for (uint32_t p = 0; p < 12u; p++) {
-            const uint32_t bi = find_block(f, t[k_pair_a[p]], t[k_pair_b[p]]);
+        for (uint32_t p = 0; p < 6u; p++) {
+            const uint32_t a = t[k_pair_a[p]], b = t[k_pair_b[p]];
+            const uint32_t bi = (a < b) ? find_block(f, a, b) : find_block(f, b, a);
             SC_ASSERT(bi != UINT32_MAX); /* every tet edge is in the pattern by construction */
-            f->tet_blk[e][p] = bi;
+            f->tet_blk[e][p] = (a < b) ? bi : (bi | SC_FEM_BLK_TRANSPOSED);
         }
         const float mq = mat->row[m->tet_label[e]].density_kg_m3 * f->vol_mm3[e] *
                          SC_FEM_RHO_VOL_TO_MASS * 0.25f;
@@ -490,7 +569,7 @@ int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat,
         }
     }
     assemble_rest(f, m);
-    SC_VALIDATE(matrix_is_symmetric(f));
+    SC_VALIDATE(pattern_is_upper_sorted(f));
     return SC_OK;
 }
 
@@ -519,7 +598,7 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
     SC_ASSERT(isfinite(dt_s) && dt_s > 0.0f);
     SC_ASSERT(cg_iterations <= SC_PHYS_ITERATIONS_MAX);
     const uint32_t nn = f->node_count;
-    const uint32_t n3 = 3u * nn;
+    const uint32_t n3 = 4u * nn; /* 4 lanes per node, the 4th stays 0 */
     float *restrict x3 = f->x3;
     float *restrict v3 = f->v3;
     float *restrict r3 = f->r3;
@@ -539,13 +618,15 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
             con = 2u;
         }
         f->constrained[i] = con;
-        x3[3u * i] = n->x[i];
-        x3[3u * i + 1u] = n->y[i];
-        x3[3u * i + 2u] = n->z[i];
+        x3[4u * i] = n->x[i];
+        x3[4u * i + 1u] = n->y[i];
+        x3[4u * i + 2u] = n->z[i];
+        x3[4u * i + 3u] = 0.0f;
         const float keep = (con == 1u) ? 0.0f : 1.0f;
-        v3[3u * i] = keep * n->vx[i];
-        v3[3u * i + 1u] = keep * n->vy[i];
-        v3[3u * i + 2u] = keep * n->vz[i];
+        v3[4u * i] = keep * n->vx[i];
+        v3[4u * i + 1u] = keep * n->vy[i];
+        v3[4u * i + 2u] = keep * n->vz[i];
+        v3[4u * i + 3u] = 0.0f;
     }
 
     const float cm = 1.0f + dt_s * f->def.rayleigh_alpha_per_s;
@@ -559,7 +640,7 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
         matvec(f, v3, q3, 0.0f, 1.0f);
         for (uint32_t i = 0; i < nn; i++) {
             for (uint32_t d = 0; d < 3u; d++) {
-                const uint32_t k = 3u * i + d;
+                const uint32_t k = 4u * i + d;
                 const float fe = (d == 0u) ? n->fx[i] : (d == 1u) ? n->fy[i] : n->fz[i];
                 r3[k] = dt_s * (fe + z3[k]) - dta * mass[i] * v3[k] - ck * q3[k];
             }
@@ -575,19 +656,21 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
         }
         matvec(f, p3, q3, 0.0f, 1.0f);
         for (uint32_t i = 0; i < nn; i++) {
-            r3[3u * i] = dt_s * n->fx[i] - dta * mass[i] * v3[3u * i] - q3[3u * i];
-            r3[3u * i + 1u] = dt_s * n->fy[i] - dta * mass[i] * v3[3u * i + 1u] - q3[3u * i + 1u];
-            r3[3u * i + 2u] = dt_s * n->fz[i] - dta * mass[i] * v3[3u * i + 2u] - q3[3u * i + 2u];
+            r3[4u * i] = dt_s * n->fx[i] - dta * mass[i] * v3[4u * i] - q3[4u * i];
+            r3[4u * i + 1u] = dt_s * n->fy[i] - dta * mass[i] * v3[4u * i + 1u] - q3[4u * i + 1u];
+            r3[4u * i + 2u] = dt_s * n->fz[i] - dta * mass[i] * v3[4u * i + 2u] - q3[4u * i + 2u];
+            r3[4u * i + 3u] = 0.0f;
         }
     }
 
     /* Jacobi preconditioner, zero on Dirichlet DOFs (projects the CG onto the free DOFs). */
     for (uint32_t i = 0; i < nn; i++) {
-        const float *D = f->blk[f->diag_blk[i]];
+        const float *D = f->blk[f->row_start[i]];
         for (uint32_t d = 0; d < 3u; d++) {
-            const float a = cm * mass[i] + ck * D[4u * d];
-            inv[3u * i + d] = (f->constrained[i] == 0u && a > 0.0f) ? 1.0f / a : 0.0f;
+            const float a = cm * mass[i] + ck * D[5u * d];
+            inv[4u * i + d] = (f->constrained[i] == 0u && a > 0.0f) ? 1.0f / a : 0.0f;
         }
+        inv[4u * i + 3u] = 0.0f;
     }
 
     for (uint32_t k = 0; k < n3; k++) {
@@ -633,11 +716,11 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
         return;
     }
     for (uint32_t i = 0; i < nn; i++) {
-        n->vx[i] = v3[3u * i];
-        n->vy[i] = v3[3u * i + 1u];
-        n->vz[i] = v3[3u * i + 2u];
-        n->x[i] = x3[3u * i] + dt_s * v3[3u * i];
-        n->y[i] = x3[3u * i + 1u] + dt_s * v3[3u * i + 1u];
-        n->z[i] = x3[3u * i + 2u] + dt_s * v3[3u * i + 2u];
+        n->vx[i] = v3[4u * i];
+        n->vy[i] = v3[4u * i + 1u];
+        n->vz[i] = v3[4u * i + 2u];
+        n->x[i] = x3[4u * i] + dt_s * v3[4u * i];
+        n->y[i] = x3[4u * i + 1u] + dt_s * v3[4u * i + 1u];
+        n->z[i] = x3[4u * i + 2u] + dt_s * v3[4u * i + 2u];
     }
 }

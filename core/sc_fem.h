@@ -30,20 +30,27 @@
  * - Fixed nodes (mesh node_fixed) and caller-driven kinematic nodes are Dirichlet DOFs: the
  *   preconditioner is zero on them, which projects the CG onto the free DOFs (their velocity
  *   stays the prescribed one: 0 for fixed nodes).
- * - Storage: 3x3 block CSR over nodes (row = node, one block per mesh edge plus the diagonal;
- *   a node has at most 19 neighbours in the 5-tet grid, 13 on average), full (both
- *   triangles) so that the mat-vec is one straight pass with no scatter. Vectors inside the
- *   solver are interleaved xyz float32 so that a block's gather of p is one cache line.
- *   Per-tet rest data (Dm^-1, volume, 12 block indices) lets the corotated step re-assemble
- *   the warped matrix in place without any search.
+ * - Storage: symmetric 3x3 block CSR over nodes: row i holds its diagonal block, then one
+ *   block per mesh edge (i, j > i), columns sorted (a node has at most 18 neighbours in the
+ *   5-tet grid, 6 on average). Each off-diagonal block serves both (i, j) and (j, i)^T in the
+ *   mat-vec, which halves the bytes streamed per CG iteration. Blocks are 3 rows of 4 floats
+ *   and the solver vectors interleaved x, y, z, 0, so that a block's work is 3 + 3 four-lane
+ *   multiply-adds (SIMD via the GCC/Clang vector extension, scalar elsewhere, bitwise the
+ *   same) and the gather of p_j is one 16-byte load. Per-tet rest data (Dm^-1, volume, 6
+ *   block indices) lets the corotated step re-assemble the warped matrix in place without
+ *   any search.
+ * - Use from the facade: sc_tissue runs one FEM step per frame of length iterations x dt
+ *   (the simulated time of the MSDS's frame) with `iterations` CG iterations, and holds the
+ *   nodes in contact with the probe as kinematic nodes.
  *
  * Memory (float32, uint32; N = SC_MAX_NODES, T = SC_MAX_TETS, B = SC_MAX_FEM_NNZ_BLOCKS):
- *   blocks 36 B + column 4 B per block       = 40 B  (B = 13 (N + 1): 4.26 MB at 32x16x16)
- *   per node: rows/diag/mass 12 B + 8 solver vectors of 3 floats 96 B + flags 2 B = 110 B
- *                                                                      (0.90 MB at 8,192)
- *   per tet: Dm^-1 + volume 40 B + 12 block indices 48 B = 88 B      (3.07 MB at 34,875)
- *   total about 8.2 MB at the default limits; sizeof(sc_fem) is printed by the benchmark.
- *   The MCU build shrinks the limits (all arrays scale with them).
+ *   per block: 48 B + column 4 B = 52 B     (B = 7 (N + 1) = 57,351: 2.98 MB at 32x16x16;
+ *                                             53,568 used by the 32x16x16 mesh)
+ *   per node: row start, mass 8 B + 8 solver vectors of 4 floats 128 B + flags 2 B = 138 B
+ *                                                                      (1.13 MB at 8,192)
+ *   per tet: Dm^-1 + volume 40 B + 6 block indices 24 B = 64 B       (2.23 MB at 34,875)
+ *   total 6.35 MB at the default limits (sizeof(sc_fem) = 6,345,216 B on x86-64, printed by
+ *   the benchmark and the tests). The MCU build shrinks the limits (all arrays scale).
  *
  * Thread rules: one writer; an sc_fem is used by one thread. Never allocates, never calls the
  * OS or stdio. Deterministic: fixed loop orders and fixed iteration counts give bit-identical
@@ -58,6 +65,10 @@
 #include "sc_material.h"
 #include "sc_mesh.h"
 
+/* A 3x3 block is stored as 3 rows of 4 floats (element (r, c) at [4 r + c], [4 r + 3] = 0):
+ * one SIMD register per row. */
+#define SC_FEM_BLK_FLOATS 12u
+
 typedef struct sc_fem_def {
     float rayleigh_beta_s;      /* stiffness-proportional damping, >= 0 (MSDS: gamma = 0.1 k) */
     float rayleigh_alpha_per_s; /* mass-proportional damping, >= 0 */
@@ -66,10 +77,10 @@ typedef struct sc_fem_def {
 
 /* Diagnostics of the last step, for tests, benchmarks and health reporting. */
 typedef struct sc_fem_stats {
-    uint32_t cg_iterations_run;  /* <= the requested count (stops early only on an exact 0) */
-    float residual_ratio;        /* sqrt(r.z) after / before the CG of the last step */
-    uint32_t degenerate_tets;    /* corotated: tets whose F had det <= 0 (linear fallback) */
-    uint32_t unstable_steps;     /* steps refused because the solution was not finite */
+    uint32_t cg_iterations_run; /* <= the requested count (stops early only on an exact 0) */
+    float residual_ratio;       /* sqrt(r.z) after / before the CG of the last step */
+    uint32_t degenerate_tets;   /* corotated: tets whose F had det <= 0 (linear fallback) */
+    uint32_t unstable_steps;    /* steps refused because the solution was not finite */
 } sc_fem_stats;
 
 typedef struct sc_fem {
@@ -84,29 +95,29 @@ typedef struct sc_fem {
     float lambda_nmm2[SC_MAX_LABELS]; /* Lame parameters per label, N/mm^2 */
     float mu_nmm2[SC_MAX_LABELS];
 
-    /* ---- hot: 3x3 block CSR of K (row-major blocks), rows = nodes ---- */
-    SC_ALIGN_HOT float blk[SC_MAX_FEM_NNZ_BLOCKS][9];
+    /* ---- hot: upper-triangle 3x3 block CSR of K (row-major blocks), rows = nodes; the
+     * first block of row i is (i, i) ---- */
+    SC_ALIGN_HOT float blk[SC_MAX_FEM_NNZ_BLOCKS][SC_FEM_BLK_FLOATS];
     SC_ALIGN_HOT uint32_t col[SC_MAX_FEM_NNZ_BLOCKS];
     SC_ALIGN_HOT uint32_t row_start[SC_MAX_NODES + 1u];
-    SC_ALIGN_HOT uint32_t diag_blk[SC_MAX_NODES]; /* index of block (i, i) */
-    SC_ALIGN_HOT float mass[SC_MAX_NODES];        /* lumped mass, N s^2 / mm (= kg * 1e-3) */
+    SC_ALIGN_HOT float mass[SC_MAX_NODES]; /* lumped mass, N s^2 / mm (= kg * 1e-3) */
 
-    /* ---- hot: solver vectors, interleaved xyz (3 floats per node) ---- */
-    SC_ALIGN_HOT float rest3[3u * SC_MAX_NODES]; /* rest positions, mm */
-    SC_ALIGN_HOT float x3[3u * SC_MAX_NODES];    /* positions at the start of the step, mm */
-    SC_ALIGN_HOT float v3[3u * SC_MAX_NODES];    /* unknown v+, mm/s (warm start: v) */
-    SC_ALIGN_HOT float r3[3u * SC_MAX_NODES];    /* residual, N s */
-    SC_ALIGN_HOT float z3[3u * SC_MAX_NODES];    /* preconditioned residual */
-    SC_ALIGN_HOT float p3[3u * SC_MAX_NODES];    /* search direction */
-    SC_ALIGN_HOT float q3[3u * SC_MAX_NODES];    /* A p */
-    SC_ALIGN_HOT float inv_diag3[3u * SC_MAX_NODES]; /* Jacobi, 0 on Dirichlet DOFs */
-    uint8_t constrained[SC_MAX_NODES]; /* this step: 1 fixed, 2 kinematic, 0 free */
-    uint8_t node_used[SC_MAX_NODES];   /* node belongs to at least one tet */
+    /* ---- hot: solver vectors, interleaved x, y, z, 0 (4 floats per node) ---- */
+    SC_ALIGN_HOT float rest3[4u * SC_MAX_NODES];     /* rest positions, mm */
+    SC_ALIGN_HOT float x3[4u * SC_MAX_NODES];        /* positions at the start of the step, mm */
+    SC_ALIGN_HOT float v3[4u * SC_MAX_NODES];        /* unknown v+, mm/s (warm start: v) */
+    SC_ALIGN_HOT float r3[4u * SC_MAX_NODES];        /* residual, N s */
+    SC_ALIGN_HOT float z3[4u * SC_MAX_NODES];        /* preconditioned residual */
+    SC_ALIGN_HOT float p3[4u * SC_MAX_NODES];        /* search direction */
+    SC_ALIGN_HOT float q3[4u * SC_MAX_NODES];        /* A p */
+    SC_ALIGN_HOT float inv_diag3[4u * SC_MAX_NODES]; /* Jacobi, 0 on Dirichlet DOFs */
+    uint8_t constrained[SC_MAX_NODES];               /* this step: 1 fixed, 2 kinematic, 0 free */
+    uint8_t node_used[SC_MAX_NODES];                 /* node belongs to at least one tet */
 
     /* ---- per tet rest data (corotated re-assembly) ---- */
     SC_ALIGN_HOT float dm_inv[SC_MAX_TETS][9]; /* rows: grad N1, grad N2, grad N3 (1/mm) */
     SC_ALIGN_HOT float vol_mm3[SC_MAX_TETS];
-    SC_ALIGN_HOT uint32_t tet_blk[SC_MAX_TETS][12]; /* block (a, b), a != b, see sc_fem.c */
+    SC_ALIGN_HOT uint32_t tet_blk[SC_MAX_TETS][6]; /* block of each vertex pair, see sc_fem.c */
 } sc_fem;
 
 /* Defaults: beta 0.1 s (the MSDS damper ratio of Algorithm 1), alpha 0, linear (paper). */
@@ -126,8 +137,7 @@ int sc_fem_def_validate(const sc_fem_def *def);
  * sc_material_table_validate), SC_ERR_CASE_LABEL (a tet label without a table row),
  * SC_ERR_FEM_PATTERN (a tet edge not between grid neighbours, or more blocks than
  * SC_MAX_FEM_NNZ_BLOCKS), SC_ERR_MESH_ORIENTATION (a tet with non-positive rest volume). */
-int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat,
-                const sc_fem_def *def);
+int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat, const sc_fem_def *def);
 
 /* Advance the nodes by dt_s: reads n->x, n->v (warm start) and the external forces n->f*,
  * writes n->x and n->v. Fixed nodes keep their position with zero velocity. Runs exactly

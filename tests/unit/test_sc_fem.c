@@ -11,6 +11,8 @@
 #include "sc_labels.h"
 #include "sc_material.h"
 #include "sc_mesh.h"
+#include "sc_msds.h"
+#include "sc_springs.h"
 
 static sc_mesh g_mesh;
 static sc_nodes g_nodes;
@@ -19,6 +21,8 @@ static sc_fem g_fem2;
 static sc_nodes g_nodes2;
 static sc_material_table g_mat;
 static uint8_t g_kin[SC_MAX_NODES];
+static sc_springs g_springs;
+static sc_msds g_msds;
 
 /* Box of the default mesh definition (40 x 20 x 30 mm), nx x ny x nz nodes, all fat, bottom
  * and sides fixed (sc_material_assign without a label map). */
@@ -45,22 +49,26 @@ static void tet_centroid(const sc_mesh *m, uint32_t e, float c[3])
     }
 }
 
-/* y = K x with the FEM's blocks (interleaved xyz), double accumulation: the test's oracle. */
+/* y = K x with the FEM's upper-triangle blocks (interleaved xyz; block (i, j) also acts as
+ * (j, i)^T), double accumulation: the test's oracle. */
 static void k_times(const sc_fem *f, const double *x, double *y)
 {
+    for (uint32_t k = 0; k < 3u * f->node_count; k++) {
+        y[k] = 0.0;
+    }
     for (uint32_t i = 0; i < f->node_count; i++) {
-        double s[3] = {0.0, 0.0, 0.0};
         for (uint32_t b = f->row_start[i]; b < f->row_start[i + 1u]; b++) {
             const uint32_t c = f->col[b];
             for (uint32_t r = 0; r < 3u; r++) {
                 for (uint32_t q = 0; q < 3u; q++) {
-                    s[r] += (double)f->blk[b][3u * r + q] * x[3u * c + q];
+                    const double v = (double)f->blk[b][4u * r + q];
+                    y[3u * i + r] += v * x[3u * c + q];
+                    if (c != i) {
+                        y[3u * c + q] += v * x[3u * i + r];
+                    }
                 }
             }
         }
-        y[3u * i] = s[0];
-        y[3u * i + 1u] = s[1];
-        y[3u * i + 2u] = s[2];
     }
 }
 
@@ -118,7 +126,7 @@ static void init_rejects_invalid_inputs(void **state)
     assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_OK);
 }
 
-static void pattern_has_diagonal_plus_one_block_per_edge_direction(void **state)
+static void pattern_has_diagonal_then_one_block_per_edge_above_it(void **state)
 {
     (void)state;
     make_mesh(5, 4, 3);
@@ -139,30 +147,26 @@ static void pattern_has_diagonal_plus_one_block_per_edge_direction(void **state)
             }
         }
     }
-    assert_int_equal(g_fem.nnz_blocks, g_mesh.node_count + 2u * edges);
+    assert_int_equal(g_fem.nnz_blocks, g_mesh.node_count + edges);
+    uint32_t found = 0;
     for (uint32_t i = 0; i < g_mesh.node_count; i++) {
-        uint32_t seen = 0;
-        for (uint32_t b = g_fem.row_start[i]; b < g_fem.row_start[i + 1u]; b++) {
+        assert_true(g_fem.row_start[i] < g_fem.row_start[i + 1u]);
+        assert_int_equal(g_fem.col[g_fem.row_start[i]], i); /* diagonal first */
+        for (uint32_t b = g_fem.row_start[i] + 1u; b < g_fem.row_start[i + 1u]; b++) {
             const uint32_t c = g_fem.col[b];
-            if (b > g_fem.row_start[i]) {
-                assert_true(c > g_fem.col[b - 1u]); /* sorted, no duplicates */
-            }
-            if (c == i) {
-                assert_int_equal(g_fem.diag_blk[i], b);
-            } else {
-                assert_true(adj[i][c]);
-            }
-            seen++;
+            assert_true(c > i && c > g_fem.col[b - 1u]); /* above the diagonal, sorted */
+            assert_true(adj[i][c]);
+            found++;
         }
-        assert_true(seen >= 1u && seen <= 19u);
+        assert_true(g_fem.row_start[i + 1u] - g_fem.row_start[i] <= 10u);
     }
+    assert_int_equal(found, edges);
     /* the configured bound holds for the largest mesh */
     make_mesh(SC_MAX_MESH_NX, SC_MAX_MESH_NY, SC_MAX_MESH_NZ);
     assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_OK);
     assert_true(g_fem.nnz_blocks <= SC_MAX_FEM_NNZ_BLOCKS);
-    print_message("blocks at %ux%ux%u: %u (limit %u), sizeof(sc_fem) %zu B\n", g_mesh.nx,
-                  g_mesh.ny, g_mesh.nz, g_fem.nnz_blocks, (unsigned)SC_MAX_FEM_NNZ_BLOCKS,
-                  sizeof(sc_fem));
+    print_message("blocks at %ux%ux%u: %u (limit %u), sizeof(sc_fem) %zu B\n", g_mesh.nx, g_mesh.ny,
+                  g_mesh.nz, g_fem.nnz_blocks, (unsigned)SC_MAX_FEM_NNZ_BLOCKS, sizeof(sc_fem));
 }
 
 /* ---- element stiffness ------------------------------------------------------------------- */
@@ -176,7 +180,7 @@ static double max_abs(const double *v, uint32_t count)
     return m;
 }
 
-static void stiffness_is_symmetric_and_annihilates_rigid_motions(void **state)
+static void stiffness_annihilates_rigid_motions_and_diagonal_blocks_are_symmetric(void **state)
 {
     (void)state;
     make_mesh(6, 5, 4);
@@ -189,19 +193,18 @@ static void stiffness_is_symmetric_and_annihilates_rigid_motions(void **state)
     const uint32_t n = g_mesh.node_count;
     double kmax = 0.0;
     for (uint32_t i = 0; i < n; i++) {
-        for (uint32_t b = g_fem.row_start[i]; b < g_fem.row_start[i + 1u]; b++) {
-            const uint32_t j = g_fem.col[b];
-            uint32_t t = g_fem.row_start[j];
-            while (g_fem.col[t] != i) {
-                t++;
+        const float *D = g_fem.blk[g_fem.row_start[i]];
+        for (uint32_t r = 0; r < 3u; r++) {
+            assert_true(D[5u * r] > 0.0f);           /* positive diagonal */
+            assert_true(same(D[4u * r + 3u], 0.0f)); /* padding lane */
+            for (uint32_t c = 0; c < 3u; c++) {
+                /* mirrored on assembly: exact */
+                assert_true(same(D[4u * r + c], D[4u * c + r]));
             }
-            for (uint32_t r = 0; r < 3u; r++) {
-                for (uint32_t c = 0; c < 3u; c++) {
-                    /* assembled from the same products in the same order: exact */
-                    assert_true(memcmp(&g_fem.blk[b][3u * r + c], &g_fem.blk[t][3u * c + r],
-                                       sizeof(float)) == 0);
-                    kmax = fmax(kmax, fabs((double)g_fem.blk[b][3u * r + c]));
-                }
+        }
+        for (uint32_t b = g_fem.row_start[i]; b < g_fem.row_start[i + 1u]; b++) {
+            for (uint32_t k = 0; k < SC_FEM_BLK_FLOATS; k++) {
+                kmax = fmax(kmax, fabs((double)g_fem.blk[b][k]));
             }
         }
     }
@@ -286,8 +289,8 @@ static void linear_field_gives_no_interior_force_and_exact_energy(void **state)
             }
         }
     }
-    print_message("patch test: interior |f| %.2e N vs boundary %.2e N; u.Ku %.6e vs %.6e\n",
-                  fint, fbnd, uku, energy2);
+    print_message("patch test: interior |f| %.2e N vs boundary %.2e N; u.Ku %.6e vs %.6e\n", fint,
+                  fbnd, uku, energy2);
     /* float blocks: relative rounding ~1e-7 per term, ~20 terms of boundary-force size */
     assert_true(fbnd > 0.0);
     assert_true(fint < 1.0e-5 * fbnd);
@@ -348,50 +351,56 @@ static void solver_converges_to_the_static_patch_solution(void **state)
                                fmaxf(fabsf(g_nodes.y[id] - ey), fabsf(g_nodes.z[id] - ez))));
         umax = fmaxf(umax, fabsf(ez - X[2]));
     }
-    print_message("patch solution: max error %.2e mm of max displacement %.3f mm\n",
-                  (double)err, (double)umax);
+    print_message("patch solution: max error %.2e mm of max displacement %.3f mm\n", (double)err,
+                  (double)umax);
     /* 1e-3 of the displacement: far below a pixel, far above float rounding (1e-6) */
     assert_true(err < 1.0e-3f * umax);
     assert_int_equal(sc_fem_status(&g_fem), SC_OK);
 }
 
 /* A displaced state released without forces returns to rest without oscillating: the
- * tracked displacement never changes sign and shrinks monotonically (over-damped). */
+ * tracked displacement never changes sign and shrinks monotonically (over-damped), both with
+ * the frame period as step and with the facade's step (20 x 0.01 s = 0.2 s per frame). */
 static void released_displacement_returns_to_rest_over_damped(void **state)
 {
     (void)state;
-    make_mesh(16, 8, 8);
-    sc_fem_def def = sc_fem_default_def();
-    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_OK);
-    uint32_t probe = 0;
-    float best = 1e9f;
-    for (uint32_t i = 0; i < g_mesh.node_count; i++) {
-        if (g_mesh.node_fixed[i]) {
-            continue;
+    const float dts[2] = {1.0f / 60.0f, 0.2f};
+    for (uint32_t run = 0; run < 2u; run++) {
+        make_mesh(16, 8, 8);
+        sc_fem_def def = sc_fem_default_def();
+        def.corotated = (uint8_t)run; /* both models */
+        assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_OK);
+        uint32_t probe = 0;
+        float best = 1e9f;
+        for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+            if (g_mesh.node_fixed[i]) {
+                continue;
+            }
+            const float dx = g_mesh.rest_x[i] - 20.0f, dy = g_mesh.rest_y[i] - 10.0f,
+                        dz = g_mesh.rest_z[i];
+            const float r2 = dx * dx + dy * dy + dz * dz;
+            g_nodes.z[i] += 3.0f * expf(-r2 / 50.0f); /* smooth dent of 3 mm under the top */
+            if (r2 < best) {
+                best = r2;
+                probe = i;
+            }
         }
-        const float dx = g_mesh.rest_x[i] - 20.0f, dy = g_mesh.rest_y[i] - 10.0f,
-                    dz = g_mesh.rest_z[i];
-        const float r2 = dx * dx + dy * dy + dz * dz;
-        g_nodes.z[i] += 3.0f * expf(-r2 / 50.0f); /* smooth dent of 3 mm under the top */
-        if (r2 < best) {
-            best = r2;
-            probe = i;
+        float prev = g_nodes.z[probe] - g_mesh.rest_z[probe];
+        assert_true(prev > 2.0f);
+        const float start = prev;
+        for (uint32_t frame = 0; frame < 120u; frame++) {
+            sc_fem_step(&g_fem, &g_mesh, &g_nodes, dts[run], 20u);
+            const float u = g_nodes.z[probe] - g_mesh.rest_z[probe];
+            assert_true(u >= -0.01f * start); /* no overshoot through rest beyond 1% */
+            assert_true(u <= prev + 1e-6f);   /* monotonic decay */
+            prev = u;
         }
+        const float dev = max_dev_from_rest_mm(&g_mesh, &g_nodes);
+        print_message("released dent (%s, dt %.3f s): %.3f mm -> max deviation %.2e mm after "
+                      "120 frames\n",
+                      run ? "corotated" : "linear", (double)dts[run], (double)start, (double)dev);
+        assert_true(dev < 0.01f * start);
     }
-    float prev = g_nodes.z[probe] - g_mesh.rest_z[probe];
-    assert_true(prev > 2.0f);
-    const float start = prev;
-    for (uint32_t frame = 0; frame < 120u; frame++) {
-        sc_fem_step(&g_fem, &g_mesh, &g_nodes, 1.0f / 60.0f, 20u);
-        const float u = g_nodes.z[probe] - g_mesh.rest_z[probe];
-        assert_true(u >= -0.01f * start); /* no overshoot through rest beyond 1% */
-        assert_true(u <= prev + 1e-6f);     /* monotonic decay */
-        prev = u;
-    }
-    const float dev = max_dev_from_rest_mm(&g_mesh, &g_nodes);
-    print_message("released dent: %.3f mm -> max deviation %.2e mm after 2 s\n",
-                  (double)start, (double)dev);
-    assert_true(dev < 0.01f * start);
 }
 
 static void fixed_nodes_never_move_and_forces_push_free_nodes(void **state)
@@ -456,8 +465,9 @@ static void corotated_model_is_invariant_under_rigid_rotation(void **state)
         }
         drift[mode] = d;
     }
-    print_message("rigid 40 deg rotation, drift after 5 frames: corotated %.2e mm, linear %.3f mm\n",
-                  (double)drift[0], (double)drift[1]);
+    print_message(
+        "rigid 40 deg rotation, drift after 5 frames: corotated %.2e mm, linear %.3f mm\n",
+        (double)drift[0], (double)drift[1]);
     /* corotated: rounding only (positions ~40 mm, float eps 4e-6 mm, amplified by the polar
      * iteration): 1e-3 mm; linear: the rotation looks like a ~30% strain, mm-scale motion */
     assert_true(drift[0] < 1.0e-3f);
@@ -470,8 +480,8 @@ static void corotated_model_is_invariant_under_rigid_rotation(void **state)
 /* Phantom in the default box (x lateral 0..40, y along the vessels 0..20, z depth 0..30 mm):
  * fat; muscle below 20 mm; a vessel of radius 3 mm at (x 13, z 10) with vessel_a's label and
  * one at (x 27, z 10) with vessel_b's. Bottom and sides fixed. */
-#define SCENE_VEIN_X_MM 13.0f
-#define SCENE_ART_X_MM 27.0f
+#define SCENE_VEIN_X_MM   13.0f
+#define SCENE_ART_X_MM    27.0f
 #define SCENE_VESSEL_Z_MM 10.0f
 #define SCENE_VESSEL_R_MM 3.0f
 /* Probe footprint: a linear probe, 36 mm aperture (x 2..38) x 12 mm elevation (y 4..16). */
@@ -510,8 +520,8 @@ static void label_volume(const sc_mesh *m, const sc_nodes *n, uint8_t lab, float
     for (uint32_t e = 0; e < m->tet_count; e++) {
         float c[3];
         tet_centroid(m, e, c);
-        if (m->tet_label[e] != lab || c[1] < SCENE_MEAS_Y0 || c[1] > SCENE_MEAS_Y1 ||
-            c[0] < x0 || c[0] > x1) {
+        if (m->tet_label[e] != lab || c[1] < SCENE_MEAS_Y0 || c[1] > SCENE_MEAS_Y1 || c[0] < x0 ||
+            c[0] > x1) {
             continue;
         }
         *vol += (double)sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[e]);
@@ -526,10 +536,10 @@ typedef struct scene_result {
     float box_mm;
 } scene_result;
 
-#define SCENE_FRAME_DT_S 0.01f /* the FEM step per frame (SC_PHYS_DT_DEFAULT_S) */
+#define SCENE_FRAME_DT_S   0.01f /* the FEM step per frame (SC_PHYS_DT_DEFAULT_S) */
 #define SCENE_PRESS_FRAMES 30u
-#define SCENE_HOLD_FRAMES 30u
-#define SCENE_LIFT_FRAMES 120u /* 2 s at 60 Hz frames */
+#define SCENE_HOLD_FRAMES  20u
+#define SCENE_LIFT_FRAMES  120u /* 2 s at 60 Hz frames */
 
 /* Prescribed-displacement indentation: the top nodes in the footprint are driven 15% of the
  * box depth down over SCENE_PRESS_FRAMES, held, then released. */
@@ -582,22 +592,28 @@ static scene_result run_scene(sc_fem *f, sc_nodes *n, uint8_t label_a, uint8_t l
     return res;
 }
 
+/* The thrombosed-vein scene runs in the default (linear) model only: it is the same solver
+ * path as the vein scene, and the corotated scenes cost the most test time. */
 static void check_clinical(int corotated)
 {
     scene_result a = run_scene(&g_fem, &g_nodes, SC_LABEL_VEIN, SC_LABEL_ARTERY, corotated,
                                SC_MAX_MESH_NX, SC_MAX_MESH_NY, SC_MAX_MESH_NZ);
-    scene_result b = run_scene(&g_fem, &g_nodes, SC_LABEL_THROMBUS, SC_LABEL_ARTERY, corotated,
-                               SC_MAX_MESH_NX, SC_MAX_MESH_NY, SC_MAX_MESH_NZ);
-    print_message("FEM %s, 15%% indentation: vein -%.0f%%, artery -%.0f%%, thrombosed vein "
-                  "-%.0f%%; 2 s after lift max deviation %.3f / %.3f mm (1%% box = %.2f mm)\n",
+    print_message("FEM %s, 15%% indentation: vein -%.1f%%, artery -%.1f%%; 2 s after lift max "
+                  "deviation %.2e mm (1%% box = %.2f mm)\n",
                   corotated ? "corotated" : "linear", 100.0 * a.shrink_a, 100.0 * a.shrink_b,
-                  100.0 * b.shrink_a, (double)a.dev_after_lift_mm, (double)b.dev_after_lift_mm,
-                  (double)(0.01f * a.box_mm));
+                  (double)a.dev_after_lift_mm, (double)(0.01f * a.box_mm));
     assert_true(a.shrink_a >= 0.60);
     assert_true(a.shrink_b <= 0.20);
-    assert_true(b.shrink_a <= 0.20);
     assert_true(a.dev_after_lift_mm <= 0.01f * a.box_mm);
-    assert_true(b.dev_after_lift_mm <= 0.01f * b.box_mm);
+    if (!corotated) {
+        scene_result b = run_scene(&g_fem, &g_nodes, SC_LABEL_THROMBUS, SC_LABEL_ARTERY, corotated,
+                                   SC_MAX_MESH_NX, SC_MAX_MESH_NY, SC_MAX_MESH_NZ);
+        print_message("FEM linear: thrombosed vein -%.1f%%, artery -%.1f%%; after lift %.2e mm\n",
+                      100.0 * b.shrink_a, 100.0 * b.shrink_b, (double)b.dev_after_lift_mm);
+        assert_true(b.shrink_a <= 0.20);
+        assert_true(b.shrink_b <= 0.20);
+        assert_true(b.dev_after_lift_mm <= 0.01f * b.box_mm);
+    }
 }
 
 static void clinical_vein_collapses_artery_and_thrombus_resist_linear(void **state)
@@ -657,6 +673,12 @@ static void steps_are_bitwise_deterministic(void **state)
     }
     print_message("state hash after 40 frames: linear %016llx corotated %016llx\n",
                   (unsigned long long)h[0][0], (unsigned long long)h[1][0]);
+    /* Stored values: the same in Debug (-O0, sanitizers) and Release (-O3) on x86-64, since
+     * the core is built with -ffp-contract=off and every reduction has a fixed order. A change
+     * here is a change of the numerics (FEM, mesh, materials or fixed nodes): update the
+     * values deliberately, in the same commit, saying why. */
+    assert_true(h[0][0] == UINT64_C(0x5cdac37fec797074));
+    assert_true(h[1][0] == UINT64_C(0xca0010e60d660e59));
 }
 
 /* ---- run-time switches -------------------------------------------------------------------- */
@@ -706,12 +728,116 @@ static void corotation_switch_mid_compression_does_not_jump(void **state)
     assert_true(worst <= 1.0f);
 }
 
+/* ---- MSDS vs FEM ------------------------------------------------------------------------ */
+
+typedef struct compare_result {
+    double rms_mm, max_mm;    /* node displacement difference MSDS - FEM over the free nodes */
+    double uz6_msds, uz6_fem; /* vertical displacement under the probe centre at 6 mm depth */
+} compare_result;
+
+/* The same prescribed indentation on the same mesh and labels: the top nodes under the
+ * footprint are driven press_mm down over 10 frames (continuously: a little before every
+ * MSDS substep), then held 50 frames, by which both methods have settled. MSDS: Algorithm 1
+ * springs, 20 explicit Euler steps of 0.01 s per frame; FEM: linear, one implicit step of
+ * 0.2 s per frame with 20 CG iterations (as sc_tissue runs it). The probe nodes are fixed
+ * nodes moved by the test: the same Dirichlet data for both methods. */
+static compare_result compare_indentation(uint8_t label_a, uint8_t label_b, float press_mm)
+{
+    make_mesh(SC_MAX_MESH_NX, SC_MAX_MESH_NY, SC_MAX_MESH_NZ);
+    label_scene(&g_mesh, label_a, label_b);
+    for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+        const float x = g_mesh.rest_x[i], y = g_mesh.rest_y[i];
+        g_kin[i] = (is_top(&g_mesh, i) && x >= SCENE_PROBE_X0 && x <= SCENE_PROBE_X1 &&
+                    y >= SCENE_PROBE_Y0 && y <= SCENE_PROBE_Y1);
+        if (g_kin[i]) {
+            g_mesh.node_fixed[i] = 1u;
+        }
+    }
+    assert_int_equal(
+        sc_springs_from_tets(&g_springs, g_mesh.tet, g_mesh.tet_label, g_mesh.tet_count, &g_mat),
+        SC_OK);
+    const sc_msds_def md = sc_msds_default_def();
+    assert_int_equal(sc_msds_init(&g_msds, &g_mesh, &g_springs, &g_mat, &md), SC_OK);
+    const sc_fem_def fd = sc_fem_default_def();
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &fd), SC_OK);
+    sc_nodes_reset_to_rest(&g_nodes, &g_mesh);  /* MSDS */
+    sc_nodes_reset_to_rest(&g_nodes2, &g_mesh); /* FEM */
+    const float frame_dt_s = md.dt_s * (float)md.iterations;
+    const float per_sub_mm = press_mm / (10.0f * (float)md.iterations);
+    for (uint32_t frame = 0; frame < 60u; frame++) {
+        for (uint32_t sub = 0; sub < md.iterations; sub++) {
+            for (uint32_t i = 0; frame < 10u && i < g_mesh.node_count; i++) {
+                g_nodes.z[i] += g_kin[i] ? per_sub_mm : 0.0f;
+            }
+            sc_msds_substep(&g_msds, &g_nodes);
+        }
+        for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+            g_nodes2.z[i] = g_kin[i] ? g_nodes.z[i] : g_nodes2.z[i];
+        }
+        sc_fem_step(&g_fem, &g_mesh, &g_nodes2, frame_dt_s, md.iterations);
+    }
+    compare_result r;
+    double sum2 = 0.0;
+    uint32_t count = 0;
+    r.max_mm = 0.0;
+    for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+        if (g_mesh.node_fixed[i]) {
+            continue;
+        }
+        const double dx = (double)g_nodes.x[i] - (double)g_nodes2.x[i];
+        const double dy = (double)g_nodes.y[i] - (double)g_nodes2.y[i];
+        const double dz = (double)g_nodes.z[i] - (double)g_nodes2.z[i];
+        const double d2 = dx * dx + dy * dy + dz * dz;
+        sum2 += d2;
+        r.max_mm = fmax(r.max_mm, sqrt(d2));
+        count++;
+    }
+    r.rms_mm = sqrt(sum2 / (double)count);
+    const uint32_t c6 = g_mesh.nx / 2u + g_mesh.nx * (g_mesh.ny / 2u + g_mesh.ny * 3u);
+    r.uz6_msds = (double)(g_nodes.z[c6] - g_mesh.rest_z[c6]);
+    r.uz6_fem = (double)(g_nodes2.z[c6] - g_mesh.rest_z[c6]);
+    assert_int_equal(sc_fem_status(&g_fem), SC_OK);
+    return r;
+}
+
+/* Indentation of one cell height (2 mm, 6.7% of the depth): both fields are driven by the
+ * same boundary displacement and the same stiffness ratios between labels (k = 0.002 E per
+ * spring); they differ through the constitutive models: a central-force spring lattice has
+ * its own effective Poisson ratio (about 0.25) where the FEM uses 0.45 (vein 0.3), so the
+ * lateral bulge around the probe differs. Measured: RMS 4-5% of the indentation; asserted:
+ * at most 10%, homogeneous and with the vessels.
+ * At the clinical 15% (4.5 mm, more than two cell heights) the MSDS's top layer of springs
+ * snaps through (the probe nodes pass the nodes below them: a mirrored, nearly unstressed
+ * configuration of the springs) and the two methods disagree; printed, not asserted (a
+ * limitation of the MSDS, reported, not something the FEM can fix). */
+static void msds_and_fem_respond_alike_to_the_same_indentation(void **state)
+{
+    (void)state;
+    const float press_mm = 2.0f;
+    const compare_result h = compare_indentation(SC_LABEL_FAT, SC_LABEL_FAT, press_mm);
+    const compare_result c = compare_indentation(SC_LABEL_VEIN, SC_LABEL_ARTERY, press_mm);
+    const compare_result deep = compare_indentation(SC_LABEL_VEIN, SC_LABEL_ARTERY, 4.5f);
+    print_message("MSDS vs FEM, %.1f mm indentation: difference RMS %.3f mm (%.1f%%), max %.3f mm "
+                  "(homogeneous); RMS %.3f mm (%.1f%%), max %.3f mm (vein + artery); u_z at 6 mm "
+                  "under the probe %.3f / %.3f mm\n",
+                  (double)press_mm, h.rms_mm, 100.0 * h.rms_mm / (double)press_mm, h.max_mm,
+                  c.rms_mm, 100.0 * c.rms_mm / (double)press_mm, c.max_mm, c.uz6_msds, c.uz6_fem);
+    print_message("MSDS vs FEM, 4.5 mm (15%%) indentation: difference RMS %.3f mm (%.1f%%), u_z "
+                  "at 6 mm under the probe MSDS %.3f mm, FEM %.3f mm (MSDS top layer snaps "
+                  "through)\n",
+                  deep.rms_mm, 100.0 * deep.rms_mm / 4.5, deep.uz6_msds, deep.uz6_fem);
+    assert_true(h.rms_mm <= 0.10 * (double)press_mm);
+    assert_true(c.rms_mm <= 0.10 * (double)press_mm);
+    /* the comparison can fail: the two methods do see the indentation at depth */
+    assert_true(c.uz6_fem > 0.3 * (double)press_mm && c.uz6_msds > 0.3 * (double)press_mm);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(init_rejects_invalid_inputs),
-        cmocka_unit_test(pattern_has_diagonal_plus_one_block_per_edge_direction),
-        cmocka_unit_test(stiffness_is_symmetric_and_annihilates_rigid_motions),
+        cmocka_unit_test(pattern_has_diagonal_then_one_block_per_edge_above_it),
+        cmocka_unit_test(stiffness_annihilates_rigid_motions_and_diagonal_blocks_are_symmetric),
         cmocka_unit_test(linear_field_gives_no_interior_force_and_exact_energy),
         cmocka_unit_test(solver_converges_to_the_static_patch_solution),
         cmocka_unit_test(released_displacement_returns_to_rest_over_damped),
@@ -721,6 +847,7 @@ int main(void)
         cmocka_unit_test(corotation_switch_mid_compression_does_not_jump),
         cmocka_unit_test(clinical_vein_collapses_artery_and_thrombus_resist_linear),
         cmocka_unit_test(clinical_vein_collapses_artery_and_thrombus_resist_corotated),
+        cmocka_unit_test(msds_and_fem_respond_alike_to_the_same_indentation),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
