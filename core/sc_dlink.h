@@ -171,7 +171,8 @@ void sc_dlink_asm_init(sc_dlink_asm *a);
  * with sc_dlink_asm_done() before the next push), 0 when not, or the negative decode error when
  * the packet was rejected (counted in stats, state unchanged). Frame numbers compare in serial
  * arithmetic (wrap-safe): a packet of a frame newer than the open one closes it and opens the
- * new one. O(len + samples), plus O(lines x samples) to carry lost rows over on a close. */
+ * new one. (A FRAME_END of a newer frame whose other packets were all lost closes two frames in
+ * one push; both are counted, only the second is left to read.) O(len + samples), plus O(lines x samples) to carry lost rows over on a close. */
 int sc_dlink_asm_push(sc_dlink_asm *a, const uint8_t *pkt, size_t len);
 
 /* Close the open frame, if any (end of stream). Returns 1 when a frame closed, else 0. */
