@@ -13,8 +13,10 @@ static const int8_t s_dir[SC_MSDS_FAMILIES][3] = {
     {1, 0, 1}, {-1, 0, 1}, {0, 1, 1}, {0, -1, 1},
 };
 
-/* shortest spring accepted in the force law (mm): guards 1/|d| in a collapsed spring */
-#define SC_MSDS_MIN_LEN_MM 1e-6f
+/* added to |d|^2 in the force law (mm^2): guards 1/|d| in a collapsed spring */
+#define SC_MSDS_MIN_LEN2_MM2 1e-12f
+/* velocities below this are set to 0 (see integrate) */
+#define SC_MSDS_V_FLUSH_MM_S 1e-12f
 
 sc_msds_def sc_msds_default_def(void)
 {
@@ -126,7 +128,7 @@ int sc_msds_init(sc_msds *s, const sc_mesh *m, const sc_springs *sp,
         const float kmm = k * 1e-3f;
         const float dx = m->rest_x[b] - m->rest_x[a], dy = m->rest_y[b] - m->rest_y[a],
                     dz = m->rest_z[b] - m->rest_z[a];
-        const float len = sqrtf(dx * dx + dy * dy + dz * dz);
+        const float len = sqrtf(dx * dx + dy * dy + dz * dz + SC_MSDS_MIN_LEN2_MM2);
         s->k_n_per_mm[fam][a] = kmm;
         s->l0_mm[fam][a] = len;
         s->ksum_n_per_mm[a] += kmm;
@@ -191,7 +193,9 @@ static void family_forces(uint32_t cnt, uint32_t o, float gk, const float *restr
         const float dy = y[i + o] - y[i];
         const float dz = z[i + o] - z[i];
         const float len2 = dx * dx + dy * dy + dz * dz;
-        const float len = fmaxf(sqrtf(len2), SC_MSDS_MIN_LEN_MM);
+        /* guard of 1/|d| for a collapsed spring without a branch or fmaxf (either stops the
+         * vectoriser); the same formula gives the rest lengths in sc_msds_init */
+        const float len = sqrtf(len2 + SC_MSDS_MIN_LEN2_MM2);
         const float inv = 1.0f / len;
         const float dvx = vx[i + o] - vx[i];
         const float dvy = vy[i + o] - vy[i];
@@ -232,9 +236,14 @@ static void integrate(uint32_t cnt, float dt, float drag, const float *restrict 
         const float w = inv_m[i] * dt;
         /* eq. 3-4: v += dt (f - s) / m  (f*: external + spring forces, sign included);
          * the drag is an external force -c m v; fixed nodes have w = 0 and v = 0 */
-        const float nvx = (w > 0.0f ? keep * vx[i] : 0.0f) + w * fx[i];
-        const float nvy = (w > 0.0f ? keep * vy[i] : 0.0f) + w * fy[i];
-        const float nvz = (w > 0.0f ? keep * vz[i] : 0.0f) + w * fz[i];
+        float nvx = (w > 0.0f ? keep * vx[i] : 0.0f) + w * fx[i];
+        float nvy = (w > 0.0f ? keep * vy[i] : 0.0f) + w * fy[i];
+        float nvz = (w > 0.0f ? keep * vz[i] : 0.0f) + w * fz[i];
+        /* a settling velocity decays geometrically into subnormal floats, which cost ~100x
+         * per operation on x86 without flush-to-zero; 1e-12 mm/s is physically zero */
+        nvx = fabsf(nvx) < SC_MSDS_V_FLUSH_MM_S ? 0.0f : nvx;
+        nvy = fabsf(nvy) < SC_MSDS_V_FLUSH_MM_S ? 0.0f : nvy;
+        nvz = fabsf(nvz) < SC_MSDS_V_FLUSH_MM_S ? 0.0f : nvz;
         vx[i] = nvx;
         vy[i] = nvy;
         vz[i] = nvz;
@@ -296,7 +305,8 @@ float sc_msds_elastic_energy_j(const sc_msds *s, const sc_nodes *n)
         for (uint32_t i = 0; o < nn && i < nn - o; i++) {
             const float dx = n->x[i + o] - n->x[i], dy = n->y[i + o] - n->y[i],
                         dz = n->z[i + o] - n->z[i];
-            const double ext = (double)sqrtf(dx * dx + dy * dy + dz * dz) - (double)s->l0_mm[d][i];
+            const double ext = (double)sqrtf(dx * dx + dy * dy + dz * dz + SC_MSDS_MIN_LEN2_MM2) -
+                               (double)s->l0_mm[d][i];
             e += 0.5 * (double)s->k_n_per_mm[d][i] * ext * ext * 1e-3;
         }
     }

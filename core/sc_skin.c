@@ -8,7 +8,7 @@
 #include "sc_err.h"
 #include "sc_springs.h"
 
-#define SC_SKIN_MIN_LEN_MM 1e-6f
+#define SC_SKIN_MIN_LEN2_MM2 1e-12f
 
 sc_skin_def sc_skin_default_def(void)
 {
@@ -113,7 +113,7 @@ int sc_skin_init(sc_skin *s, const sc_skin_def *def)
             if (has) {
                 const uint32_t m = n + s->off[f];
                 const float dx = s->rest_x[m] - s->rest_x[n], dy = s->rest_y[m] - s->rest_y[n];
-                s->l0_fam[f][n] = sqrtf(dx * dx + dy * dy);
+                s->l0_fam[f][n] = sqrtf(dx * dx + dy * dy + SC_SKIN_MIN_LEN2_MM2);
                 s->ksum_n_per_mm[n] += def->k_edge_n_per_mm;
                 s->ksum_n_per_mm[m] += def->k_edge_n_per_mm;
             }
@@ -146,7 +146,8 @@ static void skin_substep(sc_skin *s)
         for (uint32_t n = 0; n + o < nn; n++) {
             const uint32_t m = n + o;
             const float dx = x[m] - x[n], dy = y[m] - y[n], dz = z[m] - z[n];
-            const float len = fmaxf(sqrtf(dx * dx + dy * dy + dz * dz), SC_SKIN_MIN_LEN_MM);
+            const float len2 = dx * dx + dy * dy + dz * dz;
+            const float len = sqrtf(len2 + SC_SKIN_MIN_LEN2_MM2);
             const float inv = 1.0f / len;
             const float rate = (dx * (vx[m] - vx[n]) + dy * (vy[m] - vy[n]) +
                                 dz * (vz[m] - vz[n])) * inv;
@@ -165,6 +166,10 @@ static void skin_substep(sc_skin *s)
         vx[n] = keep * vx[n] + w * ax_[n];
         vy[n] = keep * vy[n] + w * ay_[n];
         vz[n] = keep * vz[n] + w * az_[n];
+        /* keep decaying velocities out of the (slow) subnormal range, as sc_msds */
+        vx[n] = fabsf(vx[n]) < 1e-12f ? 0.0f : vx[n];
+        vy[n] = fabsf(vy[n]) < 1e-12f ? 0.0f : vy[n];
+        vz[n] = fabsf(vz[n]) < 1e-12f ? 0.0f : vz[n];
         x[n] += dt * vx[n];
         y[n] += dt * vy[n];
         z[n] += dt * vz[n];

@@ -1,0 +1,312 @@
+/* sc_tissue.c: per-frame soft-tissue facade (MSDS / FEM, collider, skin, guard). */
+#include "sc_tissue.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <string.h>
+
+#include "sc_assert.h"
+#include "sc_err.h"
+
+sc_tissue_def sc_tissue_default_def(void)
+{
+    sc_tissue_def d;
+    memset(&d, 0, sizeof d);
+    d.mesh = sc_mesh_default_def();
+    d.msds = sc_msds_default_def();
+    d.fem = sc_fem_default_def();
+    d.collider = sc_collider_default_def();
+    d.skin = sc_skin_default_def();
+    d.skin.origin_mm[0] = d.mesh.origin_mm[0];
+    d.skin.origin_mm[1] = d.mesh.origin_mm[1];
+    d.skin.size_mm[0] = d.mesh.size_mm[0];
+    d.skin.size_mm[1] = d.mesh.size_mm[1];
+    d.skin.z_mm = d.mesh.origin_mm[2];
+    d.skin_enabled = 1u;
+    d.method = SC_TISSUE_MSDS;
+    d.msds_contact = SC_TISSUE_CONTACT_PROJECT;
+    return d;
+}
+
+static sc_collider_grid mesh_grid(const sc_mesh *m)
+{
+    sc_collider_grid g;
+    g.nx = m->nx;
+    g.ny = m->ny;
+    g.nz = m->nz;
+    for (uint32_t i = 0; i < 3u; i++) {
+        g.origin_mm[i] = m->origin_mm[i];
+        g.cell_mm[i] = m->cell_mm[i];
+    }
+    return g;
+}
+
+void sc_tissue_reset(sc_tissue *t)
+{
+    sc_nodes_reset_to_rest(&t->nodes, &t->mesh);
+    sc_skin_reset(&t->skin);
+    t->contacts.count = 0u;
+    for (uint32_t i = 0; i < t->mesh.node_count; i++) {
+        t->kinematic[i] = 0u;
+    }
+    t->stats.max_disp_mm = 0.0f;
+}
+
+int sc_tissue_init(sc_tissue *t, const sc_tissue_def *def, const sc_volume *vol,
+                   const sc_material_table *mat, uint8_t default_label)
+{
+    if (t == NULL || def == NULL || mat == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    if (def->method != SC_TISSUE_MSDS && def->method != SC_TISSUE_FEM) {
+        return SC_ERR_INVALID_ARG;
+    }
+    int rc = sc_material_table_validate(mat);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    t->def = *def;
+    t->method = def->method;
+    t->mat = *mat;
+    memset(&t->stats, 0, sizeof t->stats);
+    rc = sc_mesh_build(&t->mesh, &def->mesh);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    rc = sc_material_assign(&t->mesh, vol, &t->mat, default_label);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    rc = sc_springs_from_tets(&t->springs, (const uint32_t(*)[4])t->mesh.tet,
+                              t->mesh.tet_label, t->mesh.tet_count, &t->mat);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    rc = sc_msds_init(&t->msds, &t->mesh, &t->springs, &t->mat, &def->msds);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    rc = sc_fem_init(&t->fem, &t->mesh, &t->mat, &def->fem);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    rc = sc_collider_init(&t->collider, &def->collider);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    sc_skin_def sd = def->skin;
+    if (!def->skin_enabled) {
+        /* a minimal, never stepped surface keeps the struct valid */
+        sd = sc_skin_default_def();
+        sd.nx = 2u;
+        sd.ny = 2u;
+    }
+    rc = sc_skin_init(&t->skin, &sd);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    const float *s = def->mesh.size_mm;
+    t->box_diag_mm = sqrtf(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    sc_tissue_reset(t);
+    return SC_OK;
+}
+
+int sc_tissue_set_method(sc_tissue *t, sc_tissue_method m)
+{
+    if (t == NULL || (m != SC_TISSUE_MSDS && m != SC_TISSUE_FEM)) {
+        return SC_ERR_INVALID_ARG;
+    }
+    if (m != t->method) {
+        for (uint32_t i = 0; i < t->mesh.node_count; i++) {
+            t->kinematic[i] = 0u;
+        }
+        t->method = m;
+    }
+    return SC_OK;
+}
+
+int sc_tissue_set_msds_def(sc_tissue *t, const sc_msds_def *def)
+{
+    if (t == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    const int rc = sc_msds_set_def(&t->msds, def);
+    if (rc == SC_OK) {
+        t->def.msds = *def;
+    }
+    return rc;
+}
+
+/* Projection contact: the repulsion that removes a node's penetration within one step (an
+ * external force f = m (depth / dt^2 - v_n / dt) n, applied as its effect on x and v). */
+static void project_contacts(sc_tissue *t)
+{
+    sc_nodes *n = &t->nodes;
+    for (uint32_t q = 0; q < t->contacts.count; q++) {
+        const sc_contact *ct = &t->contacts.c[q];
+        const uint32_t i = ct->node;
+        const float d = sc_contact_depth_mm(ct, n->x[i], n->y[i], n->z[i]);
+        if (d > 0.0f) {
+            n->x[i] += d * ct->n[0];
+            n->y[i] += d * ct->n[1];
+            n->z[i] += d * ct->n[2];
+            const float vn = n->vx[i] * ct->n[0] + n->vy[i] * ct->n[1] + n->vz[i] * ct->n[2];
+            if (vn < 0.0f) {
+                n->vx[i] -= vn * ct->n[0];
+                n->vy[i] -= vn * ct->n[1];
+                n->vz[i] -= vn * ct->n[2];
+            }
+        }
+    }
+}
+
+static void step_msds(sc_tissue *t)
+{
+    sc_nodes *n = &t->nodes;
+    const float ratio = t->msds.def.contact_stiffness_ratio;
+    for (uint32_t it = 0; it < t->msds.def.iterations; it++) {
+        if (t->def.msds_contact == SC_TISSUE_CONTACT_PENALTY) {
+            sc_contact_clear_forces(&t->contacts, n->fx, n->fy, n->fz);
+            sc_contact_add_forces(&t->contacts, n->x, n->y, n->z, t->msds.ksum_n_per_mm, ratio,
+                                  n->fx, n->fy, n->fz);
+        }
+        sc_msds_substep(&t->msds, n);
+        if (t->def.msds_contact == SC_TISSUE_CONTACT_PROJECT) {
+            project_contacts(t);
+        }
+    }
+    sc_contact_clear_forces(&t->contacts, n->fx, n->fy, n->fz);
+}
+
+static void step_fem(sc_tissue *t)
+{
+    sc_nodes *n = &t->nodes;
+    const float dt_frame = t->msds.def.dt_s * (float)t->msds.def.iterations;
+    /* nodes in the probe or on its surface (within the hold tolerance: a node left exactly on
+     * the surface by the last frame, or by the MSDS before a switch, must stay held, or the
+     * tissue under it would push it into the probe for one frame) */
+    uint32_t held = 0;
+    for (uint32_t q = 0; q < t->contacts.count; q++) {
+        const sc_contact *ct = &t->contacts.c[q];
+        const uint32_t i = ct->node;
+        const float d = sc_contact_depth_mm(ct, n->x[i], n->y[i], n->z[i]);
+        if (d > -SC_TISSUE_CONTACT_HOLD_MM) {
+            t->kinematic[i] = 1u;
+            const float dd = d > 0.0f ? d : 0.0f;
+            n->vx[i] = dd * ct->n[0] / dt_frame;
+            n->vy[i] = dd * ct->n[1] / dt_frame;
+            n->vz[i] = dd * ct->n[2] / dt_frame;
+            held++;
+        }
+    }
+    sc_fem_step_kinematic(&t->fem, &t->mesh, n, dt_frame, t->msds.def.iterations,
+                          t->kinematic);
+    for (uint32_t q = 0; q < t->contacts.count; q++) {
+        const uint32_t i = t->contacts.c[q].node;
+        if (t->kinematic[i] != 0u) {
+            /* the node sits on the probe: it carries no velocity of its own; clear the flag
+             * (O(contacts), every node with a flag is a contact of this frame) */
+            n->vx[i] = 0.0f;
+            n->vy[i] = 0.0f;
+            n->vz[i] = 0.0f;
+            t->kinematic[i] = 0u;
+        }
+    }
+    t->stats.kinematic = held;
+}
+
+/* Guard pass: finite check, largest displacement. O(N). */
+static int guard(sc_tissue *t)
+{
+    const sc_nodes *n = &t->nodes;
+    const sc_mesh *m = &t->mesh;
+    float maxd2 = 0.0f;
+    float acc = 0.0f;
+    for (uint32_t i = 0; i < m->node_count; i++) {
+        const float dx = n->x[i] - m->rest_x[i], dy = n->y[i] - m->rest_y[i],
+                    dz = n->z[i] - m->rest_z[i];
+        const float d2 = dx * dx + dy * dy + dz * dz;
+        maxd2 = d2 > maxd2 ? d2 : maxd2;
+        acc += d2 * 0.0f + (n->vx[i] + n->vy[i] + n->vz[i]) * 0.0f;
+    }
+    const float maxd = sqrtf(maxd2);
+    t->stats.max_disp_mm = maxd;
+    if (!isfinite(acc) || !isfinite(maxd) || maxd > t->box_diag_mm) {
+        return 0;
+    }
+    if (t->method == SC_TISSUE_MSDS) {
+        const float ek = sc_msds_kinetic_energy_j(&t->msds, n);
+        if (!isfinite(ek) || ek > t->msds.energy_limit_j) {
+            return 0;
+        }
+    } else if (sc_fem_status(&t->fem) != SC_OK) {
+        return 0;
+    }
+    if (t->def.skin_enabled) {
+        if (!sc_skin_is_finite(&t->skin) ||
+            !(sc_skin_max_displacement_mm(&t->skin) <= t->box_diag_mm)) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+int sc_tissue_step(sc_tissue *t, const sc_pose *probe)
+{
+    SC_ASSERT(t != NULL);
+    int rc = sc_collider_set_pose(&t->collider, probe);
+    const sc_collider_grid g = mesh_grid(&t->mesh);
+    sc_collider_detect(&t->collider, &g, t->nodes.x, t->nodes.y, t->nodes.z,
+                       t->mesh.node_fixed, t->stats.max_disp_mm, &t->contacts);
+    t->stats.contacts = t->contacts.count;
+    if (t->method == SC_TISSUE_MSDS) {
+        t->stats.kinematic = 0u;
+        step_msds(t);
+    } else {
+        step_fem(t);
+    }
+    uint32_t mpr = t->contacts.mpr_calls;
+    if (t->def.skin_enabled) {
+        sc_skin_step(&t->skin, &t->collider);
+        mpr += t->skin.contacts.mpr_calls;
+    }
+    t->stats.mpr_calls = mpr;
+    t->stats.frames++;
+    if (!guard(t)) {
+        t->stats.faults++;
+        if (t->method == SC_TISSUE_FEM) {
+            /* the FEM's sticky status is cleared by re-initialising it on the same mesh */
+            (void)sc_fem_init(&t->fem, &t->mesh, &t->mat, &t->def.fem);
+        }
+        sc_tissue_reset(t);
+        return SC_ERR_PHYS_UNSTABLE;
+    }
+    return rc;
+}
+
+static uint64_t fnv(uint64_t h, const float *v, uint32_t count)
+{
+    const unsigned char *b = (const unsigned char *)v;
+    const size_t bytes = (size_t)count * sizeof(float);
+    for (size_t i = 0; i < bytes; i++) {
+        h ^= b[i];
+        h *= 0x100000001B3u;
+    }
+    return h;
+}
+
+uint64_t sc_tissue_state_hash(const sc_tissue *t)
+{
+    uint64_t h = 0xCBF29CE484222325u;
+    const uint32_t nn = t->mesh.node_count;
+    h = fnv(h, t->nodes.x, nn);
+    h = fnv(h, t->nodes.y, nn);
+    h = fnv(h, t->nodes.z, nn);
+    h = fnv(h, t->nodes.vx, nn);
+    h = fnv(h, t->nodes.vy, nn);
+    h = fnv(h, t->nodes.vz, nn);
+    h = fnv(h, t->skin.x, t->skin.count);
+    h = fnv(h, t->skin.y, t->skin.count);
+    h = fnv(h, t->skin.z, t->skin.count);
+    return h;
+}

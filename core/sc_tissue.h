@@ -1,0 +1,130 @@
+/*
+ * sc_tissue.h: the soft-tissue facade the engine calls once per frame.
+ *
+ * Owns the tet mesh and its node state, the material table, Algorithm 1's springs, the MSDS,
+ * the FEM, the probe collider, the skin and the stability guard. One frame:
+ *   1. place the probe (pose of the probe frame in the volume frame) or lift it (NULL);
+ *   2. contacts of the tet mesh's nodes with the probe (sc_collider.h, libccd MPR);
+ *   3. MSDS: def.msds.iterations explicit Euler steps (dt each), the repulsion forces
+ *      kappa * depth * normal re-evaluated on the contact planes before every step
+ *      (kappa = contact_stiffness_ratio * sum of the node's spring constants);
+ *      FEM: one implicit step of length iterations * dt (the same simulated time per frame
+ *      as the MSDS) with `iterations` CG iterations; nodes in the probe or on its surface
+ *      (depth > -SC_TISSUE_CONTACT_HOLD_MM) are moved onto the surface as kinematic
+ *      (Dirichlet) nodes (sc_fem_step_kinematic), so a static probe does not make a surface
+ *      node chatter, and a node is released as soon as the probe moves away from it;
+ *   4. the skin MSDS (sc_skin.h) with the same collider;
+ *   5. stability guard: any non-finite position or velocity, a node displaced by more than
+ *      the box diagonal, or (MSDS) kinetic energy above the energy of every spring stretched
+ *      by its own length, resets the tissue and the skin to rest, counts the fault and makes
+ *      the step return SC_ERR_PHYS_UNSTABLE: the diverged state never reaches the image.
+ * Switching MSDS <-> FEM at run time changes only which solver advances the shared sc_nodes:
+ * the shape and the velocities carry over, nothing is reallocated or rebuilt.
+ *
+ * Memory: one caller-owned sc_tissue (about 13 MB at the default limits, dominated by the
+ * FEM's matrix; static storage or locked memory). Never allocates, never calls the OS.
+ * Deterministic: same definition, case and pose sequence give bit-identical states
+ * (sc_tissue_state_hash). Threads: one writer; readers (B-scan) read t->nodes between steps.
+ */
+#ifndef SC_TISSUE_H
+#define SC_TISSUE_H
+
+#include <stdint.h>
+
+#include "sc_collider.h"
+#include "sc_fem.h"
+#include "sc_material.h"
+#include "sc_mesh.h"
+#include "sc_msds.h"
+#include "sc_pose.h"
+#include "sc_skin.h"
+#include "sc_springs.h"
+#include "sc_volume.h"
+
+/* FEM: a contact node is held on the probe surface while its depth is above -this (mm); a
+ * probe lifted slower than this per frame (0.06 mm/s at 60 Hz) would drag the skin along */
+#define SC_TISSUE_CONTACT_HOLD_MM 1e-3f
+
+typedef enum sc_tissue_method {
+    SC_TISSUE_MSDS = 0,
+    SC_TISSUE_FEM = 1,
+} sc_tissue_method;
+
+/* How the MSDS answers a contact (the FEM always holds penetrating nodes on the surface). */
+typedef enum sc_tissue_contact {
+    SC_TISSUE_CONTACT_PROJECT = 0, /* repulsion that removes the penetration in one step */
+    SC_TISSUE_CONTACT_PENALTY = 1, /* the paper's spring-like repulsion kappa * depth */
+} sc_tissue_contact;
+
+typedef struct sc_tissue_def {
+    sc_mesh_def mesh;
+    sc_msds_def msds;         /* dt and iterations are used by both methods */
+    sc_fem_def fem;
+    sc_collider_def collider;
+    sc_skin_def skin;
+    uint8_t skin_enabled;     /* 0: no skin surface */
+    sc_tissue_method method;  /* at start */
+    sc_tissue_contact msds_contact;
+} sc_tissue_def;
+
+typedef struct sc_tissue_stats {
+    uint32_t frames;
+    uint32_t faults;            /* guard resets since init */
+    uint32_t contacts;          /* tet-mesh contacts of the last frame */
+    uint32_t kinematic;         /* FEM: nodes held on the probe surface in the last frame */
+    uint32_t mpr_calls;         /* narrow-phase calls of the last frame (mesh + skin) */
+    float max_disp_mm;          /* largest node displacement after the last frame */
+} sc_tissue_stats;
+
+typedef struct sc_tissue {
+    sc_tissue_def def;
+    sc_tissue_method method;
+    sc_material_table mat;
+    sc_mesh mesh;
+    sc_nodes nodes;
+    sc_springs springs;
+    sc_msds msds;
+    sc_fem fem;
+    sc_collider collider;
+    sc_contact_set contacts;
+    sc_skin skin;
+    uint8_t kinematic[SC_MAX_NODES];
+    float box_diag_mm;
+    sc_tissue_stats stats;
+} sc_tissue;
+
+/* Defaults: default mesh (32x16x16 over 40 x 20 x 30 mm), MSDS, default collider (linear
+ * probe footprint), skin over the top of the box, FEM defaults. */
+sc_tissue_def sc_tissue_default_def(void);
+
+/* Build everything for a case: mesh, labels from vol's label map (see sc_material_assign;
+ * vol may be NULL: every tet gets default_label), springs, MSDS, FEM, collider, skin; state
+ * at rest. Call at case load. Cost: O(tets + nodes + springs) plus the FEM's assembly.
+ * Never allocates. Errors: SC_ERR_INVALID_ARG, and the errors of sc_mesh_build,
+ * sc_material_table_validate, sc_material_assign, sc_springs_from_tets, sc_msds_init,
+ * sc_fem_init, sc_collider_init, sc_skin_init. */
+int sc_tissue_init(sc_tissue *t, const sc_tissue_def *def, const sc_volume *vol,
+                   const sc_material_table *mat, uint8_t default_label);
+
+/* Run one frame with the probe at *probe (volume frame), or no contact (probe == NULL).
+ * Cost: MSDS O(iterations * 9 N + iterations * contacts); FEM: see sc_fem_step; collider
+ * O(contact-area candidates); skin O(iterations * skin particles); guard O(N).
+ * Never allocates. Returns 0, SC_ERR_POSE_IMPLAUSIBLE (pose refused: frame run without
+ * contact), or SC_ERR_PHYS_UNSTABLE (the guard reset the tissue to rest). */
+int sc_tissue_step(sc_tissue *t, const sc_pose *probe);
+
+/* Switch the solver; the current shape and velocities are kept. O(1) (O(N) on the FEM side:
+ * kinematic flags cleared). Errors: SC_ERR_INVALID_ARG (unknown method). */
+int sc_tissue_set_method(sc_tissue *t, sc_tissue_method m);
+
+/* Change dt and iterations (both methods) at run time. O(N) if the mass scaling changes.
+ * Errors: as sc_msds_def_validate. */
+int sc_tissue_set_msds_def(sc_tissue *t, const sc_msds_def *def);
+
+/* Back to rest (nodes, skin, contacts, kinematic flags). O(N). */
+void sc_tissue_reset(sc_tissue *t);
+
+/* FNV-1a 64 over positions and velocities of the nodes and the skin. O(N). */
+uint64_t sc_tissue_state_hash(const sc_tissue *t);
+
+#endif /* SC_TISSUE_H */

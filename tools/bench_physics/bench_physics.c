@@ -1,0 +1,116 @@
+/* bench_physics.c: soft-tissue cost per frame for the mesh sizes of the paper's Table I.
+ *
+ * Scene: the clinical block of tests/support/sc_test_tissue_scene.h (40 x 20 x 30 mm, fat,
+ * muscle, vein, artery) with the probe held 3 mm (10%) into the skin, so that contacts exist
+ * every frame. Per mesh size and method: `frames` frames after a warm-up; wall time of
+ * sc_tissue_step (solver + collision, skin off) and of the collision detection alone; one
+ * thread. Usage: bench-physics [frames]   (default 200) */
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include "sc_labels.h"
+#include "sc_stats.h"
+#include "sc_test_tissue_scene.h"
+#include "sc_tissue.h"
+
+static sc_tissue g_t;
+
+static uint64_t now_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
+}
+
+static double ms(uint64_t ns)
+{
+    return (double)ns / 1e6;
+}
+
+typedef struct result {
+    double mean_ms, p99_ms, coll_ms;
+    uint32_t contacts, mpr;
+} result;
+
+static int run(uint32_t nx, uint32_t ny, uint32_t nz, sc_tissue_method m, int frames,
+               result *out)
+{
+    sc_test_scene_params p = sc_test_scene_default_params();
+    p.nx = nx;
+    p.ny = ny;
+    p.nz = nz;
+    static sc_test_scene scene;
+    sc_test_scene_build(&scene, &p);
+    sc_tissue_def d = sc_tissue_default_def();
+    d.mesh = scene.mesh;
+    d.collider = sc_test_scene_collider(&scene);
+    d.skin_enabled = 0u;
+    d.method = m;
+    sc_material_table mat;
+    sc_material_table_default(&mat);
+    int rc = sc_tissue_init(&g_t, &d, &scene.vol, &mat, SC_LABEL_FAT);
+    if (rc != 0) {
+        return rc;
+    }
+    const sc_pose pose = sc_test_scene_probe(&scene, 3.0f);
+    for (int f = 0; f < 30; f++) { /* press in and settle */
+        const sc_pose q = sc_test_scene_probe(&scene, -0.5f + 3.5f * (float)(f + 1) / 30.0f);
+        (void)sc_tissue_step(&g_t, &q);
+    }
+    sc_stats st;
+    sc_stats_reset(&st);
+    uint64_t coll = 0;
+    const sc_collider_grid g = {g_t.mesh.nx, g_t.mesh.ny, g_t.mesh.nz,
+                                {g_t.mesh.origin_mm[0], g_t.mesh.origin_mm[1], g_t.mesh.origin_mm[2]},
+                                {g_t.mesh.cell_mm[0], g_t.mesh.cell_mm[1], g_t.mesh.cell_mm[2]}};
+    static sc_contact_set cs;
+    for (int f = 0; f < frames; f++) {
+        const uint64_t t0 = now_ns();
+        rc = sc_tissue_step(&g_t, &pose);
+        const uint64_t t1 = now_ns();
+        sc_stats_add(&st, t1 - t0);
+        sc_collider_detect(&g_t.collider, &g, g_t.nodes.x, g_t.nodes.y, g_t.nodes.z,
+                           g_t.mesh.node_fixed, g_t.stats.max_disp_mm, &cs);
+        coll += now_ns() - t1;
+        if (rc != 0) {
+            return rc;
+        }
+    }
+    out->mean_ms = ms(sc_stats_mean_ns(&st));
+    out->p99_ms = ms(sc_stats_percentile_ns(&st, 990));
+    out->coll_ms = ms(coll / (uint64_t)frames);
+    out->contacts = cs.count;
+    out->mpr = cs.mpr_calls;
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    const int frames = argc > 1 ? atoi(argv[1]) : 200;
+    static const uint32_t sizes[4][3] = {{20, 10, 10}, {24, 12, 12}, {28, 14, 14}, {32, 16, 16}};
+    static const double paper_msds[4] = {10, 17, 27, 40}, paper_fem[4] = {30, 60, 100, 150},
+                        paper_coll[4] = {0.1, 0.2, 0.2, 0.3};
+    printf("soft tissue, ms per frame (20 iterations, dt 0.01 s), one thread, %d frames, probe "
+           "3 mm in contact; paper Table I in brackets\n", frames);
+    printf("%-10s %6s %7s | %-22s | %-22s | %-26s\n", "mesh", "nodes", "tets",
+           "MSDS mean/p99 [paper]", "FEM mean/p99 [paper]", "collision ms (contacts) [paper]");
+    for (int s = 0; s < 4; s++) {
+        result a, b;
+        int rc = run(sizes[s][0], sizes[s][1], sizes[s][2], SC_TISSUE_MSDS, frames, &a);
+        rc |= run(sizes[s][0], sizes[s][1], sizes[s][2], SC_TISSUE_FEM, frames, &b);
+        if (rc != 0) {
+            fprintf(stderr, "run failed: %d\n", rc);
+            return 1;
+        }
+        char name[32];
+        snprintf(name, sizeof name, "%ux%ux%u", sizes[s][0], sizes[s][1], sizes[s][2]);
+        printf("%-10s %6u %7u | %6.2f / %6.2f [%4.0f] | %6.2f / %6.2f [%4.0f] | %6.3f (%4u, %4u MPR) "
+               "[%.1f]\n",
+               name, g_t.mesh.node_count, g_t.mesh.tet_count, a.mean_ms, a.p99_ms, paper_msds[s],
+               b.mean_ms, b.p99_ms, paper_fem[s], a.coll_ms, a.contacts, a.mpr, paper_coll[s]);
+    }
+    printf("sizeof(sc_tissue) = %zu bytes (sc_msds %zu, sc_fem %zu, sc_springs %zu)\n",
+           sizeof(sc_tissue), sizeof(sc_msds), sizeof(sc_fem), sizeof(sc_springs));
+    return 0;
+}
