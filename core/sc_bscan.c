@@ -207,7 +207,8 @@ static void emit_run(sc_bscan *b, uint32_t k0, uint32_t k1, const float a[3], co
 }
 
 /* Barycentric coordinates of a tet in the image frame as affine functions of the point:
- * lambda_i(p) = alpha[i] + g[i] . p. Returns 0 for a degenerate (flat) tet. */
+ * lambda_i(p) = alpha[i] + g[i] . p. Returns 1 for a positively oriented tet, -1 for an
+ * inverted one (still a valid point location), 0 for a degenerate (flat) one. */
 static int tet_affine(const sc_bscan *b, const uint32_t tv[4], float alpha[4], float g[4][3])
 {
     const float x0 = b->qx[tv[0]], y0 = b->qy[tv[0]], z0 = b->qz[tv[0]];
@@ -229,6 +230,7 @@ static int tet_affine(const sc_bscan *b, const uint32_t tv[4], float alpha[4], f
     if (!(fabsf(det) > 1e-12f)) {
         return 0;
     }
+    const int sign = det > 0.0f ? 1 : -1;
     const float inv = 1.0f / det;
     float sa = 0.0f, sg[3] = {0.0f, 0.0f, 0.0f};
     for (uint32_t i = 0; i < 3u; i++) {
@@ -243,7 +245,7 @@ static int tet_affine(const sc_bscan *b, const uint32_t tv[4], float alpha[4], f
     for (uint32_t d = 0; d < 3u; d++) {
         g[0][d] = -sg[d];
     }
-    return 1;
+    return sign;
 }
 
 /* ---- walker ------------------------------------------------------------------------------ */
@@ -391,39 +393,6 @@ static uint32_t line_events(sc_bscan *b, uint32_t l, uint32_t *active_n, const f
     return ne;
 }
 
-/* Brute-force point location in the image frame (rare fallback): the tet whose smallest
- * barycentric coordinate is largest, if that is >= -eps. O(tets). Returns -1 if none. */
-static int32_t locate_brute(const sc_bscan *b, const sc_mesh *m, float x, float z)
-{
-    int32_t best = -1;
-    float best_min = -SC_BSCAN_LAMBDA_EPS;
-    const float p[3] = {x, 0.0f, z};
-    for (uint32_t t = 0; t < m->tet_count; t++) {
-        const uint32_t *tv = m->tet[t];
-        float ymin = b->qy[tv[0]], ymax = ymin;
-        for (uint32_t v = 1; v < 4u; v++) {
-            ymin = fminf(ymin, b->qy[tv[v]]);
-            ymax = fmaxf(ymax, b->qy[tv[v]]);
-        }
-        if (ymin > 0.0f || ymax < 0.0f) {
-            continue;
-        }
-        float al[4], g[4][3];
-        if (!tet_affine(b, tv, al, g)) {
-            continue;
-        }
-        float lmin = 1.0f;
-        for (uint32_t i = 0; i < 4u; i++) {
-            lmin = fminf(lmin, al[i] + g[i][0] * p[0] + g[i][2] * p[2]);
-        }
-        if (lmin > best_min) {
-            best_min = lmin;
-            best = (int32_t)t;
-        }
-    }
-    return best;
-}
-
 /* The plane-affine maps of tet t for this frame, from a direct-mapped cache (adjacent scan
  * lines cross the same tets). Hit or miss, the values are the same: computed by one function
  * from the same inputs. */
@@ -437,7 +406,7 @@ static const sc_bscan_tcache *tet_cached(sc_bscan *b, const sc_mesh *m, uint32_t
     tc->tet = t;
     const uint32_t *tv = m->tet[t];
     float al[4], g[4][3];
-    tc->ok = (uint32_t)tet_affine(b, tv, al, g);
+    tc->ok = (uint32_t)(tet_affine(b, tv, al, g) == 1); /* the walker needs orientation */
     if (!tc->ok) {
         return tc;
     }
@@ -463,18 +432,20 @@ static const sc_bscan_tcache *tet_cached(sc_bscan *b, const sc_mesh *m, uint32_t
  * parameter s_in, writing the rest positions of the samples from *k on. Returns the parameter
  * where the walk left the mesh (or >= n when it reached the end of the line). */
 static float walk(sc_bscan *b, const sc_mesh *m, const frame_ctx *c, uint32_t t, uint32_t f_in,
-                  float s_in, uint32_t *k, uint32_t *steps)
+                  float s_in, uint32_t *k, uint32_t *steps, int *trouble)
 {
     const uint32_t n = c->n;
     for (;;) {
         if (*steps >= SC_BSCAN_MAX_WALK_STEPS) {
             b->status.walk_aborts++;
-            return (float)n; /* the rest of the line stays rigid */
+            *trouble = 1;
+            return (float)n;
         }
         (*steps)++;
         const sc_bscan_tcache *tc = tet_cached(b, m, t);
         if (!tc->ok) {
-            return s_in; /* flat tet: leave the mesh here */
+            *trouble = 1; /* flat or inverted tet: the walk cannot be trusted */
+            return (float)n;
         }
         float a[4], be[4];
         for (uint32_t i = 0; i < 4u; i++) {
@@ -491,7 +462,8 @@ static float walk(sc_bscan *b, const sc_mesh *m, const frame_ctx *c, uint32_t t,
             }
         }
         if (f_out == 4u) {
-            return s_in; /* no way out along the ray: degenerate, leave */
+            *trouble = 1; /* no way out along the ray: degenerate */
+            return (float)n;
         }
         float s_out = -a[f_out] / be[f_out];
         if (s_out < s_in) {
@@ -533,27 +505,22 @@ static float walk(sc_bscan *b, const sc_mesh *m, const frame_ctx *c, uint32_t t,
     }
 }
 
+static int build_regions(sc_bscan *b, const sc_mesh *m);
+static void map_line_regions(sc_bscan *b, uint32_t l, const frame_ctx *c);
+
 static void map_line_walk(sc_bscan *b, const sc_mesh *m, uint32_t l, uint32_t *active_n,
                           const frame_ctx *c)
 {
     const uint32_t ne = line_events(b, l, active_n, c);
     uint32_t k = 0, steps = 0, ei = 0;
+    int trouble = 0;
     if (ne > 0u && !b->events[0].entry) {
-        /* the line starts inside the mesh (far behind the face): locate its first pixel */
-        const float s_first_exit = b->events[0].s;
+        /* the line starts inside the mesh (behind the face) or the boundary is folded:
+         * harmless if that is behind the first pixel, else the walker has no entry */
+        trouble = b->events[0].s > 0.0f;
         ei = 1u;
-        if (s_first_exit > 0.0f) {
-            b->status.locate_fallbacks++;
-            const int32_t t0 = locate_brute(b, m, c->ox, c->oz);
-            if (t0 >= 0) {
-                const float sx = walk(b, m, c, (uint32_t)t0, 4u, 0.0f, &k, &steps);
-                while (ei < ne && b->events[ei].s < sx - 1e-3f) {
-                    ei++;
-                }
-            }
-        }
     }
-    while (ei < ne && k < c->n) {
+    while (!trouble && ei < ne && k < c->n) {
         const sc_bscan_event *e = &b->events[ei++];
         if (!e->entry) {
             continue;
@@ -562,13 +529,27 @@ static void map_line_walk(sc_bscan *b, const sc_mesh *m, uint32_t l, uint32_t *a
             break;
         }
         const sc_bscan_seg *s = &b->segs[e->seg];
-        const float sx = walk(b, m, c, s->tet, s->face, e->s, &k, &steps);
+        const float sx = walk(b, m, c, s->tet, s->face, e->s, &k, &steps, &trouble);
         /* boundary crossings before the exit are behind us */
         while (ei < ne && b->events[ei].s < sx - 1e-3f) {
             ei++;
         }
     }
     b->status.walk_steps += steps;
+    if (trouble) {
+        /* inverted or flat tets, a folded boundary, a line starting inside the mesh: this
+         * line goes through point location (the region path), which needs none of it */
+        if (b->regions_state == 0u) {
+            b->regions_state = build_regions(b, m) ? 1u : 2u;
+        }
+        if (b->regions_state == 1u) {
+            b->run_count = 0u;
+            map_line_regions(b, l, c);
+            b->status.line_fallbacks++;
+        } else {
+            b->status.region_overflows++;
+        }
+    }
 }
 
 /* ---- region path (paper section IV) ---------------------------------------------------- */
@@ -1209,6 +1190,7 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes,
     }
 
     uint32_t mapper = b->def.mapper;
+    b->regions_state = 0u;
     if (mesh != NULL) {
         const sc_xform vol2img = sc_xform_inverse(&c.img2vol);
         const float *r = vol2img.r, *t = vol2img.t_mm;
@@ -1220,6 +1202,7 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes,
         }
         if (mapper == SC_BSCAN_MAP_REGIONS) {
             if (build_regions(b, mesh)) {
+                b->regions_state = 1u;
                 st->plane_tets = b->ptet_count;
             } else {
                 st->region_overflows++;

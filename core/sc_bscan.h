@@ -19,11 +19,15 @@
  *   through a boundary triangle (found among the boundary triangles cut by the image plane) and
  *   walks from tet to face neighbour, the exit parameter of each tet coming from its
  *   barycentric coordinates along the ray; inside a tet the rest position is affine in the
- *   sample index.
+ *   sample index. A line the walker cannot trust (an inverted or flat tet on its way, a folded
+ *   boundary, a start inside the mesh) is redone by the region path, which is point location
+ *   and needs no orientation.
  *
  * The compression measure comes from the same pass: for each label, the image area whose rest
  * position has that label now, against the area with that label in the rigid (undeformed) slice
- * at the same pose: the instructor's "did the vein collapse?".
+ * at the same pose: the instructor's "did the vein collapse?". Known limit: the reference covers
+ * the same pixels, so a structure within the press depth of the probe face at rest is cut from
+ * the reference too (the ratio then overstates what is left of it).
  *
  * Memory: all state in the caller's sc_bscan, sized by config/sc_config.h (about 2 MB with the
  * default limits). Never allocates, never calls the OS. Threads: one writer. Deterministic:
@@ -80,8 +84,9 @@ typedef struct sc_bscan_status {
     /* cumulative counters of degraded work (each stays exact or falls back, see .c) */
     uint32_t walk_aborts;        /* a line exceeded SC_BSCAN_MAX_WALK_STEPS */
     uint32_t event_overflows;    /* a line crossed the boundary > SC_BSCAN_MAX_LINE_EVENTS */
-    uint32_t locate_fallbacks;   /* a line start inside the mesh, located by brute force */
-    uint32_t region_overflows;   /* region path over its limits: frame done by the walker */
+    uint32_t line_fallbacks;     /* lines the walker handed to the region path (inverted or
+                                    flat tets, folded boundary, line start inside the mesh) */
+    uint32_t region_overflows;   /* region path over its limits (walker result kept) */
     uint32_t display_errors;     /* display calls that returned an error */
 } sc_bscan_status;
 
@@ -160,6 +165,7 @@ typedef struct sc_bscan {
     sc_bscan_tcache tcache[SC_BSCAN_TET_CACHE];
     /* region path */
     uint32_t ptet_count;
+    uint32_t regions_state;      /* this frame: 0 not built, 1 built, 2 over the limits */
     sc_bscan_ptet ptets[SC_BSCAN_MAX_PLANE_TETS];
     int32_t ptet_lo[SC_BSCAN_MAX_PLANE_TETS];
     int32_t ptet_hi[SC_BSCAN_MAX_PLANE_TETS];
@@ -204,8 +210,8 @@ int sc_bscan_attach_mesh(sc_bscan *b, const sc_mesh *mesh);
  * O(tets + lines * samples * tets per region) worst case; oracle O(pixels * tets). Bounded by
  * SC_MAX_NODES, SC_MAX_TETS, SC_MAX_SCAN_LINES, SC_MAX_SCAN_SAMPLES, SC_BSCAN_MAX_WALK_STEPS.
  * Never allocates.
- * Errors: SC_ERR_INVALID_ARG (NULL b/volume/probe/display, volume without voxels, mesh not the
- * attached one), SC_ERR_CASE_TRANSFORM (probe transform not rigid or not finite), or the first
+ * Errors: SC_ERR_INVALID_ARG (NULL b/volume/probe/display, volume without voxels or with an
+ * axis of fewer than 2 voxels, mesh not the attached one), SC_ERR_CASE_TRANSFORM (probe transform not rigid or not finite), or the first
  * error a display call returned (the frame is still computed and streamed to the end). */
 int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes,
                    const sc_volume *volume, const sc_xform *probe_to_volume, int contact,

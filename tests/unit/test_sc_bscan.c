@@ -273,6 +273,47 @@ static void fast_paths_match_oracle_on_deformed_full_mesh(void **state)
     check_against_oracle(small_def(0, 24, 80), &probe, 80u);
 }
 
+/* A node pushed through its neighbours inverts tets: the walker cannot follow its faces there,
+ * hands those lines to point location (the region path), and the image agrees with the region
+ * path's everywhere but on face ties. */
+static void lines_through_inverted_tets_fall_back_to_point_location(void **state)
+{
+    (void)state;
+    build_mesh(16, 8, 8);
+    deform(SCN_DEFORM_DENT, 4.0f, 0);
+    /* the node nearest to (20, 10, 8): pushed up by 1.6 cells in z, through its upper
+     * neighbours' cells */
+    uint32_t best = 0;
+    float bd = 1e9f;
+    for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+        const float dx = g_mesh.rest_x[i] - 20.0f, dy = g_mesh.rest_y[i] - 10.0f,
+                    dz = g_mesh.rest_z[i] - 8.0f;
+        const float d2 = dx * dx + dy * dy + dz * dz;
+        if (d2 < bd) {
+            bd = d2;
+            best = i;
+        }
+    }
+    g_nodes.z[best] -= 1.6f * g_mesh.cell_mm[2];
+    uint32_t inverted = 0;
+    for (uint32_t t = 0; t < g_mesh.tet_count; t++) {
+        inverted += sc_mesh_tet_volume_mm3(g_nodes.x, g_nodes.y, g_nodes.z, g_mesh.tet[t]) <= 0.0f;
+    }
+    assert_true(inverted > 0u);
+    /* the image plane through the pushed node */
+    const sc_xform probe = scn_probe(20.0f, g_mesh.rest_y[best], 4.0f, 0.0f);
+    sc_bscan_def d = small_def(SC_BSCAN_MAP_WALK, 64, 160);
+    render(&d, &probe, 1, g_a);
+    assert_true(g_b.status.line_fallbacks > 0u);
+    assert_int_equal(g_b.status.walk_aborts, 0);
+    d.mapper = SC_BSCAN_MAP_REGIONS;
+    render(&d, &probe, 1, g_o);
+    const uint32_t n = d.scan.lines_n * d.scan.samples_n;
+    cmp_result r = compare(g_a, g_o, n);
+    assert_true(r.equal * 1000u >= n * 999u);
+    assert_true(r.max_diff <= 1u);
+}
+
 /* ---- dark images ------------------------------------------------------------------------- */
 
 static void probe_in_air_gives_dark_image(void **state)
@@ -522,6 +563,7 @@ int main(void)
         cmocka_unit_test(linear_fast_paths_match_oracle_on_deformed_small_mesh),
         cmocka_unit_test(curvilinear_fast_paths_match_oracle_on_deformed_small_mesh),
         cmocka_unit_test(fast_paths_match_oracle_on_deformed_full_mesh),
+        cmocka_unit_test(lines_through_inverted_tets_fall_back_to_point_location),
         cmocka_unit_test(probe_in_air_gives_dark_image),
         cmocka_unit_test(gain_tgc_and_dynamic_range_follow_the_display_formula),
         cmocka_unit_test(lines_stream_in_order_between_begin_and_end_with_frame_number),
