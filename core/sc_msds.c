@@ -235,12 +235,14 @@ static void integrate(uint32_t cnt, float dt, float drag, const float *restrict 
     for (uint32_t i = 0; i < cnt; i++) {
         const float w = inv_m[i] * dt;
         /* eq. 3-4: v += dt (f - s) / m  (f*: external + spring forces, sign included);
-         * the drag is an external force -c m v; fixed nodes have w = 0 and v = 0 */
-        float nvx = (w > 0.0f ? keep * vx[i] : 0.0f) + w * fx[i];
-        float nvy = (w > 0.0f ? keep * vy[i] : 0.0f) + w * fy[i];
-        float nvz = (w > 0.0f ? keep * vz[i] : 0.0f) + w * fz[i];
+         * the drag is an external force -c m v; fixed nodes have w = 0, and their v is 0
+         * (reset and never written), so it stays 0 */
+        float nvx = keep * vx[i] + w * fx[i];
+        float nvy = keep * vy[i] + w * fy[i];
+        float nvz = keep * vz[i] + w * fz[i];
         /* a settling velocity decays geometrically into subnormal floats, which cost ~100x
-         * per operation on x86 without flush-to-zero; 1e-12 mm/s is physically zero */
+         * per operation on x86 without flush-to-zero; 1e-12 mm/s is physically zero (a
+         * select of two computed values: the loop still vectorises) */
         nvx = fabsf(nvx) < SC_MSDS_V_FLUSH_MM_S ? 0.0f : nvx;
         nvy = fabsf(nvy) < SC_MSDS_V_FLUSH_MM_S ? 0.0f : nvy;
         nvz = fabsf(nvz) < SC_MSDS_V_FLUSH_MM_S ? 0.0f : nvz;
