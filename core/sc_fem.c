@@ -33,6 +33,29 @@ static const uint8_t k_pair_b[6] = {1u, 2u, 3u, 2u, 3u, 3u};
 /* det F below this: the element is flat or inverted; polar factor undefined: use R = I. */
 #define SC_FEM_DET_MIN 1.0e-3f
 
+/* 4-lane float vectors: GCC/Clang vector extension (plain SIMD on SSE2 / NEON, lowered to
+ * scalar code on targets without SIMD); other compilers take the scalar loops. Both do the
+ * same IEEE operations per lane in the same order: results are bitwise identical. */
+#if defined(__GNUC__)
+#define SC_FEM_VEC 1
+typedef float sc_fem_v4 __attribute__((vector_size(16)));
+static inline sc_fem_v4 v4_load(const float *p)
+{
+    sc_fem_v4 v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
+static inline void v4_store(float *p, sc_fem_v4 v)
+{
+    memcpy(p, &v, sizeof v);
+}
+static inline sc_fem_v4 v4_splat(float x)
+{
+    const sc_fem_v4 v = {x, x, x, x};
+    return v;
+}
+#endif
+
 sc_fem_def sc_fem_default_def(void)
 {
     sc_fem_def d;
@@ -108,7 +131,7 @@ static int polar_rotation(const float F[9], float R[9])
             diff2 += d * d;
             x[i] = nv;
         }
-        if (diff2 < 1.0e-11f) {
+        if (diff2 < 1.0e-8f) {
             break;
         }
     }
@@ -119,7 +142,7 @@ static int polar_rotation(const float F[9], float R[9])
 }
 
 /* Shape gradients of tet e (n[0] = -(n1 + n2 + n3)), 1/mm. */
-static void tet_grads(const float dmi[9], float n[4][3])
+static void tet_grads(const float dmi[9], float n[4][4])
 {
     for (uint32_t d = 0; d < 3u; d++) {
         n[1][d] = dmi[d];
@@ -127,11 +150,14 @@ static void tet_grads(const float dmi[9], float n[4][3])
         n[3][d] = dmi[6u + d];
         n[0][d] = -(n[1][d] + n[2][d] + n[3][d]);
     }
+    for (uint32_t a = 0; a < 4u; a++) {
+        n[a][3] = 0.0f;
+    }
 }
 
 /* Add the element blocks built from gradients g (rest or rotated) into the matrix. */
 static void add_tet_blocks(sc_fem *f, const uint32_t tet[4], const uint32_t blk_idx[6],
-                           const float g[4][3], float lam_v, float mu_v)
+                           const float g[4][4], float lam_v, float mu_v)
 {
     for (uint32_t a = 0; a < 4u; a++) {
         float *B = f->blk[f->row_start[tet[a]]]; /* the diagonal block leads its row */
@@ -147,30 +173,33 @@ static void add_tet_blocks(sc_fem *f, const uint32_t tet[4], const uint32_t blk_
         }
     }
     for (uint32_t p = 0; p < 6u; p++) {
-        const uint32_t a = k_pair_a[p], b = k_pair_b[p];
-        const float dd = mu_v * (g[a][0] * g[b][0] + g[a][1] * g[b][1] + g[a][2] * g[b][2]);
-        float kab[9];
-        for (uint32_t r = 0; r < 3u; r++) {
-            for (uint32_t c = 0; c < 3u; c++) {
-                kab[3u * r + c] = lam_v * g[a][r] * g[b][c] + mu_v * g[b][r] * g[a][c];
-            }
-            kab[4u * r] += dd;
-        }
+        /* the stored block is K_ab, or K_ba = K_ab^T: the same formula with a and b swapped */
         const uint32_t bi = blk_idx[p];
+        const int tr = (bi & SC_FEM_BLK_TRANSPOSED) != 0u;
+        const uint32_t a = tr ? k_pair_b[p] : k_pair_a[p];
+        const uint32_t b = tr ? k_pair_a[p] : k_pair_b[p];
+        const float dd = mu_v * (g[a][0] * g[b][0] + g[a][1] * g[b][1] + g[a][2] * g[b][2]);
         float *B = f->blk[bi & ~SC_FEM_BLK_TRANSPOSED];
-        if ((bi & SC_FEM_BLK_TRANSPOSED) == 0u) {
-            for (uint32_t r = 0; r < 3u; r++) {
-                for (uint32_t c = 0; c < 3u; c++) {
-                    B[4u * r + c] += kab[3u * r + c];
+        /* row r of K_ab: (lambda V g_a[r]) g_b + (mu V g_b[r]) g_a, plus dd on the diagonal */
+#if defined(SC_FEM_VEC)
+        const sc_fem_v4 ga = v4_load(g[a]), gb = v4_load(g[b]);
+        for (uint32_t r = 0; r < 3u; r++) {
+            sc_fem_v4 row = v4_splat(lam_v * g[a][r]) * gb + v4_splat(mu_v * g[b][r]) * ga;
+            row[r] += dd;
+            v4_store(&B[4u * r], v4_load(&B[4u * r]) + row);
+        }
+#else
+        for (uint32_t r = 0; r < 3u; r++) {
+            const float la = lam_v * g[a][r], mb = mu_v * g[b][r];
+            for (uint32_t c = 0; c < 4u; c++) {
+                float v = la * g[b][c] + mb * g[a][c];
+                if (c == r) {
+                    v += dd;
                 }
-            }
-        } else {
-            for (uint32_t r = 0; r < 3u; r++) {
-                for (uint32_t c = 0; c < 3u; c++) {
-                    B[4u * c + r] += kab[3u * r + c];
-                }
+                B[4u * r + c] += v;
             }
         }
+#endif
     }
 }
 
@@ -186,7 +215,7 @@ static void assemble_rest(sc_fem *f, const sc_mesh *m)
 {
     zero_floats(&f->blk[0][0], SC_FEM_BLK_FLOATS * f->nnz_blocks);
     for (uint32_t e = 0; e < f->tet_count; e++) {
-        float n[4][3];
+        float n[4][4];
         tet_grads(f->dm_inv[e], n);
         const uint8_t lab = m->tet_label[e];
         add_tet_blocks(f, m->tet[e], f->tet_blk[e], n, f->lambda_nmm2[lab] * f->vol_mm3[e],
@@ -241,7 +270,7 @@ static void assemble_corotated(sc_fem *f, const sc_mesh *m, float *restrict fel)
             }
             sig[4u * r] += lam * tr - 2.0f * mu;
         }
-        float n[4][3], g[4][3];
+        float n[4][4], g[4][4];
         tet_grads(dmi, n);
         for (uint32_t a = 0; a < 4u; a++) {
             float s[3];
@@ -254,35 +283,13 @@ static void assemble_corotated(sc_fem *f, const sc_mesh *m, float *restrict fel)
                 fa[r] -= vol * (R[3u * r] * s[0] + R[3u * r + 1u] * s[1] + R[3u * r + 2u] * s[2]);
                 g[a][r] = R[3u * r] * n[a][0] + R[3u * r + 1u] * n[a][1] + R[3u * r + 2u] * n[a][2];
             }
+            g[a][3] = 0.0f;
         }
         add_tet_blocks(f, t, f->tet_blk[e], g, lam * vol, mu * vol);
     }
     f->stats.degenerate_tets = degenerate;
     f->matrix_is_rest = 0u;
 }
-
-/* 4-lane float vectors: GCC/Clang vector extension (plain SIMD on SSE2 / NEON, lowered to
- * scalar code on targets without SIMD); other compilers take the scalar loops. Both do the
- * same IEEE operations per lane in the same order: results are bitwise identical. */
-#if defined(__GNUC__)
-#define SC_FEM_VEC 1
-typedef float sc_fem_v4 __attribute__((vector_size(16)));
-static inline sc_fem_v4 v4_load(const float *p)
-{
-    sc_fem_v4 v;
-    memcpy(&v, p, sizeof v);
-    return v;
-}
-static inline void v4_store(float *p, sc_fem_v4 v)
-{
-    memcpy(p, &v, sizeof v);
-}
-static inline sc_fem_v4 v4_splat(float x)
-{
-    const sc_fem_v4 v = {x, x, x, x};
-    return v;
-}
-#endif
 
 /* q = cm M p + ck K p over the symmetric block CSR (upper triangle stored: each row is its
  * diagonal block, then the blocks (i, j > i); block (i, j) also acts as (j, i)^T). Vectors and
@@ -354,16 +361,29 @@ static void matvec(const sc_fem *f, const float *restrict p, float *restrict q, 
     }
 }
 
-/* Dot product with 8 partial sums in a fixed order (deterministic, vectorisable). */
+/* Dot product with 8 partial sums in a fixed order (deterministic; two 4-lane accumulators
+ * with the vector extension, the same sums lane by lane as the scalar loop). */
 static float dot(const float *restrict a, const float *restrict b, uint32_t count)
 {
     float s[8] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
     uint32_t i = 0;
+#if defined(SC_FEM_VEC)
+    sc_fem_v4 s0 = v4_splat(0.0f), s1 = v4_splat(0.0f);
+    for (; i + 8u <= count; i += 8u) {
+        s0 += v4_load(&a[i]) * v4_load(&b[i]);
+        s1 += v4_load(&a[i + 4u]) * v4_load(&b[i + 4u]);
+    }
+    for (uint32_t k = 0; k < 4u; k++) {
+        s[k] = s0[k];
+        s[4u + k] = s1[k];
+    }
+#else
     for (; i + 8u <= count; i += 8u) {
         for (uint32_t k = 0; k < 8u; k++) {
             s[k] += a[i + k] * b[i + k];
         }
     }
+#endif
     for (; i < count; i++) {
         s[0] += a[i] * b[i];
     }
@@ -596,7 +616,7 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
     SC_ASSERT(f != NULL && m != NULL && n != NULL);
     SC_ASSERT(f->node_count == m->node_count && f->tet_count == m->tet_count);
     SC_ASSERT(isfinite(dt_s) && dt_s > 0.0f);
-    SC_ASSERT(cg_iterations <= SC_PHYS_ITERATIONS_MAX);
+    SC_ASSERT(cg_iterations >= 1u && cg_iterations <= SC_PHYS_ITERATIONS_MAX);
     const uint32_t nn = f->node_count;
     const uint32_t n3 = 4u * nn; /* 4 lanes per node, the 4th stays 0 */
     float *restrict x3 = f->x3;
@@ -609,6 +629,12 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
     const float *restrict rest3 = f->rest3;
     const float *restrict mass = f->mass;
 
+    /* Warm start v0 = v beta / (beta + dt): the exact one-step decay of an over-damped,
+     * stiffness-damped mode (mass negligible: (beta + dt) K v+ = -K u). Modes that the
+     * fixed-count CG leaves unconverged then keep relaxing; a plain v0 = v lets them coast on
+     * a stale velocity, which overshoots and oscillates at 1-5 CG iterations. */
+    const float damp_s = f->def.rayleigh_beta_s;
+    const float warm = damp_s / (damp_s + dt_s);
     /* Gather the shared SoA state; Dirichlet DOFs: fixed (v = 0) and kinematic (v given). */
     for (uint32_t i = 0; i < nn; i++) {
         uint8_t con = 0u;
@@ -622,7 +648,7 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
         x3[4u * i + 1u] = n->y[i];
         x3[4u * i + 2u] = n->z[i];
         x3[4u * i + 3u] = 0.0f;
-        const float keep = (con == 1u) ? 0.0f : 1.0f;
+        const float keep = (con == 1u) ? 0.0f : (con == 2u) ? 1.0f : warm;
         v3[4u * i] = keep * n->vx[i];
         v3[4u * i + 1u] = keep * n->vy[i];
         v3[4u * i + 2u] = keep * n->vz[i];
@@ -696,9 +722,9 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
             z3[k] = inv[k] * r3[k];
         }
         const float rz_new = dot(r3, z3, n3);
-        const float beta = rz_new / rz;
+        const float gamma = rz_new / rz;
         for (uint32_t k = 0; k < n3; k++) {
-            p3[k] = z3[k] + beta * p3[k];
+            p3[k] = z3[k] + gamma * p3[k];
         }
         rz = rz_new;
     }

@@ -22,8 +22,11 @@
  *   and the lowest mode of a 30 mm block of 1 kPa tissue is ~50 rad/s).
  * - Backward Euler is unconditionally stable, so the step may be the frame period; an
  *   unconverged CG (fixed count) only slows the relaxation, it cannot blow it up. Warm start:
- *   the CG starts from the current velocity, which is the solution of the previous frame, so
- *   convergence accumulates over frames (paper: "quasi-static ... CG").
+ *   the CG starts from the previous frame's solution, the current velocity, decayed by
+ *   beta / (beta + dt) (the exact one-step decay of an over-damped mode), so convergence
+ *   accumulates over frames (paper: "quasi-static ... CG") while modes the CG has not
+ *   resolved keep relaxing instead of coasting (a plain v0 = v overshoots and oscillates
+ *   with 1-5 CG iterations per frame).
  * - Solving for v+ keeps the whole state in sc_nodes (x, v): the FEM has no hidden state
  *   besides its matrix, so switching MSDS <-> FEM at run time keeps the shape and velocity and
  *   needs no reallocation; toggling corotation is equally seamless.
@@ -32,13 +35,13 @@
  *   stays the prescribed one: 0 for fixed nodes).
  * - Storage: symmetric 3x3 block CSR over nodes: row i holds its diagonal block, then one
  *   block per mesh edge (i, j > i), columns sorted (a node has at most 18 neighbours in the
- *   5-tet grid, 6 on average). Each off-diagonal block serves both (i, j) and (j, i)^T in the
- *   mat-vec, which halves the bytes streamed per CG iteration. Blocks are 3 rows of 4 floats
- *   and the solver vectors interleaved x, y, z, 0, so that a block's work is 3 + 3 four-lane
- *   multiply-adds (SIMD via the GCC/Clang vector extension, scalar elsewhere, bitwise the
- *   same) and the gather of p_j is one 16-byte load. Per-tet rest data (Dm^-1, volume, 6
- *   block indices) lets the corotated step re-assemble the warped matrix in place without
- *   any search.
+ *   5-tet grid, 12 on average: 6.5 blocks per row). Each off-diagonal block serves both
+ *   (i, j) and (j, i)^T in the mat-vec, which halves the bytes streamed per CG iteration.
+ *   Blocks are 3 rows of 4 floats and the solver vectors interleaved x, y, z, 0, so that a
+ *   block's work is 3 + 3 four-lane multiply-adds (SIMD via the GCC/Clang vector extension,
+ *   scalar elsewhere, bitwise the same) and the gather of p_j is one 16-byte load. Per-tet
+ *   rest data (Dm^-1, volume, 6 block indices) lets the corotated step re-assemble the
+ *   warped matrix in place without any search.
  * - Use from the facade: sc_tissue runs one FEM step per frame of length iterations x dt
  *   (the simulated time of the MSDS's frame) with `iterations` CG iterations, and holds the
  *   nodes in contact with the probe as kinematic nodes.
@@ -147,7 +150,7 @@ int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat, const
  * Never allocates, cannot fail by contract: a non-finite solution leaves n unchanged, counts
  * stats.unstable_steps and sets the sticky status read by sc_fem_status().
  * Preconditions (SC_ASSERT): f initialised with m; dt_s finite and > 0;
- * cg_iterations <= SC_PHYS_ITERATIONS_MAX. */
+ * 1 <= cg_iterations <= SC_PHYS_ITERATIONS_MAX. */
 void sc_fem_step(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s, uint32_t cg_iterations);
 
 /* As sc_fem_step, and nodes with kinematic[i] != 0 are driven by the caller: they move with

@@ -60,8 +60,8 @@ int main(int argc, char **argv)
 {
     const uint32_t frames = argc > 1 ? (uint32_t)strtoul(argv[1], NULL, 10) : 200u;
     const uint32_t iters = argc > 2 ? (uint32_t)strtoul(argv[2], NULL, 10) : 20u;
-    if (frames == 0u || frames > 100000u || iters > SC_PHYS_ITERATIONS_MAX) {
-        fprintf(stderr, "usage: bench-fem [frames 1..100000] [cg iterations 0..%u]\n",
+    if (frames == 0u || frames > 100000u || iters == 0u || iters > SC_PHYS_ITERATIONS_MAX) {
+        fprintf(stderr, "usage: bench-fem [frames 1..100000] [cg iterations 1..%u]\n",
                 (unsigned)SC_PHYS_ITERATIONS_MAX);
         return 2;
     }
