@@ -188,15 +188,19 @@ static uint32_t first_k(float s, uint32_t n)
     if (s >= (float)n) {
         return n;
     }
-    return (uint32_t)ceilf(s);
+    /* ceil without the libm call (0 < s < n here) */
+    const uint32_t k = (uint32_t)s;
+    return (float)k < s ? k + 1u : k;
 }
 
 /* A run of samples [k0, k1) inside the mesh whose sampling position (voxel units) is
  * a + k b. Mappers emit runs in increasing k, without overlap. */
-static void emit_run(sc_bscan *b, uint32_t k0, uint32_t k1, const float a[3], const float bb[3])
+static inline void emit_run(sc_bscan *b, uint32_t k0, uint32_t k1, const float a[3],
+                            const float bb[3])
 {
-    SC_ASSERT(k0 < k1 && k1 <= SC_MAX_SCAN_SAMPLES && b->run_count < SC_MAX_SCAN_SAMPLES);
-    SC_ASSERT(b->run_count == 0u || b->runs[b->run_count - 1u].k1 <= k0);
+    /* runs are disjoint and increasing: at most one per sample */
+    SC_VALIDATE(k0 < k1 && k1 <= SC_MAX_SCAN_SAMPLES && b->run_count < SC_MAX_SCAN_SAMPLES);
+    SC_VALIDATE(b->run_count == 0u || b->runs[b->run_count - 1u].k1 <= k0);
     sc_bscan_run *r = &b->runs[b->run_count++];
     r->k0 = (uint16_t)k0;
     r->k1 = (uint16_t)k1;
