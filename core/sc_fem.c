@@ -156,21 +156,33 @@ static void tet_grads(const float dmi[9], float n[4][4])
 }
 
 /* Add the element blocks built from gradients g (rest or rotated) into the matrix. */
+/* Unit rows: the scaled identity of a block is added as dd * k_eye[r] (exact: dd * 1 = dd and
+ * x + dd * 0 = x), so that a block row is one straight 4-lane expression. */
+static const float k_eye[3][4] = {
+    {1.0f, 0.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 1.0f, 0.0f}};
+
 static void add_tet_blocks(sc_fem *f, const uint32_t tet[4], const uint32_t blk_idx[6],
                            const float g[4][4], float lam_v, float mu_v)
 {
+    /* diagonal blocks K_aa = (lambda + mu) V g_a g_a^T + mu V |g_a|^2 I; element (r, c) is
+     * lm * (g[r] * g[c]): the product is commutative, so the block is exactly symmetric */
+    const float lm = lam_v + mu_v;
     for (uint32_t a = 0; a < 4u; a++) {
         float *B = f->blk[f->row_start[tet[a]]]; /* the diagonal block leads its row */
         const float dd = mu_v * (g[a][0] * g[a][0] + g[a][1] * g[a][1] + g[a][2] * g[a][2]);
-        const float lm = lam_v + mu_v;
+#if defined(SC_FEM_VEC)
+        const sc_fem_v4 ga = v4_load(g[a]), vlm = v4_splat(lm), vdd = v4_splat(dd);
         for (uint32_t r = 0; r < 3u; r++) {
-            B[5u * r] += lm * g[a][r] * g[a][r] + dd;
-            for (uint32_t c = r + 1u; c < 3u; c++) {
-                const float v = lm * g[a][r] * g[a][c]; /* mirrored: exactly symmetric */
-                B[4u * r + c] += v;
-                B[4u * c + r] += v;
+            const sc_fem_v4 row = vlm * (v4_splat(g[a][r]) * ga) + vdd * v4_load(k_eye[r]);
+            v4_store(&B[4u * r], v4_load(&B[4u * r]) + row);
+        }
+#else
+        for (uint32_t r = 0; r < 3u; r++) {
+            for (uint32_t c = 0; c < 4u; c++) {
+                B[4u * r + c] += lm * (g[a][r] * g[a][c]) + dd * k_eye[r][c];
             }
         }
+#endif
     }
     for (uint32_t p = 0; p < 6u; p++) {
         /* the stored block is K_ab, or K_ba = K_ab^T: the same formula with a and b swapped */
@@ -180,23 +192,19 @@ static void add_tet_blocks(sc_fem *f, const uint32_t tet[4], const uint32_t blk_
         const uint32_t b = tr ? k_pair_a[p] : k_pair_b[p];
         const float dd = mu_v * (g[a][0] * g[b][0] + g[a][1] * g[b][1] + g[a][2] * g[b][2]);
         float *B = f->blk[bi & ~SC_FEM_BLK_TRANSPOSED];
-        /* row r of K_ab: (lambda V g_a[r]) g_b + (mu V g_b[r]) g_a, plus dd on the diagonal */
+        /* row r of K_ab: (lambda V g_a[r]) g_b + (mu V g_b[r]) g_a + dd e_r */
 #if defined(SC_FEM_VEC)
-        const sc_fem_v4 ga = v4_load(g[a]), gb = v4_load(g[b]);
+        const sc_fem_v4 ga = v4_load(g[a]), gb = v4_load(g[b]), vdd = v4_splat(dd);
         for (uint32_t r = 0; r < 3u; r++) {
-            sc_fem_v4 row = v4_splat(lam_v * g[a][r]) * gb + v4_splat(mu_v * g[b][r]) * ga;
-            row[r] += dd;
+            const sc_fem_v4 row = (v4_splat(lam_v * g[a][r]) * gb + v4_splat(mu_v * g[b][r]) * ga) +
+                                  vdd * v4_load(k_eye[r]);
             v4_store(&B[4u * r], v4_load(&B[4u * r]) + row);
         }
 #else
         for (uint32_t r = 0; r < 3u; r++) {
             const float la = lam_v * g[a][r], mb = mu_v * g[b][r];
             for (uint32_t c = 0; c < 4u; c++) {
-                float v = la * g[b][c] + mb * g[a][c];
-                if (c == r) {
-                    v += dd;
-                }
-                B[4u * r + c] += v;
+                B[4u * r + c] += (la * g[b][c] + mb * g[a][c]) + dd * k_eye[r][c];
             }
         }
 #endif
