@@ -80,9 +80,9 @@ typedef struct sc_fem_def {
 
 /* Diagnostics of the last step, for tests, benchmarks and health reporting. */
 typedef struct sc_fem_stats {
-    uint32_t cg_iterations_run; /* <= the requested count (stops early only on an exact 0) */
+    uint32_t cg_iterations_run; /* <= requested (early only on r.z = 0 or p.Ap <= 0) */
     float residual_ratio;       /* sqrt(r.z) after / before the CG of the last step */
-    uint32_t degenerate_tets;   /* corotated: tets whose F had det <= 0 (linear fallback) */
+    uint32_t degenerate_tets;   /* corotated: tets with det F <= 1e-3 (flat/inverted: R = I) */
     uint32_t unstable_steps;    /* steps refused because the solution was not finite */
 } sc_fem_stats;
 
@@ -144,7 +144,8 @@ int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat, const
 
 /* Advance the nodes by dt_s: reads n->x, n->v (warm start) and the external forces n->f*,
  * writes n->x and n->v. Fixed nodes keep their position with zero velocity. Runs exactly
- * cg_iterations CG iterations (fewer only if the residual is exactly zero).
+ * cg_iterations CG iterations (fewer only if r.z is exactly 0 or p.Ap <= 0, e.g. no free
+ * DOF).
  * Cost: linear: (cg_iterations + 1) block mat-vecs, O(B) each, plus O(N); corotated: plus one
  * O(T) re-assembly with a polar decomposition per tet (bounded Newton iterations).
  * Never allocates, cannot fail by contract: a non-finite solution leaves n unchanged, counts
