@@ -46,8 +46,7 @@ static int db_ok(float v, float lo, float hi)
 
 static int check_def(const sc_bscan_def *d)
 {
-    if (!isfinite(d->gain_db) || !isfinite(d->dynamic_range_db) ||
-        !isfinite(d->volume_range_db)) {
+    if (!isfinite(d->gain_db) || !isfinite(d->dynamic_range_db) || !isfinite(d->volume_range_db)) {
         return SC_ERR_NOT_FINITE;
     }
     for (uint32_t i = 0; i < SC_BSCAN_TGC_BANDS; i++) {
@@ -162,10 +161,10 @@ const sc_bscan_status *sc_bscan_status_get(const sc_bscan *b)
 /* ---- per-frame context -------------------------------------------------------------------- */
 
 typedef struct frame_ctx {
-    sc_xform img2vol;          /* image frame -> volume frame */
-    float vo[3];               /* volume origin, mm */
-    float inv_sp[3];           /* 1 / spacing */
-    uint32_t n;                /* samples per line */
+    sc_xform img2vol; /* image frame -> volume frame */
+    float vo[3];      /* volume origin, mm */
+    float inv_sp[3];  /* 1 / spacing */
+    uint32_t n;       /* samples per line */
     /* current line, image frame */
     float ox, oz, dx, dz;
     /* current line, voxel-index units: rigid position of sample k is f0 + k * fd */
@@ -376,15 +375,15 @@ static uint32_t line_events(sc_bscan *b, uint32_t l, uint32_t *active_n, const f
             b->status.event_overflows++;
             break;
         }
-        sc_bscan_event ev = {.s = sp, .seg = si,
-                             .entry = (uint8_t)(s->nx * c->dx + s->nz * c->dz < 0.0f)};
+        sc_bscan_event ev = {
+            .s = sp, .seg = si, .entry = (uint8_t)(s->nx * c->dx + s->nz * c->dz < 0.0f)};
         /* insertion sort: lists are short (2..8 typically) */
         uint32_t j = ne++;
         while (j > 0u) {
             const sc_bscan_event *p = &b->events[j - 1u];
-            const int after = p->s < ev.s || (!(p->s > ev.s) &&
-                                              (p->entry > ev.entry ||
-                                               (p->entry == ev.entry && p->seg < ev.seg)));
+            const int after =
+                p->s < ev.s || (!(p->s > ev.s) &&
+                                (p->entry > ev.entry || (p->entry == ev.entry && p->seg < ev.seg)));
             if (after) {
                 break;
             }
@@ -460,8 +459,7 @@ static float walk(sc_bscan *b, const sc_mesh *m, const frame_ctx *c, uint32_t t,
          * compared by cross-multiplication (be_i be_j > 0), one division at the end */
         uint32_t f_out = 4u;
         for (uint32_t i = 0; i < 4u; i++) {
-            if (i != f_in && be[i] < 0.0f &&
-                (f_out == 4u || a[i] * be[f_out] > a[f_out] * be[i])) {
+            if (i != f_in && be[i] < 0.0f && (f_out == 4u || a[i] * be[f_out] > a[f_out] * be[i])) {
                 f_out = i;
             }
         }
@@ -756,8 +754,8 @@ static void map_line_regions(sc_bscan *b, uint32_t l, const frame_ctx *c)
         const uint32_t mid = a + (z - a + 1u) / 2u;
         const int32_t tm1 = locate_region(b, r, c->ox + (float)(mid - 1u) * c->dx,
                                           c->oz + (float)(mid - 1u) * c->dz);
-        const int32_t tm = locate_region(b, r, c->ox + (float)mid * c->dx,
-                                         c->oz + (float)mid * c->dz);
+        const int32_t tm =
+            locate_region(b, r, c->ox + (float)mid * c->dx, c->oz + (float)mid * c->dz);
         SC_ASSERT(sp + 2u <= SC_COUNT_OF(st));
         st[sp].a = mid;
         st[sp].z = z;
@@ -811,9 +809,9 @@ static void map_line_oracle(sc_bscan *b, const sc_mesh *m, const sc_nodes *nd, u
                 e[2][d] = p[3][d] - p[0][d];
                 r[d] = w[d] - p[0][d];
             }
-#define SC_DET3_(a, bb, cc)                                                                    \
-    ((a)[0] * ((bb)[1] * (cc)[2] - (bb)[2] * (cc)[1]) -                                        \
-     (a)[1] * ((bb)[0] * (cc)[2] - (bb)[2] * (cc)[0]) +                                        \
+#define SC_DET3_(a, bb, cc)                                                                        \
+    ((a)[0] * ((bb)[1] * (cc)[2] - (bb)[2] * (cc)[1]) -                                            \
+     (a)[1] * ((bb)[0] * (cc)[2] - (bb)[2] * (cc)[0]) +                                            \
      (a)[2] * ((bb)[0] * (cc)[1] - (bb)[1] * (cc)[0]))
             const float det = SC_DET3_(e[0], e[1], e[2]);
             if (!(fabsf(det) > 1e-12f)) {
@@ -864,8 +862,7 @@ static uint8_t label_at(const sc_volume *v, float fx, float fy, float fz)
     if (!(fx >= -0.5f && fx < hx && fy >= -0.5f && fy < hy && fz >= -0.5f && fz < hz)) {
         return (uint8_t)SC_LABEL_OUTSIDE;
     }
-    const uint32_t i = (uint32_t)(fx + 0.5f), j = (uint32_t)(fy + 0.5f),
-                   k = (uint32_t)(fz + 0.5f);
+    const uint32_t i = (uint32_t)(fx + 0.5f), j = (uint32_t)(fy + 0.5f), k = (uint32_t)(fz + 0.5f);
     return v->labels[(size_t)i + (size_t)v->dim[0] * ((size_t)j + (size_t)v->dim[1] * k)];
 }
 
@@ -899,11 +896,11 @@ static void count_labels(const uint8_t *lab, uint32_t n, uint32_t *cnt, uint32_t
 
 typedef struct vol_ctx {
     const uint8_t *vox, *lab;
-    float hi[3];        /* dim - 1/2: the volume's extent in voxel units is [-1/2, hi) */
-    int64_t xmax[3];    /* largest 32.32 position kept: just below the last voxel centre */
+    float hi[3];         /* dim - 1/2: the volume's extent in voxel units is [-1/2, hi) */
+    int64_t xmax[3];     /* largest 32.32 position kept: just below the last voxel centre */
     uint32_t sy32, sz32; /* strides of y and z (a volume has < 2^32 voxels) */
-    size_t stride[3];   /* 1, dim0, dim0 * dim1 */
-    int64_t la;         /* display gain lut_a in 16.16 */
+    size_t stride[3];    /* 1, dim0, dim0 * dim1 */
+    int64_t la;          /* display gain lut_a in 16.16 */
 } vol_ctx;
 
 /* Positions are 32.32 fixed point (int64): stepping along a span adds exactly, the step's
@@ -921,7 +918,7 @@ static int64_t to_fx32(float v)
  * weights rounded to nearest (within 0.2 grey level of the exact value for neighbour
  * differences up to 128), nearest label, display table. */
 #define SC_W_BITS 10
-#define SC_W_ONE (1 << SC_W_BITS)
+#define SC_W_ONE  (1 << SC_W_BITS)
 #define SC_W_HALF ((int64_t)1 << (31 - SC_W_BITS)) /* half a weight step in 32.32 */
 
 /* One sample at 32.32 position (X, Y, Z), clamped into [0, xmax]: trilinear with 10-bit
@@ -931,7 +928,7 @@ static int64_t to_fx32(float v)
  * volume's values are passed by value so that the byte stores (which may alias anything) do
  * not force reloads. */
 #define SC_W_BITS 10
-#define SC_W_ONE (1 << SC_W_BITS)
+#define SC_W_ONE  (1 << SC_W_BITS)
 #define SC_W_HALF ((int64_t)1 << (31 - SC_W_BITS)) /* half a weight step in 32.32 */
 
 typedef struct vol_regs {
@@ -951,8 +948,7 @@ static inline void sample_fx(const vol_regs v, const int64_t *restrict lut_b_fx,
     const int32_t ty = (int32_t)((Y >> (32 - SC_W_BITS)) & (SC_W_ONE - 1));
     const int32_t tz = (int32_t)((Z >> (32 - SC_W_BITS)) & (SC_W_ONE - 1));
     const size_t base = (size_t)(X >> 32) + v.sy * (size_t)(Y >> 32) + v.sz * (size_t)(Z >> 32);
-    const uint8_t *r00 = v.vox + base, *r10 = r00 + v.sy, *r01 = r00 + v.sz,
-                  *r11 = r01 + v.sy;
+    const uint8_t *r00 = v.vox + base, *r10 = r00 + v.sy, *r01 = r00 + v.sz, *r11 = r01 + v.sy;
     /* 18 bits after the first level, 28 bits inside the later ones: int32 is enough */
     const int32_t c00 = r00[0] * SC_W_ONE + tx * (r00[1] - r00[0]);
     const int32_t c10 = r10[0] * SC_W_ONE + tx * (r10[1] - r10[0]);
@@ -962,9 +958,9 @@ static inline void sample_fx(const vol_regs v, const int64_t *restrict lut_b_fx,
     const int32_t c1 = (c01 * SC_W_ONE + ty * (c11 - c01) + SC_W_ONE / 2) >> SC_W_BITS;
     const int32_t ifx = (c0 * SC_W_ONE + tz * (c1 - c0) + SC_W_ONE / 2) >> SC_W_BITS;
     uint8_t label = (uint8_t)SC_LABEL_MUSCLE; /* volumes without a label map */
-    if (v.lab != NULL) { /* nearest voxel's label */
-        label = v.lab[base + (size_t)(tx >> (SC_W_BITS - 1)) +
-                      (ty >= SC_W_ONE / 2 ? v.sy : 0u) + (tz >= SC_W_ONE / 2 ? v.sz : 0u)];
+    if (v.lab != NULL) {                      /* nearest voxel's label */
+        label = v.lab[base + (size_t)(tx >> (SC_W_BITS - 1)) + (ty >= SC_W_ONE / 2 ? v.sy : 0u) +
+                      (tz >= SC_W_ONE / 2 ? v.sz : 0u)];
     }
     lab_out[k] = label;
     /* display: out = (A * I + B[k]) >> 26 with I in 1/1024 grey, A = lut_a in 16.16 and
@@ -987,8 +983,8 @@ static int in_volume(const vol_ctx *vc, const float p[3])
 }
 
 /* Samples [k0, k1) at voxel positions a + k b. */
-static void sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1,
-                        const float a[3], const float bb[3])
+static void sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1, const float a[3],
+                        const float bb[3])
 {
     float p0[3], p1[3];
     for (uint32_t d = 0; d < 3u; d++) {
@@ -1006,8 +1002,8 @@ static void sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1
         const int64_t DX = to_fx32(bb[0]), DY = to_fx32(bb[1]), DZ = to_fx32(bb[2]);
         const int64_t j1 = (int64_t)(k1 - 1u - k0);
         const int64_t xe = X + j1 * DX, ye = Y + j1 * DY, ze = Z + j1 * DZ;
-        if (X >= 0 && xe >= 0 && Y >= 0 && ye >= 0 && Z >= 0 && ze >= 0 && X <= xm0 &&
-            xe <= xm0 && Y <= xm1 && ye <= xm1 && Z <= xm2 && ze <= xm2) {
+        if (X >= 0 && xe >= 0 && Y >= 0 && ye >= 0 && Z >= 0 && ze >= 0 && X <= xm0 && xe <= xm0 &&
+            Y <= xm1 && ye <= xm1 && Z <= xm2 && ze <= xm2) {
             /* clear of the half-voxel border at both ends, so everywhere: no clamping */
             for (uint32_t k = k0; k < k1; k++) {
                 sample_fx(vr, lut, k, X, Y, Z, out, lab);
@@ -1018,8 +1014,7 @@ static void sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1
             return;
         }
         for (uint32_t k = k0; k < k1; k++) {
-            sample_fx(vr, lut, k, clamp_fx(X, xm0), clamp_fx(Y, xm1), clamp_fx(Z, xm2), out,
-                      lab);
+            sample_fx(vr, lut, k, clamp_fx(X, xm0), clamp_fx(Y, xm1), clamp_fx(Z, xm2), out, lab);
             X += DX;
             Y += DY;
             Z += DZ;
@@ -1070,10 +1065,8 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
         }
         if (in_volume(vc, p0) && in_volume(vc, p1)) {
             /* nearest voxel: 16.16 positions offset by a half */
-            int64_t X = to_fx32(p0[0] + 0.5f), Y = to_fx32(p0[1] + 0.5f),
-                    Z = to_fx32(p0[2] + 0.5f);
-            const int64_t DX = to_fx32(c->fd[0]), DY = to_fx32(c->fd[1]),
-                          DZ = to_fx32(c->fd[2]);
+            int64_t X = to_fx32(p0[0] + 0.5f), Y = to_fx32(p0[1] + 0.5f), Z = to_fx32(p0[2] + 0.5f);
+            const int64_t DX = to_fx32(c->fd[0]), DY = to_fx32(c->fd[1]), DZ = to_fx32(c->fd[2]);
             const int64_t lx = (int64_t)v->dim[0] - 1, ly = (int64_t)v->dim[1] - 1,
                           lz = (int64_t)v->dim[2] - 1;
             for (uint32_t kk = k0; kk < k1; kk++) {
@@ -1082,8 +1075,8 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
                 ix = ix > lx ? lx : ix;
                 iy = iy > ly ? ly : iy;
                 iz = iz > lz ? lz : iz;
-                b->line_label[kk] = vc->lab[(size_t)ix + vc->stride[1] * (size_t)iy +
-                                            vc->stride[2] * (size_t)iz];
+                b->line_label[kk] =
+                    vc->lab[(size_t)ix + vc->stride[1] * (size_t)iy + vc->stride[2] * (size_t)iz];
                 X += DX;
                 Y += DY;
                 Z += DZ;
@@ -1115,11 +1108,10 @@ static int volume_ok(const sc_volume *v)
     return 1;
 }
 
-static int emit_line(sc_bscan *b, const sc_display_dev *disp, uint32_t frame_no, uint32_t l,
-                     int rc)
+static int emit_line(sc_bscan *b, const sc_display_dev *disp, uint32_t frame_no, uint32_t l, int rc)
 {
-    const int r = sc_display_line(disp, frame_no, (uint16_t)l, b->line_out,
-                                  (uint16_t)b->def.scan.samples_n);
+    const int r =
+        sc_display_line(disp, frame_no, (uint16_t)l, b->line_out, (uint16_t)b->def.scan.samples_n);
     if (r != SC_OK) {
         b->status.display_errors++;
         return rc != SC_OK ? rc : r;
@@ -1127,9 +1119,9 @@ static int emit_line(sc_bscan *b, const sc_display_dev *disp, uint32_t frame_no,
     return rc;
 }
 
-int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes,
-                   const sc_volume *volume, const sc_xform *probe_to_volume, int contact,
-                   const sc_display_dev *display, uint32_t frame_no)
+int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, const sc_volume *volume,
+                   const sc_xform *probe_to_volume, int contact, const sc_display_dev *display,
+                   uint32_t frame_no)
 {
     if (b == NULL || volume == NULL || probe_to_volume == NULL || display == NULL ||
         !volume_ok(volume)) {
@@ -1234,8 +1226,8 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes,
         vc.hi[d] = (float)dim - 0.5f;
         /* below the last voxel centre by the weight rounding, so x + 1 stays in the grid */
         vc.xmax[d] = dim > 1u ? ((int64_t)(dim - 1u) << 32) - 1 - SC_W_HALF : 0;
-        vc.stride[d] = d == 0u ? 1u : (d == 1u ? volume->dim[0]
-                                               : (size_t)volume->dim[0] * volume->dim[1]);
+        vc.stride[d] =
+            d == 0u ? 1u : (d == 1u ? volume->dim[0] : (size_t)volume->dim[0] * volume->dim[1]);
     }
     vc.sy32 = volume->dim[0];
     vc.sz32 = volume->dim[0] * volume->dim[1];

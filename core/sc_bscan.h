@@ -60,34 +60,34 @@ enum {
  * centres). With gain 0, TGC 0 and R = Rv the display shows the volume values unchanged. */
 typedef struct sc_bscan_def {
     sc_scan_def scan;
-    uint32_t mapper;                 /* SC_BSCAN_MAP_* */
-    uint32_t regions_n;              /* R of the region path, 1..SC_BSCAN_MAX_REGIONS */
-    float gain_db;                   /* overall gain, [-60, 60] */
+    uint32_t mapper;                  /* SC_BSCAN_MAP_* */
+    uint32_t regions_n;               /* R of the region path, 1..SC_BSCAN_MAX_REGIONS */
+    float gain_db;                    /* overall gain, [-60, 60] */
     float tgc_db[SC_BSCAN_TGC_BANDS]; /* per depth band, shallow first, [-60, 60] */
-    float dynamic_range_db;          /* displayed range, [10, 120] */
-    float volume_range_db;           /* range the volume's 0..255 stands for, [10, 120] */
+    float dynamic_range_db;           /* displayed range, [10, 120] */
+    float volume_range_db;            /* range the volume's 0..255 stands for, [10, 120] */
 } sc_bscan_def;
 
 /* Labels whose area the compression measure follows (all labels are counted). */
 typedef struct sc_bscan_status {
     uint32_t frame_no;
     uint8_t contact;
-    uint8_t areas_valid;                      /* 0: no contact or no label map */
-    float area_now_mm2[SC_LABEL_COUNT];       /* image area by rest label, this frame */
-    float area_rest_mm2[SC_LABEL_COUNT];      /* same pose, undeformed mesh */
-    float area_ratio[SC_LABEL_COUNT];         /* now / rest; -1 where the rest area is 0 */
+    uint8_t areas_valid;                 /* 0: no contact or no label map */
+    float area_now_mm2[SC_LABEL_COUNT];  /* image area by rest label, this frame */
+    float area_rest_mm2[SC_LABEL_COUNT]; /* same pose, undeformed mesh */
+    float area_ratio[SC_LABEL_COUNT];    /* now / rest; -1 where the rest area is 0 */
     float image_area_mm2;
-    uint32_t pixels_in_mesh;                  /* this frame */
-    uint32_t plane_hull_segments;             /* boundary triangles cut by the plane */
-    uint32_t plane_tets;                      /* region path: tets cut by the plane */
-    uint32_t walk_steps;                      /* walker: tet steps this frame */
+    uint32_t pixels_in_mesh;      /* this frame */
+    uint32_t plane_hull_segments; /* boundary triangles cut by the plane */
+    uint32_t plane_tets;          /* region path: tets cut by the plane */
+    uint32_t walk_steps;          /* walker: tet steps this frame */
     /* cumulative counters of degraded work (each stays exact or falls back, see .c) */
-    uint32_t walk_aborts;        /* a line exceeded SC_BSCAN_MAX_WALK_STEPS */
-    uint32_t event_overflows;    /* a line crossed the boundary > SC_BSCAN_MAX_LINE_EVENTS */
-    uint32_t line_fallbacks;     /* lines the walker handed to the region path (inverted or
-                                    flat tets, folded boundary, line start inside the mesh) */
-    uint32_t region_overflows;   /* region path over its limits (walker result kept) */
-    uint32_t display_errors;     /* display calls that returned an error */
+    uint32_t walk_aborts;      /* a line exceeded SC_BSCAN_MAX_WALK_STEPS */
+    uint32_t event_overflows;  /* a line crossed the boundary > SC_BSCAN_MAX_LINE_EVENTS */
+    uint32_t line_fallbacks;   /* lines the walker handed to the region path (inverted or
+                                  flat tets, folded boundary, line start inside the mesh) */
+    uint32_t region_overflows; /* region path over its limits (walker result kept) */
+    uint32_t display_errors;   /* display calls that returned an error */
 } sc_bscan_status;
 
 /* A boundary triangle of the mesh: face `face` (opposite that vertex) of tet `tet`. */
@@ -99,7 +99,7 @@ typedef struct sc_bscan_hull_face {
 /* A boundary triangle cut by the image plane: its 2D segment in the image frame (x, z). */
 typedef struct sc_bscan_seg {
     float ax, az, bx, bz;
-    float nx, nz;      /* in-plane part of the outward normal */
+    float nx, nz; /* in-plane part of the outward normal */
     uint32_t tet;
     uint32_t face;
     int32_t line_lo, line_hi;
@@ -108,8 +108,8 @@ typedef struct sc_bscan_seg {
 /* Region path: a tet cut by the plane, with its barycentric coordinates and rest position as
  * affine functions of the image-frame (x, z). */
 typedef struct sc_bscan_ptet {
-    float lam[4][3];   /* lambda_i = lam[i][0] + lam[i][1] x + lam[i][2] z */
-    float rest[3][3];  /* rest coordinate d = rest[d][0] + rest[d][1] x + rest[d][2] z */
+    float lam[4][3];  /* lambda_i = lam[i][0] + lam[i][1] x + lam[i][2] z */
+    float rest[3][3]; /* rest coordinate d = rest[d][0] + rest[d][1] x + rest[d][2] z */
     float xmin, xmax, zmin, zmax;
 } sc_bscan_ptet;
 
@@ -135,17 +135,17 @@ _Static_assert((SC_BSCAN_TET_CACHE & (SC_BSCAN_TET_CACHE - 1u)) == 0u,
                "SC_BSCAN_TET_CACHE must be a power of two");
 
 typedef struct sc_bscan_event {
-    float s;        /* line parameter, samples */
-    uint32_t seg;   /* index into segs */
-    uint8_t entry;  /* 1: the line enters the mesh here */
+    float s;       /* line parameter, samples */
+    uint32_t seg;  /* index into segs */
+    uint8_t entry; /* 1: the line enters the mesh here */
 } sc_bscan_event;
 
 typedef struct sc_bscan {
     sc_bscan_def def;
     sc_scan_geom geom;
-    float lut_a;                             /* display: out = lut_a * I + lut_b[k] */
+    float lut_a; /* display: out = lut_a * I + lut_b[k] */
     float lut_b[SC_MAX_SCAN_SAMPLES];
-    int64_t lut_b_fx[SC_MAX_SCAN_SAMPLES];   /* lut_b in 38.26 fixed point, + 1/2 */
+    int64_t lut_b_fx[SC_MAX_SCAN_SAMPLES]; /* lut_b in 38.26 fixed point, + 1/2 */
     /* mesh boundary, from sc_bscan_attach_mesh */
     uint32_t hull_count;
     uint32_t mesh_tets;
@@ -165,7 +165,7 @@ typedef struct sc_bscan {
     sc_bscan_tcache tcache[SC_BSCAN_TET_CACHE];
     /* region path */
     uint32_t ptet_count;
-    uint32_t regions_state;      /* this frame: 0 not built, 1 built, 2 over the limits */
+    uint32_t regions_state; /* this frame: 0 not built, 1 built, 2 over the limits */
     sc_bscan_ptet ptets[SC_BSCAN_MAX_PLANE_TETS];
     int32_t ptet_lo[SC_BSCAN_MAX_PLANE_TETS];
     int32_t ptet_hi[SC_BSCAN_MAX_PLANE_TETS];
@@ -211,11 +211,12 @@ int sc_bscan_attach_mesh(sc_bscan *b, const sc_mesh *mesh);
  * SC_MAX_NODES, SC_MAX_TETS, SC_MAX_SCAN_LINES, SC_MAX_SCAN_SAMPLES, SC_BSCAN_MAX_WALK_STEPS.
  * Never allocates.
  * Errors: SC_ERR_INVALID_ARG (NULL b/volume/probe/display, volume without voxels or with an
- * axis of fewer than 2 voxels, mesh not the attached one), SC_ERR_CASE_TRANSFORM (probe transform not rigid or not finite), or the first
- * error a display call returned (the frame is still computed and streamed to the end). */
-int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes,
-                   const sc_volume *volume, const sc_xform *probe_to_volume, int contact,
-                   const sc_display_dev *display, uint32_t frame_no);
+ * axis of fewer than 2 voxels, mesh not the attached one), SC_ERR_CASE_TRANSFORM (probe transform
+ * not rigid or not finite), or the first error a display call returned (the frame is still computed
+ * and streamed to the end). */
+int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, const sc_volume *volume,
+                   const sc_xform *probe_to_volume, int contact, const sc_display_dev *display,
+                   uint32_t frame_no);
 
 /* Status of the last frame (compression measure, work counters). O(1). */
 const sc_bscan_status *sc_bscan_status_get(const sc_bscan *b);

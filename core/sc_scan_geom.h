@@ -34,29 +34,29 @@ enum {
 };
 
 typedef struct sc_scan_def {
-    uint32_t kind;      /* SC_SCAN_GEOM_LINEAR or SC_SCAN_GEOM_CURVILINEAR */
-    uint32_t lines_n;   /* 2..SC_MAX_SCAN_LINES */
-    uint32_t samples_n; /* 2..SC_MAX_SCAN_SAMPLES */
-    float depth_mm;     /* imaging depth from the probe face, (0, 300] */
-    float width_mm;     /* linear: aperture width, (0, 200] */
-    float radius_mm;    /* curvilinear: radius of the probe face, (0, 200] */
-    float sector_deg;   /* curvilinear: fan angle, (0, 170] */
+    uint32_t kind;           /* SC_SCAN_GEOM_LINEAR or SC_SCAN_GEOM_CURVILINEAR */
+    uint32_t lines_n;        /* 2..SC_MAX_SCAN_LINES */
+    uint32_t samples_n;      /* 2..SC_MAX_SCAN_SAMPLES */
+    float depth_mm;          /* imaging depth from the probe face, (0, 300] */
+    float width_mm;          /* linear: aperture width, (0, 200] */
+    float radius_mm;         /* curvilinear: radius of the probe face, (0, 200] */
+    float sector_deg;        /* curvilinear: fan angle, (0, 170] */
     sc_xform image_to_probe; /* calibration; must be rigid */
 } sc_scan_def;
 
 /* Derived per-line tables (image frame, mm). */
 typedef struct sc_scan_geom {
     sc_scan_def def;
-    float sample_mm;                        /* distance between samples along a line */
-    float start_x_mm[SC_MAX_SCAN_LINES];    /* first sample of each line */
+    float sample_mm;                     /* distance between samples along a line */
+    float start_x_mm[SC_MAX_SCAN_LINES]; /* first sample of each line */
     float start_z_mm[SC_MAX_SCAN_LINES];
-    float step_x_mm[SC_MAX_SCAN_LINES];     /* one sample further along the line */
+    float step_x_mm[SC_MAX_SCAN_LINES]; /* one sample further along the line */
     float step_z_mm[SC_MAX_SCAN_LINES];
     float sample_area_mm2[SC_MAX_SCAN_SAMPLES]; /* area a pixel of sample k stands for */
-    float s_min;  /* lowest line parameter (in samples) of interest: linear -samples_n (one
-                     depth behind the face), curvilinear the apex */
-    float line_first;  /* linear: x of line 0; curvilinear: angle of line 0 (rad) */
-    float line_pitch;  /* linear: mm between lines; curvilinear: rad between lines */
+    float s_min;      /* lowest line parameter (in samples) of interest: linear -samples_n (one
+                         depth behind the face), curvilinear the apex */
+    float line_first; /* linear: x of line 0; curvilinear: angle of line 0 (rad) */
+    float line_pitch; /* linear: mm between lines; curvilinear: rad between lines */
 } sc_scan_geom;
 
 /* Linear probe: 256 lines x 512 samples, 38 mm wide, 60 mm deep, identity calibration. */

@@ -47,9 +47,8 @@ static const sc_bscan_status *image(float face_z_mm, uint32_t frame_no)
     const sc_pose pose = sc_test_scene_probe(&g_scene, face_z_mm);
     const sc_xform x = sc_xform_from_pose(&pose);
     const sc_display_dev dev = sc_hs_display_dev(&g_disp);
-    assert_int_equal(sc_bscan_frame(&g_b, &g_t.mesh, &g_t.nodes, &g_scene.vol, &x, 1, &dev,
-                                    frame_no),
-                     SC_OK);
+    assert_int_equal(
+        sc_bscan_frame(&g_b, &g_t.mesh, &g_t.nodes, &g_scene.vol, &x, 1, &dev, frame_no), SC_OK);
     assert_int_equal(g_disp.protocol_errors, 0);
     return sc_bscan_status_get(&g_b);
 }
@@ -79,9 +78,9 @@ static void check(sc_tissue_method m)
     const float press_mm = press();
     st = image(press_mm, 2u);
     print_message("%s: vein area %.1f of %.1f mm^2 (%.2f), artery %.1f of %.1f mm^2 (%.2f)\n",
-                  m == SC_TISSUE_MSDS ? "MSDS" : "FEM",
-                  (double)st->area_now_mm2[SC_LABEL_VEIN], (double)st->area_rest_mm2[SC_LABEL_VEIN],
-                  (double)st->area_ratio[SC_LABEL_VEIN], (double)st->area_now_mm2[SC_LABEL_ARTERY],
+                  m == SC_TISSUE_MSDS ? "MSDS" : "FEM", (double)st->area_now_mm2[SC_LABEL_VEIN],
+                  (double)st->area_rest_mm2[SC_LABEL_VEIN], (double)st->area_ratio[SC_LABEL_VEIN],
+                  (double)st->area_now_mm2[SC_LABEL_ARTERY],
                   (double)st->area_rest_mm2[SC_LABEL_ARTERY],
                   (double)st->area_ratio[SC_LABEL_ARTERY]);
     print_message("  in mesh %u px, walk aborts %u, line fallbacks %u, event overflows %u\n",

@@ -115,14 +115,16 @@ static void rigid_slice(const sc_bscan_def *def, const sc_xform *probe)
             double acc = 0.0;
             for (int c = 0; c < 8; c++) {
                 const int dx = c & 1, dy = (c >> 1) & 1, dz = (c >> 2) & 1;
-                const double wgt = (dx ? t[0] : 1.0 - t[0]) * (dy ? t[1] : 1.0 - t[1]) *
-                                   (dz ? t[2] : 1.0 - t[2]);
-                const size_t idx = (size_t)(i0[0] + dx) +
-                                   v->dim[0] * ((size_t)(i0[1] + dy) + v->dim[1] * (size_t)(i0[2] + dz));
+                const double wgt =
+                    (dx ? t[0] : 1.0 - t[0]) * (dy ? t[1] : 1.0 - t[1]) * (dz ? t[2] : 1.0 - t[2]);
+                const size_t idx =
+                    (size_t)(i0[0] + dx) +
+                    v->dim[0] * ((size_t)(i0[1] + dy) + v->dim[1] * (size_t)(i0[2] + dz));
                 acc += wgt * v->voxels[idx];
             }
-            const size_t li = (size_t)(int)(f[0] + 0.5) +
-                              v->dim[0] * ((size_t)(int)(f[1] + 0.5) + v->dim[1] * (size_t)(int)(f[2] + 0.5));
+            const size_t li =
+                (size_t)(int)(f[0] + 0.5) +
+                v->dim[0] * ((size_t)(int)(f[1] + 0.5) + v->dim[1] * (size_t)(int)(f[2] + 0.5));
             const int dark = v->labels[li] == SC_LABEL_OUTSIDE;
             g_ref_i[o] = dark ? -1.0f : (float)acc;
             g_ref[o] = dark ? 0 : (uint8_t)floor(acc + 0.5);
@@ -169,8 +171,8 @@ static void undeformed_mesh_image_equals_rigid_slice_all_mappers(void **state)
     for (int p = 0; p < 2; p++) {
         for (uint32_t mp = 0; mp < SC_BSCAN_MAP_COUNT; mp++) {
             /* the oracle is O(pixels * tets): a smaller image */
-            sc_bscan_def d = mp == SC_BSCAN_MAP_ORACLE ? small_def(mp, 24, 64)
-                                                       : small_def(mp, 256, 512);
+            sc_bscan_def d =
+                mp == SC_BSCAN_MAP_ORACLE ? small_def(mp, 24, 64) : small_def(mp, 256, 512);
             render(&d, &poses[p], 1, g_a);
             rigid_slice(&d, &poses[p]);
             const uint32_t n = d.scan.lines_n * d.scan.samples_n;
@@ -243,9 +245,9 @@ static void linear_fast_paths_match_oracle_on_deformed_small_mesh(void **state)
     check_against_oracle(small_def(0, 48, 128), &straight, 300u);
     /* tilted and rolled: lines leave through the side, pixels above the skin */
     sc_xform tilted = scn_probe(5.0f, 8.0f, -1.0f, 17.0f);
-    const sc_xform roll = {.r = {1.0f, 0.0f, 0.0f, 0.0f, 0.9848078f, -0.1736482f, 0.0f,
-                                 0.1736482f, 0.9848078f},
-                           .t_mm = {0.0f, 0.0f, 0.0f}};
+    const sc_xform roll = {
+        .r = {1.0f, 0.0f, 0.0f, 0.0f, 0.9848078f, -0.1736482f, 0.0f, 0.1736482f, 0.9848078f},
+        .t_mm = {0.0f, 0.0f, 0.0f}};
     tilted = sc_xform_compose(&tilted, &roll);
     check_against_oracle(small_def(0, 48, 128), &tilted, 150u);
 }
@@ -464,7 +466,8 @@ static void lines_stream_in_order_between_begin_and_end_with_frame_number(void *
     assert_int_equal(rec.info.lines, 256);
     assert_int_equal(rec.info.samples, 512);
     assert_int_equal(rec.info.geometry_id, SC_SCAN_GEOM_LINEAR);
-    assert_true(fabsf(rec.info.depth_mm - 60.0f) < 1e-6f && fabsf(rec.info.width_mm - 38.0f) < 1e-6f);
+    assert_true(fabsf(rec.info.depth_mm - 60.0f) < 1e-6f &&
+                fabsf(rec.info.width_mm - 38.0f) < 1e-6f);
     /* a failing display line is counted and reported, the frame still completes */
     rec = (rec_display){.order_ok = 1, .fail_line = 17};
     assert_int_equal(sc_bscan_frame(&g_b, &g_mesh, &g_nodes, &g_vol.v, &probe, 1, &dev, 5u),

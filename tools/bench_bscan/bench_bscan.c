@@ -106,8 +106,10 @@ static int write_png(const char *path, const sc_bscan_def *d)
         const float ztop = r0 * cosf(half) - r0;
         w = (uint32_t)(2.0f * xmax / px_mm);
         h = (uint32_t)((depth - ztop) / px_mm);
-        if (w > 1024u) w = 1024u;
-        if (h > 1024u) h = 1024u;
+        if (w > 1024u)
+            w = 1024u;
+        if (h > 1024u)
+            h = 1024u;
         for (uint32_t y = 0; y < h; y++) {
             for (uint32_t x = 0; x < w; x++) {
                 const float X = -xmax + ((float)x + 0.5f) * px_mm;
@@ -169,8 +171,8 @@ static void time_frames(const sc_xform *probe, int frames, double *median, doubl
     }
     for (int i = 0; i < frames; i++) {
         const double t0 = now_ms();
-        const int rc = sc_bscan_frame(&g_b, &g_mesh, &g_nodes, &g_vol.v, probe, 1, &g_dev,
-                                      (uint32_t)i);
+        const int rc =
+            sc_bscan_frame(&g_b, &g_mesh, &g_nodes, &g_vol.v, probe, 1, &g_dev, (uint32_t)i);
         t[i] = now_ms() - t0;
         if (rc != SC_OK) {
             fprintf(stderr, "frame failed: %s\n", sc_err_str(rc));
@@ -206,8 +208,8 @@ int main(int argc, char **argv)
         double med, worst;
         time_frames(&probe, frames, &med, &worst);
         printf("target: 32x16x16 256x512 walk: min %.3f, median %.3f ms, worst %.3f ms, steps %u, "
-               "segments %u\n", g_last_min, med, worst, g_b.status.walk_steps,
-               g_b.status.plane_hull_segments);
+               "segments %u\n",
+               g_last_min, med, worst, g_b.status.walk_steps, g_b.status.plane_hull_segments);
         /* the same without the mesh (sampling, display, areas only) */
         static double t[1000];
         const int nf = frames > 1000 ? 1000 : frames;
@@ -221,9 +223,10 @@ int main(int argc, char **argv)
         return 0;
     }
     printf("B-scan synthesis, CPU ms per frame (median / worst of %d), deep compression "
-           "(%.0f mm dent), linear 38 x 60 mm probe, one core\n", frames, (double)dent_mm);
-    printf("%-10s %6s %-9s %8s %8s %8s %8s %8s %8s %8s\n", "mesh", "tets", "image", "walk",
-           "worst", "regions", "worst", "rigid", "in-mesh", "paper");
+           "(%.0f mm dent), linear 38 x 60 mm probe, one core\n",
+           frames, (double)dent_mm);
+    printf("%-10s %6s %-9s %8s %8s %8s %8s %8s %8s %8s\n", "mesh", "tets", "image", "walk", "worst",
+           "regions", "worst", "rigid", "in-mesh", "paper");
     for (int s = 0; s < 4; s++) {
         build_mesh(sizes[s][0], sizes[s][1], sizes[s][2]);
         scn_deform(&g_mesh, &g_nodes, SCN_DEFORM_DENT, dent_mm);

@@ -19,18 +19,18 @@
 #include "sc_pose.h"
 #include "sc_volume.h"
 
-#define SCN_SP_MM 0.5f
-#define SCN_NX 121u /* x -10 .. 50 */
-#define SCN_NY 61u  /* y -5 .. 25 */
-#define SCN_NZ 151u /* z -5 .. 70 */
+#define SCN_SP_MM  0.5f
+#define SCN_NX     121u /* x -10 .. 50 */
+#define SCN_NY     61u  /* y -5 .. 25 */
+#define SCN_NZ     151u /* z -5 .. 70 */
 #define SCN_VOXELS (SCN_NX * SCN_NY * SCN_NZ)
 
 #define SCN_VEIN_X 14.0f
 #define SCN_VEIN_Z 12.0f
 #define SCN_VEIN_R 4.0f
-#define SCN_ART_X 27.0f
-#define SCN_ART_Z 13.0f
-#define SCN_ART_R 3.0f
+#define SCN_ART_X  27.0f
+#define SCN_ART_Z  13.0f
+#define SCN_ART_R  3.0f
 
 typedef struct scn_volume {
     uint8_t vox[SCN_VOXELS];
@@ -96,8 +96,8 @@ static inline void scn_make_volume(scn_volume *s)
                 if (lab != SC_LABEL_OUTSIDE) {
                     speckle = (float)(scn_hash(idx) & 63u) - 31.5f;
                 }
-                float val = base + (lab == SC_LABEL_VEIN || lab == SC_LABEL_ARTERY ? 0.2f : 0.8f) *
-                                       speckle;
+                float val =
+                    base + (lab == SC_LABEL_VEIN || lab == SC_LABEL_ARTERY ? 0.2f : 0.8f) * speckle;
                 val = val < 0.0f ? 0.0f : (val > 255.0f ? 255.0f : val);
                 s->vox[idx] = (uint8_t)(val + 0.5f);
                 s->lab[idx] = lab;
@@ -116,7 +116,8 @@ static inline void scn_displacement(int kind, float a, float x, float y, float z
     switch (kind) {
     case SCN_DEFORM_DENT: {
         /* a probe dent of depth a at (20, 10), decaying with depth, with a little bulge */
-        const float g = expf(-((x - 20.0f) * (x - 20.0f)) / 64.0f - ((y - 10.0f) * (y - 10.0f)) / 36.0f);
+        const float g =
+            expf(-((x - 20.0f) * (x - 20.0f)) / 64.0f - ((y - 10.0f) * (y - 10.0f)) / 36.0f);
         const float h = (1.0f - z / 30.0f) * (1.0f - z / 30.0f);
         u[2] = a * g * h;
         u[0] = 0.08f * a * (x - 20.0f) / 8.0f * g * (z / 30.0f) * (1.0f - z / 30.0f) * 4.0f;
