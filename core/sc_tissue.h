@@ -5,9 +5,12 @@
  * the FEM, the probe collider, the skin and the stability guard. One frame:
  *   1. place the probe (pose of the probe frame in the volume frame) or lift it (NULL);
  *   2. contacts of the tet mesh's nodes with the probe (sc_collider.h, libccd MPR);
- *   3. MSDS: def.msds.iterations explicit Euler steps (dt each), the repulsion forces
- *      kappa * depth * normal re-evaluated on the contact planes before every step
- *      (kappa = contact_stiffness_ratio * sum of the node's spring constants);
+ *   3. MSDS: def.msds.iterations explicit Euler steps (dt each); after every step each node
+ *      that penetrates its contact plane gets the repulsion that removes the penetration in
+ *      that step (SC_TISSUE_CONTACT_PROJECT, default: x onto the plane, inward normal
+ *      velocity removed), or, with SC_TISSUE_CONTACT_PENALTY, the paper's spring-like
+ *      repulsion kappa * depth * normal before every step (kappa = contact_stiffness_ratio *
+ *      sum of the node's spring constants; softer, the tissue sinks into the probe);
  *      FEM: one implicit step of length iterations * dt (the same simulated time per frame
  *      as the MSDS) with `iterations` CG iterations; nodes in the probe or on its surface
  *      (depth > -SC_TISSUE_CONTACT_HOLD_MM) are moved onto the surface as kinematic
