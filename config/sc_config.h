@@ -70,9 +70,22 @@
 #ifndef SC_MAX_SPRINGS
 #define SC_MAX_SPRINGS (6u * SC_MAX_NODES)
 #endif
-/* log2 of the build-time spring hash table (>= 2 SC_MAX_SPRINGS slots). */
+/* log2 of the build-time spring hash table (>= 2 SC_MAX_SPRINGS slots): the smallest that
+ * fits, so that a target with smaller mesh limits gets a smaller table. */
 #ifndef SC_SPRINGS_HASH_BITS
+#if SC_MAX_SPRINGS <= 512u
+#define SC_SPRINGS_HASH_BITS 10u
+#elif SC_MAX_SPRINGS <= 2048u
+#define SC_SPRINGS_HASH_BITS 12u
+#elif SC_MAX_SPRINGS <= 8192u
+#define SC_SPRINGS_HASH_BITS 14u
+#elif SC_MAX_SPRINGS <= 32768u
+#define SC_SPRINGS_HASH_BITS 16u
+#elif SC_MAX_SPRINGS <= 65536u
 #define SC_SPRINGS_HASH_BITS 17u
+#else
+#define SC_SPRINGS_HASH_BITS 20u
+#endif
 #endif
 /* Skin surface (sc_skin.h): a regular triangle grid over the top of the mesh box. */
 #ifndef SC_MAX_SKIN_NX
