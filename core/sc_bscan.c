@@ -36,6 +36,7 @@ sc_bscan_def sc_bscan_default_def(void)
     }
     d.dynamic_range_db = 60.0f;
     d.volume_range_db = 60.0f;
+    d.rest_margin_mm = 15.0f;
     return d;
 }
 
@@ -46,7 +47,8 @@ static int db_ok(float v, float lo, float hi)
 
 static int check_def(const sc_bscan_def *d)
 {
-    if (!isfinite(d->gain_db) || !isfinite(d->dynamic_range_db) || !isfinite(d->volume_range_db)) {
+    if (!isfinite(d->gain_db) || !isfinite(d->dynamic_range_db) || !isfinite(d->volume_range_db) ||
+        !isfinite(d->rest_margin_mm)) {
         return SC_ERR_NOT_FINITE;
     }
     for (uint32_t i = 0; i < SC_BSCAN_TGC_BANDS; i++) {
@@ -59,7 +61,8 @@ static int check_def(const sc_bscan_def *d)
     }
     if (d->mapper >= (uint32_t)SC_BSCAN_MAP_COUNT || d->regions_n < 1u ||
         d->regions_n > SC_BSCAN_MAX_REGIONS || !db_ok(d->gain_db, -60.0f, 60.0f) ||
-        !db_ok(d->dynamic_range_db, 10.0f, 120.0f) || !db_ok(d->volume_range_db, 10.0f, 120.0f)) {
+        !db_ok(d->dynamic_range_db, 10.0f, 120.0f) || !db_ok(d->volume_range_db, 10.0f, 120.0f) ||
+        !db_ok(d->rest_margin_mm, 0.0f, 60.0f)) {
         return SC_ERR_RANGE;
     }
     return SC_OK;
@@ -161,10 +164,11 @@ const sc_bscan_status *sc_bscan_status_get(const sc_bscan *b)
 /* ---- per-frame context -------------------------------------------------------------------- */
 
 typedef struct frame_ctx {
-    sc_xform img2vol; /* image frame -> volume frame */
-    float vo[3];      /* volume origin, mm */
-    float inv_sp[3];  /* 1 / spacing */
-    uint32_t n;       /* samples per line */
+    sc_xform img2vol;  /* image frame -> volume frame */
+    float vo[3];       /* volume origin, mm */
+    float inv_sp[3];   /* 1 / spacing */
+    uint32_t n;        /* samples per line */
+    uint32_t margin_n; /* samples of the rest reference above the face */
     /* current line, image frame */
     float ox, oz, dx, dz;
     /* current line, voxel-index units: rigid position of sample k is f0 + k * fd */
@@ -852,7 +856,14 @@ static void map_line_oracle(sc_bscan *b, const sc_mesh *m, const sc_nodes *nd, u
 typedef struct area_acc {
     uint32_t now_n[SC_LABEL_COUNT], now_k[SC_LABEL_COUNT];
     uint32_t rest_n[SC_LABEL_COUNT], rest_k[SC_LABEL_COUNT];
+    /* rest reference above the probe face (negative sample indices, every 4th sample) */
+    uint32_t margin_n[SC_LABEL_COUNT];
+    int32_t margin_k[SC_LABEL_COUNT];
 } area_acc;
+
+/* Samples of the rest reference above the face are taken every SC_BSCAN_MARGIN_STEP. */
+#define SC_BSCAN_MARGIN_STEP 4u
+_Static_assert(SC_BSCAN_MARGIN_STEP == 4u, "the margin block sums in sample_line assume 4");
 
 /* Nearest label at voxel-index position f, or SC_LABEL_OUTSIDE outside the grid. */
 static uint8_t label_at(const sc_volume *v, float fx, float fy, float fz)
@@ -1090,6 +1101,18 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
         }
     }
     count_labels(b->line_label, n, acc->rest_n, acc->rest_k);
+    /* the rest reference continues above the face by the margin: tissue the probe has pushed
+     * into the image was there at rest (every 4th sample, each counting for 4) */
+    /* blocks of 4 samples above the face, -(4i + 1) .. -(4i + 4), each sampled at -(4i + 2) */
+    for (uint32_t j0 = 0; j0 + SC_BSCAN_MARGIN_STEP <= c->margin_n; j0 += SC_BSCAN_MARGIN_STEP) {
+        const float s = -(float)(j0 + 2u);
+        const uint8_t label =
+            label_at(v, c->f0[0] + s * c->fd[0], c->f0[1] + s * c->fd[1], c->f0[2] + s * c->fd[2]);
+        if (label < SC_LABEL_COUNT) {
+            acc->margin_n[label] += SC_BSCAN_MARGIN_STEP;
+            acc->margin_k[label] -= (int32_t)(4u * j0 + 10u); /* sum of the block's indices */
+        }
+    }
 }
 
 /* ---- frame ------------------------------------------------------------------------------- */
@@ -1180,6 +1203,14 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
     frame_ctx c;
     c.img2vol = sc_xform_compose(probe_to_volume, &sd->image_to_probe);
     c.n = n;
+    {
+        /* above the face, not beyond the apex (curvilinear) */
+        float m = b->def.rest_margin_mm / b->geom.sample_mm;
+        if (m > -b->geom.s_min) {
+            m = -b->geom.s_min;
+        }
+        c.margin_n = (uint32_t)m;
+    }
     for (uint32_t d = 0; d < 3u; d++) {
         c.vo[d] = volume->origin_mm[d];
         c.inv_sp[d] = 1.0f / volume->spacing_mm[d];
@@ -1283,10 +1314,11 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
     st->image_area_mm2 = 0.0f;
     for (uint32_t i = 0; i < SC_LABEL_COUNT; i++) {
         st->area_now_mm2[i] = a0 * (float)acc.now_n[i] + a1 * (float)acc.now_k[i];
-        st->area_rest_mm2[i] = a0 * (float)acc.rest_n[i] + a1 * (float)acc.rest_k[i];
+        st->area_rest_mm2[i] = a0 * (float)(acc.rest_n[i] + acc.margin_n[i]) +
+                               a1 * ((float)acc.rest_k[i] + (float)acc.margin_k[i]);
         st->area_ratio[i] =
             st->area_rest_mm2[i] > 0.0f ? st->area_now_mm2[i] / st->area_rest_mm2[i] : -1.0f;
-        st->image_area_mm2 += st->area_rest_mm2[i];
+        st->image_area_mm2 += st->area_now_mm2[i];
     }
     return rc;
 }

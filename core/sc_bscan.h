@@ -25,9 +25,10 @@
  *
  * The compression measure comes from the same pass: for each label, the image area whose rest
  * position has that label now, against the area with that label in the rigid (undeformed) slice
- * at the same pose: the instructor's "did the vein collapse?". Known limit: the reference covers
- * the same pixels, so a structure within the press depth of the probe face at rest is cut from
- * the reference too (the ratio then overstates what is left of it).
+ * at the same pose: the instructor's "did the vein collapse?". The reference extends
+ * rest_margin_mm above the probe face (every 4th sample there), so that a vessel the probe has
+ * pushed down into view counts whole at rest; with a press deeper than the margin the part above
+ * it is missing from the reference (the ratio then overstates what is left).
  *
  * Memory: all state in the caller's sc_bscan, sized by config/sc_config.h (about 2 MB with the
  * default limits). Never allocates, never calls the OS. Threads: one writer. Deterministic:
@@ -66,6 +67,8 @@ typedef struct sc_bscan_def {
     float tgc_db[SC_BSCAN_TGC_BANDS]; /* per depth band, shallow first, [-60, 60] */
     float dynamic_range_db;           /* displayed range, [10, 120] */
     float volume_range_db;            /* range the volume's 0..255 stands for, [10, 120] */
+    float rest_margin_mm; /* the compression measure's rest reference extends this far above
+                             the probe face (tissue pushed into view), [0, 60] */
 } sc_bscan_def;
 
 /* Labels whose area the compression measure follows (all labels are counted). */
@@ -76,11 +79,11 @@ typedef struct sc_bscan_status {
     float area_now_mm2[SC_LABEL_COUNT];  /* image area by rest label, this frame */
     float area_rest_mm2[SC_LABEL_COUNT]; /* same pose, undeformed mesh */
     float area_ratio[SC_LABEL_COUNT];    /* now / rest; -1 where the rest area is 0 */
-    float image_area_mm2;
-    uint32_t pixels_in_mesh;      /* this frame */
-    uint32_t plane_hull_segments; /* boundary triangles cut by the plane */
-    uint32_t plane_tets;          /* region path: tets cut by the plane */
-    uint32_t walk_steps;          /* walker: tet steps this frame */
+    float image_area_mm2;                /* the whole image (all labels, outside included) */
+    uint32_t pixels_in_mesh;             /* this frame */
+    uint32_t plane_hull_segments;        /* boundary triangles cut by the plane */
+    uint32_t plane_tets;                 /* region path: tets cut by the plane */
+    uint32_t walk_steps;                 /* walker: tet steps this frame */
     /* cumulative counters of degraded work (each stays exact or falls back, see .c) */
     uint32_t walk_aborts;      /* a line exceeded SC_BSCAN_MAX_WALK_STEPS */
     uint32_t event_overflows;  /* a line crossed the boundary > SC_BSCAN_MAX_LINE_EVENTS */

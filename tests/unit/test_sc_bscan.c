@@ -505,6 +505,28 @@ static void squashed_vein_area_drops_while_artery_stays(void **state)
     }
 }
 
+/* A probe pressed 10 mm in: the vein (top 8 mm deep at rest) lies partly above the face in
+ * the rigid slice; the rest reference reaches rest_margin_mm above the face and counts it
+ * whole, so the measure compares with the whole vessel. */
+static void rest_reference_counts_vessels_pushed_into_view(void **state)
+{
+    (void)state;
+    build_mesh(32, 16, 16);
+    deform(SCN_DEFORM_DENT, 10.0f, 0);
+    const sc_xform probe = scn_probe(20.0f, 10.0f, 10.0f, 0.0f);
+    sc_bscan_def d = sc_bscan_default_def();
+    render(&d, &probe, 1, g_a);
+    /* pi 4^2 = 50.3 mm^2; pixel and margin sampling quantisation: 5 % */
+    print_message("vein rest %.2f mm^2 now %.2f\n", (double)g_b.status.area_rest_mm2[SC_LABEL_VEIN],
+                  (double)g_b.status.area_now_mm2[SC_LABEL_VEIN]);
+    assert_true(fabsf(g_b.status.area_rest_mm2[SC_LABEL_VEIN] - 50.27f) < 2.5f);
+    const float ratio_margin = g_b.status.area_ratio[SC_LABEL_VEIN];
+    d.rest_margin_mm = 0.0f;
+    render(&d, &probe, 1, g_a);
+    assert_true(g_b.status.area_rest_mm2[SC_LABEL_VEIN] < 45.0f); /* cut at the face */
+    assert_true(g_b.status.area_ratio[SC_LABEL_VEIN] > ratio_margin);
+}
+
 /* ---- determinism ------------------------------------------------------------------------- */
 
 /* Golden image: fixed scene, deformation and pose. A change of this value is a numerics
@@ -571,6 +593,7 @@ int main(void)
         cmocka_unit_test(gain_tgc_and_dynamic_range_follow_the_display_formula),
         cmocka_unit_test(lines_stream_in_order_between_begin_and_end_with_frame_number),
         cmocka_unit_test(squashed_vein_area_drops_while_artery_stays),
+        cmocka_unit_test(rest_reference_counts_vessels_pushed_into_view),
         cmocka_unit_test(golden_image_hash_is_stable),
         cmocka_unit_test(bad_arguments_are_refused),
     };
