@@ -274,6 +274,23 @@ static void same_inputs_give_a_bit_identical_state_hash(void **state)
     assert_true(sc_tissue_state_hash(&g_t) != b);
 }
 
+/* MSDS only (the FEM's numerics belong to its own test): a fixed press-and-lift script gives
+ * a stored hash in every build type, so that a change in the MSDS/collider/skin numerics is a
+ * visible decision (update the constant with the printed value when it is intended). */
+#define SC_TISSUE_MSDS_HASH UINT64_C(0xfc579def65361424)
+static void msds_script_matches_the_stored_state_hash(void **state)
+{
+    (void)state;
+    init_scene(SC_LABEL_VEIN, SC_TISSUE_MSDS);
+    press(1.5f, 10, 5);
+    for (int f = 0; f < 5; f++) {
+        (void)sc_tissue_step(&g_t, NULL);
+    }
+    const uint64_t h = sc_tissue_state_hash(&g_t);
+    print_message("MSDS script state hash %016llx\n", (unsigned long long)h);
+    assert_true(h == SC_TISSUE_MSDS_HASH);
+}
+
 /* Switching the method mid-compression keeps the shape: in the frame of the switch no node
  * moves more than 1 mm (with the probe held still). Both directions. */
 static void method_switch_mid_compression_does_not_jump(void **state)
@@ -367,6 +384,7 @@ int main(void)
         cmocka_unit_test(clinical_msds_vein_collapses_artery_and_thrombus_resist),
         cmocka_unit_test(msds_and_fem_give_a_similar_indentation_response),
         cmocka_unit_test(same_inputs_give_a_bit_identical_state_hash),
+        cmocka_unit_test(msds_script_matches_the_stored_state_hash),
         cmocka_unit_test(method_switch_mid_compression_does_not_jump),
         cmocka_unit_test(guard_resets_to_rest_on_nan_inf_and_runaway_energy),
         cmocka_unit_test(implausible_pose_runs_the_frame_without_contact),
