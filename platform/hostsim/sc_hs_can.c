@@ -118,6 +118,7 @@ static int hs_send(void *ctx, const sc_can_frame *frame)
 {
     sc_hs_can_node *n = ctx;
     sc_hs_can_bus *bus = n->bus;
+    sc_hs_can_injected *mine = &bus->by_sender[n->index];
     if (!sc_can_len_valid(frame->len, frame->flags) || (frame->flags & SC_CAN_FLAG_ERR)) {
         return SC_ERR_INVALID_ARG;
     }
@@ -127,8 +128,10 @@ static int hs_send(void *ctx, const sc_can_frame *frame)
     }
     n->tx_frames++;
     bus->injected.sent++;
+    mine->sent++;
     if (draw(bus, bus->faults.drop_ppm)) {
         bus->injected.dropped++;
+        mine->dropped++;
         return SC_OK; /* lost on the wire: the sender cannot tell */
     }
     sc_can_frame f = *frame;
@@ -136,22 +139,26 @@ static int hs_send(void *ctx, const sc_can_frame *frame)
         uint32_t bit = rng_next(bus) % (8u * f.len);
         f.data[bit / 8u] ^= (uint8_t)(1u << (bit % 8u));
         bus->injected.corrupted++;
+        mine->corrupted++;
     }
     const int dup = draw(bus, bus->faults.duplicate_ppm);
+    if (dup) {
+        bus->injected.duplicated++;
+        mine->duplicated++;
+    }
     if (!bus->held_valid && draw(bus, bus->faults.reorder_ppm)) {
         bus->held = f;
         bus->held_from = n->index;
         bus->held_valid = 1;
         bus->injected.reordered++;
+        mine->reordered++;
         if (dup) {
-            bus->injected.duplicated++;
             broadcast(bus, n->index, &f);
         }
         return SC_OK;
     }
     broadcast(bus, n->index, &f);
     if (dup) {
-        bus->injected.duplicated++;
         broadcast(bus, n->index, &f);
     }
     sc_hs_can_flush(bus); /* a held frame goes out after this one: order swapped */

@@ -70,7 +70,8 @@ typedef struct sc_hs_can_bus {
     sc_hs_can_node nodes[SC_HS_CAN_MAX_NODES];
     uint32_t node_count;
     sc_hs_can_faults faults;
-    sc_hs_can_injected injected;
+    sc_hs_can_injected injected;                         /* all traffic */
+    sc_hs_can_injected by_sender[SC_HS_CAN_MAX_NODES];   /* per sending node */
     uint64_t rng;
     uint8_t bus_off;
     uint8_t held_valid;     /* a frame held back for reordering */

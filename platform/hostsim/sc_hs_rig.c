@@ -22,9 +22,11 @@ int sc_hs_rig_init(sc_hs_rig *rig, const sc_engine_def *def, uint64_t seed, int 
     sc_hs_display_init(&rig->display);
     sc_hs_storage_init(&rig->storage);
     sc_hs_log_init(&rig->log, print_log);
+    sc_hs_can_tap_init(&rig->tap, sc_hs_can_dev(&rig->bus, rig->engine_node), &rig->clock_dev,
+                       NULL, NULL);
     rig->hal = (sc_hal){
         .clock = rig->clock_dev,
-        .can = sc_hs_can_dev(&rig->bus, rig->engine_node),
+        .can = sc_hs_can_tap_dev(&rig->tap),
         .display = sc_hs_display_dev(&rig->display),
         .storage = sc_hs_storage_dev(&rig->storage),
         .log = sc_hs_log_dev(&rig->log),

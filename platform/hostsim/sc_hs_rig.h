@@ -2,6 +2,9 @@
  * sc_hs_rig.h: a whole engine on the host simulator: virtual clock, a CAN bus with the
  * engine's node and a peer node (the tracker / test bench), the display recorder, storage and
  * log, wired into an sc_hal and one sc_engine. Integration tests and the host runner use it.
+ * The engine's CAN device is the bus node seen through a tap (sc_hs_can_tap.h), so every
+ * frame the engine takes carries its time of reception and can be recorded for replay.
+ * The platform may replace hal.storage before loading a case (the host runner maps files).
  * The rig is large (the engine and the display recorder hold full-size buffers): place it in
  * static storage or allocate it once before the frames start.
  */
@@ -10,6 +13,7 @@
 
 #include "sc_engine.h"
 #include "sc_hs_can.h"
+#include "sc_hs_can_tap.h"
 #include "sc_hs_clock.h"
 #include "sc_hs_display.h"
 #include "sc_hs_log.h"
@@ -22,6 +26,8 @@ typedef struct sc_hs_rig {
     uint32_t engine_node; /* bus node of the engine */
     uint32_t peer_node;   /* bus node of the tracker emulator / bench */
     sc_can_dev peer;      /* the peer's device */
+    sc_hs_can_tap tap;    /* between the engine and its bus node: stamps reception times and
+                           * reports each received frame (set tap.fn to record) */
     sc_hs_display display;
     sc_hs_storage storage;
     sc_hs_log log;

@@ -1,0 +1,652 @@
+/*
+ * main_hostsim.c: sc-hostsim, the engine's main job on the host simulator.
+ *
+ * The real core runs on the simulated HAL (virtual clock, in-process CAN bus, display
+ * recorder) with a case file mapped read-only, while the tracker emulator's generator drives
+ * a scripted probe over the simulated bus (or a candump -l log is replayed). Every received
+ * CAN frame can be recorded as a candump -l log; replaying that log reproduces the session's
+ * frames bit for bit. Output: scan-converted PNG frames, a per-frame CSV and a summary.
+ * Virtual time makes the run deterministic; the host CPU time of each frame is measured
+ * separately (wall clock around each frame) and reported.
+ *
+ * Exit codes: 0 success, 1 the run failed (case refused, output not writable), 2 bad usage.
+ */
+#include <errno.h>
+#include <getopt.h>
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+
+#include "sc_candump.h"
+#include "sc_engine.h"
+#include "sc_err.h"
+#include "sc_hs_rig.h"
+#include "sc_labels.h"
+#include "sc_png_write.h"
+#include "sc_scanconv.h"
+#include "sc_stats.h"
+#include "sc_storage_linux.h"
+#include "sc_trkemu.h"
+
+#ifndef SC_DEFAULT_CASES_DIR
+#define SC_DEFAULT_CASES_DIR "cases"
+#endif
+#define SC_HOSTSIM_VERSION "0.1.0"
+
+typedef struct options {
+    const char *case_name;
+    const char *cases_dir;
+    const char *out_dir;
+    const char *script;
+    const char *csv_path;
+    const char *replay_path;
+    const char *record_path;
+    const char *frame_raw_path;
+    double seconds;
+    uint32_t every;
+    uint32_t png_width, png_height;
+    int method; /* -1 keep default */
+    int fd;
+    uint64_t seed;
+    sc_hs_can_faults faults;
+    float point_mm[3];
+    int point_set;
+    float depth_mm;
+    int quiet;
+} options;
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: sc-hostsim [options]\n"
+            "Runs the engine on the host simulator with a scripted probe and writes B-scans.\n"
+            "  --case NAME|PATH     case (default neck-ijv; NAME is looked up in --cases-dir)\n"
+            "  --cases-dir DIR      folder of the built cases (default " SC_DEFAULT_CASES_DIR ")\n"
+            "  --out DIR            output folder (default out/demo)\n"
+            "  --script NAME        press|sweep|rock|lift (default press)\n"
+            "  --csv FILE           timed poses instead of a script (t_s,x,y,z,qw,qx,qy,qz[,force])\n"
+            "  --seconds S          simulated time (default 6)\n"
+            "  --method msds|fem    soft-tissue solver (default msds)\n"
+            "  --point X,Y,Z        probe contact point, volume frame mm (default: over the vein)\n"
+            "  --depth MM           press depth (default 8)\n"
+            "  --fd                 CAN FD pose frames\n"
+            "  --faults LIST        bus faults, e.g. drop=100000,corrupt=10000,dup=5000,reorder=5000\n"
+            "                       (parts per million), delay=NS\n"
+            "  --seed N             fault injection seed (default 1)\n"
+            "  --record FILE        write every frame the engine received as a candump -l log\n"
+            "  --replay FILE        replay a candump -l log instead of the emulator\n"
+            "  --every N            write every N-th frame as PNG (default 6; 0: none)\n"
+            "  --png-size WxH       PNG raster (default 480x640)\n"
+            "  --frame-raw FILE     also write the deepest-compression frame as a raw frame file\n"
+            "  --quiet              no per-second progress\n"
+            "  --help, --version\n");
+}
+
+static int parse_u64(const char *s, uint64_t max, uint64_t *out)
+{
+    char *end;
+    errno = 0;
+    unsigned long long v = strtoull(s, &end, 10);
+    if (errno || end == s || *end || v > max || s[0] == '-') {
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+static int parse_double(const char *s, double lo, double hi, double *out)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (errno || end == s || *end || !isfinite(v) || v < lo || v > hi) {
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+static int parse_faults(const char *s, sc_hs_can_faults *f)
+{
+    char buf[256];
+    if (strlen(s) >= sizeof(buf)) {
+        return -1;
+    }
+    strcpy(buf, s);
+    for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+        char *eq = strchr(tok, '=');
+        if (!eq) {
+            return -1;
+        }
+        *eq = '\0';
+        uint64_t v;
+        if (parse_u64(eq + 1, strcmp(tok, "delay") == 0 ? 1000000000ull : 1000000ull, &v)) {
+            return -1;
+        }
+        if (strcmp(tok, "drop") == 0) {
+            f->drop_ppm = (uint32_t)v;
+        } else if (strcmp(tok, "corrupt") == 0) {
+            f->corrupt_ppm = (uint32_t)v;
+        } else if (strcmp(tok, "dup") == 0) {
+            f->duplicate_ppm = (uint32_t)v;
+        } else if (strcmp(tok, "reorder") == 0) {
+            f->reorder_ppm = (uint32_t)v;
+        } else if (strcmp(tok, "delay") == 0) {
+            f->delay_ns = v;
+        } else {
+            return -1;
+        }
+    }
+    return 0;
+}
+
+static int parse_args(int argc, char **argv, options *o)
+{
+    *o = (options){.case_name = "neck-ijv",
+                   .cases_dir = SC_DEFAULT_CASES_DIR,
+                   .out_dir = "out/demo",
+                   .script = "press",
+                   .seconds = 6.0,
+                   .every = 6,
+                   .png_width = 480,
+                   .png_height = 640,
+                   .method = -1,
+                   .seed = 1,
+                   .depth_mm = 8.0f};
+    enum { O_CASE = 256, O_CASES_DIR, O_OUT, O_SCRIPT, O_CSV, O_SECONDS, O_METHOD, O_POINT,
+           O_DEPTH, O_FD, O_FAULTS, O_SEED, O_RECORD, O_REPLAY, O_EVERY, O_PNG, O_RAW, O_QUIET,
+           O_HELP, O_VERSION };
+    static const struct option opts[] = {
+        {"case", required_argument, 0, O_CASE},     {"cases-dir", required_argument, 0, O_CASES_DIR},
+        {"out", required_argument, 0, O_OUT},       {"script", required_argument, 0, O_SCRIPT},
+        {"csv", required_argument, 0, O_CSV},       {"seconds", required_argument, 0, O_SECONDS},
+        {"method", required_argument, 0, O_METHOD}, {"point", required_argument, 0, O_POINT},
+        {"depth", required_argument, 0, O_DEPTH},   {"fd", no_argument, 0, O_FD},
+        {"faults", required_argument, 0, O_FAULTS}, {"seed", required_argument, 0, O_SEED},
+        {"record", required_argument, 0, O_RECORD}, {"replay", required_argument, 0, O_REPLAY},
+        {"every", required_argument, 0, O_EVERY},   {"png-size", required_argument, 0, O_PNG},
+        {"frame-raw", required_argument, 0, O_RAW}, {"quiet", no_argument, 0, O_QUIET},
+        {"help", no_argument, 0, O_HELP},           {"version", no_argument, 0, O_VERSION},
+        {0, 0, 0, 0}};
+    int c;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
+        uint64_t u;
+        double d;
+        switch (c) {
+        case O_CASE: o->case_name = optarg; break;
+        case O_CASES_DIR: o->cases_dir = optarg; break;
+        case O_OUT: o->out_dir = optarg; break;
+        case O_SCRIPT: o->script = optarg; break;
+        case O_CSV: o->csv_path = optarg; break;
+        case O_SECONDS:
+            if (parse_double(optarg, 0.01, 3600.0, &o->seconds)) {
+                fprintf(stderr, "sc-hostsim: --seconds wants 0.01..3600, got '%s'\n", optarg);
+                return 2;
+            }
+            break;
+        case O_METHOD:
+            if (strcmp(optarg, "msds") == 0) {
+                o->method = SC_TISSUE_MSDS;
+            } else if (strcmp(optarg, "fem") == 0) {
+                o->method = SC_TISSUE_FEM;
+            } else {
+                fprintf(stderr, "sc-hostsim: --method wants msds or fem, got '%s'\n", optarg);
+                return 2;
+            }
+            break;
+        case O_POINT:
+            if (sscanf(optarg, "%f,%f,%f", &o->point_mm[0], &o->point_mm[1], &o->point_mm[2]) != 3 ||
+                !isfinite(o->point_mm[0]) || !isfinite(o->point_mm[1]) || !isfinite(o->point_mm[2])) {
+                fprintf(stderr, "sc-hostsim: --point wants X,Y,Z in mm, got '%s'\n", optarg);
+                return 2;
+            }
+            o->point_set = 1;
+            break;
+        case O_DEPTH:
+            if (parse_double(optarg, 0.0, 50.0, &d)) {
+                fprintf(stderr, "sc-hostsim: --depth wants 0..50 mm, got '%s'\n", optarg);
+                return 2;
+            }
+            o->depth_mm = (float)d;
+            break;
+        case O_FD: o->fd = 1; break;
+        case O_FAULTS:
+            if (parse_faults(optarg, &o->faults)) {
+                fprintf(stderr, "sc-hostsim: --faults wants drop|corrupt|dup|reorder=PPM "
+                                "(0..1000000) or delay=NS, comma separated; got '%s'\n", optarg);
+                return 2;
+            }
+            break;
+        case O_SEED:
+            if (parse_u64(optarg, UINT64_MAX, &o->seed)) {
+                fprintf(stderr, "sc-hostsim: --seed wants an unsigned integer, got '%s'\n", optarg);
+                return 2;
+            }
+            break;
+        case O_RECORD: o->record_path = optarg; break;
+        case O_REPLAY: o->replay_path = optarg; break;
+        case O_EVERY:
+            if (parse_u64(optarg, 100000u, &u)) {
+                fprintf(stderr, "sc-hostsim: --every wants 0..100000, got '%s'\n", optarg);
+                return 2;
+            }
+            o->every = (uint32_t)u;
+            break;
+        case O_PNG:
+            if (sscanf(optarg, "%ux%u", &o->png_width, &o->png_height) != 2 || o->png_width < 16 ||
+                o->png_height < 16 || o->png_width > 4096 || o->png_height > 4096) {
+                fprintf(stderr, "sc-hostsim: --png-size wants WxH, 16..4096, got '%s'\n", optarg);
+                return 2;
+            }
+            break;
+        case O_RAW: o->frame_raw_path = optarg; break;
+        case O_QUIET: o->quiet = 1; break;
+        case O_HELP: usage(stdout); exit(0);
+        case O_VERSION: printf("sc-hostsim %s\n", SC_HOSTSIM_VERSION); exit(0);
+        default:
+            fprintf(stderr, "sc-hostsim: unknown or incomplete option '%s'\n", argv[optind - 1]);
+            usage(stderr);
+            return 2;
+        }
+    }
+    if (optind != argc) {
+        fprintf(stderr, "sc-hostsim: unexpected argument '%s'\n", argv[optind]);
+        return 2;
+    }
+    if (o->replay_path && (o->csv_path || o->record_path)) {
+        fprintf(stderr, "sc-hostsim: --replay cannot be combined with --csv or --record\n");
+        return 2;
+    }
+    return 0;
+}
+
+/* ---- recording ----------------------------------------------------------------------------- */
+
+typedef struct recorder {
+    FILE *fp;
+    uint64_t frames;
+    uint64_t errors;
+} recorder;
+
+static void record_frame(void *user, const sc_can_frame *f)
+{
+    recorder *r = user;
+    sc_candump_rec rec = {.ts_us = f->ts_ns / 1000u, .frame = *f};
+    strcpy(rec.iface, "hs0");
+    char line[SC_CANDUMP_LINE_MAX + 2];
+    int n = sc_candump_format(&rec, line, sizeof(line));
+    if (n < 0 || fputs(line, r->fp) == EOF) {
+        r->errors++;
+        return;
+    }
+    r->frames++;
+}
+
+/* ---- output ------------------------------------------------------------------------------- */
+
+static int write_frame_png(const options *o, sc_scanconv *conv, uint8_t *raster,
+                           const sc_hs_display *d, uint32_t frame_no)
+{
+    char path[4096];
+    snprintf(path, sizeof(path), "%s/frame_%05u.png", o->out_dir, frame_no);
+    sc_scanconv_render(conv, &d->last_info, d->last, d->last_info.samples, raster);
+    return sc_png_write(path, conv->width, conv->height, 1, raster, conv->width);
+}
+
+static int write_frame_raw(const char *path, const sc_display_frame_info *info,
+                           const uint8_t *image)
+{
+    FILE *fp = fopen(path, "wb");
+    if (!fp) {
+        return -1;
+    }
+    uint8_t h[24] = "SCFRAME1";
+    h[8] = (uint8_t)info->lines;
+    h[9] = (uint8_t)(info->lines >> 8);
+    h[10] = (uint8_t)info->samples;
+    h[11] = (uint8_t)(info->samples >> 8);
+    h[12] = (uint8_t)info->geometry_id;
+    h[13] = (uint8_t)(info->geometry_id >> 8);
+    memcpy(h + 16, &info->depth_mm, 4);
+    memcpy(h + 20, &info->width_mm, 4);
+    size_t n = (size_t)info->lines * info->samples;
+    int ok = fwrite(h, 1, sizeof(h), fp) == sizeof(h) && fwrite(image, 1, n, fp) == n;
+    return (fclose(fp) == 0 && ok) ? 0 : -1;
+}
+
+static double mono_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+static int mkdir_p(const char *dir)
+{
+    char buf[4096];
+    if (strlen(dir) >= sizeof(buf)) {
+        return -1;
+    }
+    strcpy(buf, dir);
+    for (char *p = buf + 1; *p; p++) {
+        if (*p == '/') {
+            *p = '\0';
+            if (mkdir(buf, 0755) != 0 && errno != EEXIST) {
+                return -1;
+            }
+            *p = '/';
+        }
+    }
+    return (mkdir(buf, 0755) != 0 && errno != EEXIST) ? -1 : 0;
+}
+
+/* ---- main ---------------------------------------------------------------------------------- */
+
+static sc_hs_rig rig; /* about 20 MB: static, allocated once */
+static sc_emu emu;
+static sc_emu_row csv_rows[100000];
+
+int main(int argc, char **argv)
+{
+    options o;
+    int rc = parse_args(argc, argv, &o);
+    if (rc) {
+        return rc;
+    }
+    if (mkdir_p(o.out_dir) != 0) {
+        fprintf(stderr, "sc-hostsim: cannot create %s: %s\n", o.out_dir, strerror(errno));
+        return 1;
+    }
+
+    /* engine on the host simulator, cases mapped from files */
+    sc_engine_def def = sc_engine_default_def();
+    def.watchdog_timeout_ms = 0; /* no watchdog on the simulator */
+    static const char *const catalogue[] = {"neck-ijv.scase", "femoral.scase",
+                                            "femoral-dvt.scase"};
+    for (uint32_t i = 0; i < 3u; i++) {
+        def.case_names[i] = catalogue[i];
+    }
+    def.case_count = 3u;
+    if (o.method >= 0) {
+        def.tissue.method = (sc_tissue_method)o.method;
+    }
+    rc = sc_hs_rig_init(&rig, &def, o.seed, 0);
+    if (rc != SC_OK) {
+        fprintf(stderr, "sc-hostsim: engine init failed: %s\n", sc_err_str(rc));
+        return 1;
+    }
+    sc_hs_can_set_faults(&rig.bus, &o.faults);
+    static sc_storage_linux storage;
+    sc_storage_linux_init(&storage, o.cases_dir);
+    rig.hal.storage = sc_storage_linux_dev(&storage);
+
+    char case_name[1024];
+    if (strchr(o.case_name, '/') || strstr(o.case_name, ".scase")) {
+        snprintf(case_name, sizeof(case_name), "%s", o.case_name);
+    } else {
+        snprintf(case_name, sizeof(case_name), "%s.scase", o.case_name);
+    }
+    rc = sc_engine_load_case(&rig.engine, case_name);
+    if (rc != SC_OK) {
+        fprintf(stderr, "sc-hostsim: case '%s' refused: %s (%s)%s\n", case_name,
+                sc_err_name(rc), sc_err_str(rc),
+                rc == SC_ERR_NOT_FOUND ? "; build the cases first (cmake --build ... --target cases)"
+                                       : "");
+        return 1;
+    }
+    const sc_case *cs = &rig.engine.cas;
+
+    /* probe: emulator script or replay */
+    FILE *replay = NULL;
+    sc_candump_reader reader;
+    sc_candump_rec pending;
+    int have_pending = 0;
+    recorder rec = {0};
+    if (o.replay_path) {
+        replay = fopen(o.replay_path, "r");
+        if (!replay) {
+            fprintf(stderr, "sc-hostsim: cannot open %s: %s\n", o.replay_path, strerror(errno));
+            return 1;
+        }
+        sc_candump_reader_init(&reader, replay);
+    } else {
+        sc_emu_def ed = sc_emu_default_def();
+        if (o.csv_path) {
+            FILE *fp = fopen(o.csv_path, "r");
+            size_t n = 0, bad = 0;
+            if (!fp) {
+                fprintf(stderr, "sc-hostsim: cannot open %s: %s\n", o.csv_path, strerror(errno));
+                return 1;
+            }
+            rc = sc_emu_load_csv(fp, csv_rows, sizeof(csv_rows) / sizeof(csv_rows[0]), &n, &bad);
+            fclose(fp);
+            if (rc != SC_OK) {
+                fprintf(stderr, "sc-hostsim: %s:%zu: %s\n", o.csv_path, bad, sc_err_str(rc));
+                return 1;
+            }
+            ed.script = SC_EMU_CSV;
+            ed.rows = csv_rows;
+            ed.n_rows = n;
+        } else if (sc_emu_script_from_name(o.script, &ed.script) != SC_OK ||
+                   ed.script == SC_EMU_CSV) {
+            fprintf(stderr, "sc-hostsim: unknown script '%s' (press, sweep, rock, lift)\n",
+                    o.script);
+            return 2;
+        }
+        /* contact point: over the vein of the case unless given, in the tracker frame */
+        float p_vol[3];
+        if (o.point_set) {
+            memcpy(p_vol, o.point_mm, sizeof(p_vol));
+        } else {
+            /* top centre of the mesh box: the phantoms centre their vessels under it */
+            p_vol[0] = cs->mesh.origin_mm[0] + 0.5f * cs->mesh.size_mm[0];
+            p_vol[1] = cs->mesh.origin_mm[1] + 0.5f * cs->mesh.size_mm[1];
+            p_vol[2] = cs->mesh.origin_mm[2];
+        }
+        const sc_xform v2t = sc_xform_inverse(&cs->tracker_to_volume);
+        sc_xform_apply(&v2t, p_vol, ed.point_mm);
+        ed.depth_mm = o.depth_mm;
+        ed.duration_s = o.seconds;
+        ed.fd = o.fd;
+        rc = sc_emu_init(&emu, &ed);
+        if (rc != SC_OK) {
+            fprintf(stderr, "sc-hostsim: emulator: %s\n", sc_err_str(rc));
+            return 2;
+        }
+        if (o.record_path) {
+            rec.fp = fopen(o.record_path, "w");
+            if (!rec.fp) {
+                fprintf(stderr, "sc-hostsim: cannot write %s: %s\n", o.record_path,
+                        strerror(errno));
+                return 1;
+            }
+            rig.tap.fn = record_frame;
+            rig.tap.user = &rec;
+        }
+    }
+
+    char path[4096];
+    snprintf(path, sizeof(path), "%s/frames.csv", o.out_dir);
+    FILE *csv = fopen(path, "w");
+    if (!csv) {
+        fprintf(stderr, "sc-hostsim: cannot write %s: %s\n", path, strerror(errno));
+        return 1;
+    }
+    fprintf(csv, "frame,t_s,tracked,contact,vein_area_ratio,artery_area_ratio,state,faults,"
+                 "image_hash\n");
+
+    sc_scanconv conv;
+    uint8_t *raster = malloc((size_t)o.png_width * o.png_height);
+    if (!raster || sc_scanconv_init(&conv, o.png_width, o.png_height) != 0) {
+        fprintf(stderr, "sc-hostsim: out of memory\n");
+        return 1;
+    }
+    static uint8_t deepest[SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES];
+    sc_display_frame_info deepest_info = {0};
+    float min_vein = 2.0f, artery_at_min = -1.0f;
+    uint32_t min_vein_frame = 0, contact_frames = 0, pngs = 0, png_errors = 0;
+    sc_stats wall;
+    sc_stats_reset(&wall);
+
+    const uint64_t period = rig.engine.sched.period_ns;
+    const uint64_t t0 = rig.clock.now_ns;
+    const uint32_t frames = (uint32_t)ceil(o.seconds * 1e9 / (double)period);
+    uint64_t emu_next_ns = 0;
+    sc_can_frame ef[SC_EMU_MAX_FRAMES];
+    int emu_more = !replay;
+    for (uint32_t i = 0; i < frames; i++) {
+        /* release time of the frame about to run */
+        const uint64_t release = rig.engine.sched.started ? rig.engine.sched.next_release_ns
+                                                          : rig.clock.now_ns;
+        if (replay) {
+            for (;;) {
+                if (!have_pending) {
+                    int r = sc_candump_reader_next(&reader, &pending);
+                    if (r != SC_OK) {
+                        break;
+                    }
+                    have_pending = 1;
+                }
+                if (pending.ts_us * 1000u > release) {
+                    break;
+                }
+                (void)sc_hs_can_inject(&rig.bus, rig.engine_node, &pending.frame);
+                have_pending = 0;
+            }
+        } else {
+            while (emu_more && t0 + emu_next_ns <= release) {
+                uint64_t t_ns;
+                int n = sc_emu_next(&emu, ef, SC_EMU_MAX_FRAMES, &t_ns);
+                if (n < 0) {
+                    emu_more = 0;
+                    break;
+                }
+                for (int k = 0; k < n; k++) {
+                    (void)sc_can_send(&rig.peer, &ef[k]);
+                }
+                emu_next_ns = t_ns + (uint64_t)(1e9 / emu.def.rate_hz);
+            }
+        }
+        const double w0 = mono_s();
+        sc_engine_step(&rig.engine, NULL);
+        sc_stats_add(&wall, (uint64_t)((mono_s() - w0) * 1e9));
+
+        sc_engine_status st;
+        sc_engine_get_status(&rig.engine, &st);
+        const uint64_t h = rig.display.hash_count
+                               ? rig.display.hashes[rig.display.hash_count - 1u]
+                               : 0u;
+        fprintf(csv, "%u,%.4f,%u,%u,%.4f,%.4f,%s,0x%04x,%016" PRIx64 "\n", i,
+                (double)(rig.clock.now_ns - t0) * 1e-9, st.probe_tracked, st.probe_contact,
+                (double)st.vein_area_ratio, (double)st.artery_area_ratio,
+                sc_health_state_name(st.state), st.faults, h);
+        if (st.probe_contact) {
+            contact_frames++;
+            if (st.vein_area_ratio >= 0.0f && st.vein_area_ratio < min_vein) {
+                min_vein = st.vein_area_ratio;
+                artery_at_min = st.artery_area_ratio;
+                min_vein_frame = i;
+                deepest_info = rig.display.last_info;
+                memcpy(deepest, rig.display.last,
+                       (size_t)deepest_info.lines * deepest_info.samples);
+            }
+        }
+        if (o.every && i % o.every == 0u && rig.display.frames_complete) {
+            if (write_frame_png(&o, &conv, raster, &rig.display, i) == 0) {
+                pngs++;
+            } else {
+                png_errors++;
+            }
+        }
+        if (!o.quiet && i % 60u == 59u) {
+            printf("t=%5.2fs frame %5u state=%-8s tracked=%u contact=%u vein=%5.2f artery=%5.2f\n",
+                   (double)(rig.clock.now_ns - t0) * 1e-9, i + 1u, sc_health_state_name(st.state),
+                   st.probe_tracked, st.probe_contact, (double)st.vein_area_ratio,
+                   (double)st.artery_area_ratio);
+        }
+    }
+    fclose(csv);
+    if (rec.fp) {
+        fclose(rec.fp);
+    }
+    if (replay) {
+        fclose(replay);
+    }
+    if (deepest_info.lines) {
+        sc_scanconv_render(&conv, &deepest_info, deepest, deepest_info.samples, raster);
+        snprintf(path, sizeof(path), "%s/deepest_compression.png", o.out_dir);
+        if (sc_png_write(path, conv.width, conv.height, 1, raster, conv.width) == 0) {
+            pngs++;
+        }
+        if (o.frame_raw_path && write_frame_raw(o.frame_raw_path, &deepest_info, deepest) != 0) {
+            fprintf(stderr, "sc-hostsim: cannot write %s\n", o.frame_raw_path);
+        }
+    }
+
+    /* summary */
+    sc_engine_status st;
+    sc_engine_get_status(&rig.engine, &st);
+    const sc_trk_counters *tc = sc_tracker_counters(&rig.engine.tracker);
+    const uint64_t last_hash =
+        rig.display.hash_count ? rig.display.hashes[rig.display.hash_count - 1u] : 0u;
+    snprintf(path, sizeof(path), "%s/summary.txt", o.out_dir);
+    FILE *sf = fopen(path, "w");
+    FILE *outs[2] = {stdout, sf};
+    for (int k = 0; k < 2; k++) {
+        FILE *f = outs[k];
+        if (!f) {
+            continue;
+        }
+        fprintf(f, "sonocomp host simulator run\n");
+        fprintf(f, "case            %s (%s), volume %ux%ux%u, mesh %ux%ux%u = %u nodes, %u tets\n",
+                cs->name, case_name, cs->volume.dim[0], cs->volume.dim[1], cs->volume.dim[2],
+                cs->mesh.nx, cs->mesh.ny, cs->mesh.nz, rig.engine.tissue.mesh.node_count,
+                rig.engine.tissue.mesh.tet_count);
+        fprintf(f, "probe           %s%s, %.2f s simulated, %u frames at %u Hz\n",
+                replay ? "replay of " : (o.csv_path ? "csv " : "script "),
+                replay ? o.replay_path : (o.csv_path ? o.csv_path : o.script), o.seconds,
+                frames, def.sched.rate_hz);
+        fprintf(f, "method          %s\n", st.method == SC_TISSUE_FEM ? "fem" : "msds");
+        fprintf(f, "display         %" PRIu64 " complete frames, %" PRIu64
+                   " incomplete, %" PRIu64 " protocol errors\n",
+                rig.display.frames_complete, rig.display.frames_incomplete,
+                rig.display.protocol_errors);
+        fprintf(f, "compression     min vein area ratio %.3f at frame %u (artery %.3f there); "
+                   "%u frames in contact\n",
+                (double)(min_vein > 1.5f ? -1.0f : min_vein), min_vein_frame,
+                (double)artery_at_min, contact_frames);
+        fprintf(f, "tracker         %u frames, %u poses accepted, %u E2E rejects, "
+                   "%u implausible, %u lift events\n",
+                tc->frames, tc->outcome[SC_TRK_POSE_ACCEPTED],
+                sc_tracker_rejected_e2e(&rig.engine.tracker),
+                sc_tracker_rejected_implausible(&rig.engine.tracker), tc->lift_events);
+        fprintf(f, "bus faults      injected: %" PRIu64 " dropped, %" PRIu64 " corrupted, %" PRIu64
+                   " duplicated, %" PRIu64 " reordered\n",
+                rig.bus.injected.dropped, rig.bus.injected.corrupted,
+                rig.bus.injected.duplicated, rig.bus.injected.reordered);
+        fprintf(f, "host CPU time   per frame mean %.3f ms, p99 %.3f ms, worst %.3f ms "
+                   "(wall clock on this host)\n",
+                (double)sc_stats_mean_ns(&wall) * 1e-6,
+                (double)sc_stats_percentile_ns(&wall, 990) * 1e-6, (double)wall.worst_ns * 1e-6);
+        fprintf(f, "final state     %s, faults 0x%04x\n", sc_health_state_name(st.state),
+                st.faults);
+        fprintf(f, "hashes          last image %016" PRIx64 ", tissue state %016" PRIx64 "\n",
+                last_hash, sc_engine_state_hash(&rig.engine));
+        fprintf(f, "output          %u PNG files%s in %s, frames.csv, summary.txt\n", pngs,
+                png_errors ? " (some failed)" : "", o.out_dir);
+        if (rec.fp) {
+            fprintf(f, "recorded        %" PRIu64 " frames to %s\n", rec.frames, o.record_path);
+        }
+    }
+    if (sf) {
+        fclose(sf);
+    }
+    sc_scanconv_free(&conv);
+    free(raster);
+    return (png_errors || rec.errors) ? 1 : 0;
+}
