@@ -10,5 +10,5 @@ tools/install-deps.sh base
 cmake --preset release >/dev/null
 cmake --build --preset release -j"$(nproc)" --target sc-hostsim cases
 rm -rf out/demo
-build/release/platform/hostsim/sc-hostsim --out out/demo --quiet "$@"
+build/release/platform/hostsim/sc-hostsim --out out/demo --depth 12 --quiet "$@"
 echo "B-scans and summary written to $top/out/demo/"
