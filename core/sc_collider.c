@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 
 #include <ccd/ccd.h>
 
@@ -194,6 +195,16 @@ static void point_support(const void *obj, const ccd_vec3_t *dir, ccd_vec3_t *ou
     out->v[2] = o->p[2];
 }
 
+/* libccd's first search direction (GJK only; set for completeness): +x */
+static void first_dir_x(const void *o1, const void *o2, ccd_vec3_t *dir)
+{
+    (void)o1;
+    (void)o2;
+    dir->v[0] = 1.0;
+    dir->v[1] = 0.0;
+    dir->v[2] = 0.0;
+}
+
 static void point_center(const void *obj, ccd_vec3_t *out)
 {
     const ccd_point *o = obj;
@@ -265,8 +276,11 @@ void sc_collider_detect(const sc_collider *c, const sc_collider_grid *g, const f
     index_range(lo[1], hi[1], g->origin_mm[1], g->cell_mm[1], g->ny, &r0[1], &r1[1]);
     index_range(lo[2], hi[2], g->origin_mm[2], g->cell_mm[2], g->nz, &r0[2], &r1[2]);
 
+    /* CCD_INIT would reference ccdFirstDirDefault, which lives in libccd's ccd.c (GJK/EPA,
+     * heap-allocating, not linked into the bare-metal image); MPR never calls first_dir. */
     ccd_t ccd;
-    CCD_INIT(&ccd);
+    memset(&ccd, 0, sizeof(ccd));
+    ccd.first_dir = first_dir_x;
     ccd.support1 = probe_support;
     ccd.center1 = probe_center;
     ccd.support2 = point_support;
