@@ -1,0 +1,733 @@
+/*
+ * main_sonocomp.c: `sonocomp`, the engine binary of the Linux appliance.
+ *
+ * Reads the runtime configuration (config/sonocomp.conf syntax; every bad line refused with its
+ * line number and reason), sets the process up for real time (mlockall, SCHED_FIFO, CPU pinning,
+ * each with a warning and a fallback when refused), opens the devices (SocketCAN, the display
+ * target, case storage, watchdog), loads the case, and runs the frame loop at the configured
+ * rate until SIGINT/SIGTERM (or --frames / --seconds). Once a second: a live status line on a
+ * terminal, a structured status record otherwise. At exit: a final statistics report (frame
+ * times, wake-up latency, misses, per-stage times, display link and CAN counters) on stdout.
+ *
+ * Exit status: 0 clean stop; 1 runtime error (a device or the engine could not start);
+ * 2 command-line usage error; 3 configuration refused.
+ */
+#include <errno.h>
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "sc_engine.h"
+#include "sc_err.h"
+#include "sc_kms_display.h"
+#include "sc_log_linux.h"
+#include "sc_png_sink.h"
+#include "sc_rt.h"
+#include "sc_rtcfg.h"
+#include "sc_socketcan.h"
+#include "sc_storage_linux.h"
+#include "sc_udp_display.h"
+
+#ifndef SONOCOMP_VERSION
+#define SONOCOMP_VERSION "0.1.0"
+#endif
+
+enum { EXIT_OK = 0, EXIT_RUNTIME = 1, EXIT_USAGE = 2, EXIT_CONFIG = 3 };
+
+#define CONFIG_FILE_MAX (256u * 1024u)
+
+/* The engine object: static storage, locked and pre-faulted with the rest of the process. */
+static sc_engine g_engine;
+static sc_log_linux g_log;
+
+/* ---- null devices: can.interface = none, display.target = none ------------------------- */
+
+static int null_can_send(void *ctx, const sc_can_frame *f)
+{
+    (void)ctx;
+    (void)f;
+    return 0;
+}
+
+static int null_can_recv(void *ctx, sc_can_frame *out)
+{
+    (void)ctx;
+    (void)out;
+    return SC_ERR_WOULD_BLOCK;
+}
+
+static const sc_can_ops k_null_can = {null_can_send, null_can_recv, NULL, NULL};
+
+static int null_begin(void *ctx, const sc_display_frame_info *info)
+{
+    (void)ctx;
+    (void)info;
+    return 0;
+}
+
+static int null_line(void *ctx, uint32_t f, uint16_t l, const uint8_t *s, uint16_t n)
+{
+    (void)ctx;
+    (void)f;
+    (void)l;
+    (void)s;
+    (void)n;
+    return 0;
+}
+
+static int null_end(void *ctx, uint32_t f)
+{
+    (void)ctx;
+    (void)f;
+    return 0;
+}
+
+static const sc_display_ops k_null_display = {null_begin, null_line, null_end, NULL};
+
+/* ---- command line ----------------------------------------------------------------------- */
+
+typedef struct cli {
+    const char *config_path;
+    const char *sets[64];
+    uint32_t set_n;
+    int check_config;
+    uint64_t frames;
+    double seconds;
+    const char *case_dir;
+    uint32_t inject_loss_permille; /* test option: display link lines lost on purpose */
+} cli;
+
+static void usage(FILE *f)
+{
+    fprintf(
+        f, "usage: sonocomp [options]\n"
+           "The sonocomp real-time engine: tracker on CAN in, B-scan lines to the display.\n\n"
+           "  -c, --config FILE     runtime configuration (default: built-in defaults;\n"
+           "                        see config/sonocomp.conf)\n"
+           "  -s, --set KEY=VALUE   override one key after the file (repeatable)\n"
+           "      --check-config    validate the configuration, print it, exit\n"
+           "      --help-config     list every key with its default and range\n"
+           "      --case-dir DIR    directory relative case paths are resolved in\n"
+           "  -n, --frames N        stop after N frames\n"
+           "  -t, --seconds S       stop after S seconds\n"
+           "      --inject-loss P   (tests) lose P permille of the display link lines on\n"
+           "                        purpose, counted, as a lossy network would\n"
+           "  -h, --help            this help\n"
+           "  -V, --version         version\n\n"
+           "Stops cleanly on SIGINT or SIGTERM and prints its final statistics on stdout.\n"
+           "Exit status: 0 clean stop, 1 runtime error, 2 usage error, 3 configuration refused.\n");
+}
+
+static void help_config(void)
+{
+    printf("Runtime configuration keys (key = value; # comments):\n\n");
+    for (uint32_t i = 0; i < sc_rtcfg_key_count(); i++) {
+        sc_rtcfg_key_info k;
+        sc_rtcfg_key_describe(i, &k);
+        printf("%-24s default %s\n%-24s %s\n%-24s %s\n\n", k.name, k.default_text, "", k.range_text,
+               "", k.help);
+    }
+}
+
+static void print_config(FILE *f, const sc_rtcfg *c)
+{
+    fprintf(f, "can.interface = %s\n", c->can_interface);
+    switch ((sc_rtcfg_target)c->display_target) {
+    case SC_RTCFG_TARGET_UDP:
+        fprintf(f, "display.target = udp:%s:%u\n", c->display_host, (unsigned)c->display_port);
+        break;
+    case SC_RTCFG_TARGET_PNG:
+    case SC_RTCFG_TARGET_DRM:
+    case SC_RTCFG_TARGET_FBDEV:
+        fprintf(f, "display.target = %s%s%s\n", sc_rtcfg_target_name(c->display_target),
+                c->display_path[0] ? ":" : "", c->display_path);
+        break;
+    case SC_RTCFG_TARGET_NONE:
+        fprintf(f, "display.target = none\n");
+        break;
+    }
+    fprintf(f, "frame_rate_hz = %u\n", (unsigned)c->frame_rate_hz);
+    fprintf(f, "case = %s\n", c->case_path);
+    fprintf(f, "physics.method = %s\n", sc_rtcfg_method_name(c->physics_method));
+    fprintf(f, "physics.iterations = %u\n", (unsigned)c->physics_iterations);
+    fprintf(f, "physics.dt_s = %g\n", (double)c->physics_dt_s);
+    fprintf(f, "image.geometry = %s\n", sc_rtcfg_geometry_name(c->image_geometry));
+    fprintf(f, "image.depth_mm = %g\n", (double)c->image_depth_mm);
+    fprintf(f, "image.width_mm = %g\n", (double)c->image_width_mm);
+    fprintf(f, "image.sector_deg = %g\n", (double)c->image_sector_deg);
+    fprintf(f, "image.lines = %u\n", (unsigned)c->image_lines);
+    fprintf(f, "image.samples = %u\n", (unsigned)c->image_samples);
+    fprintf(f, "image.gain_db = %g\n", (double)c->image_gain_db);
+    fprintf(f, "image.tgc_db =");
+    for (uint32_t i = 0; i < SC_BSCAN_TGC_BANDS; i++) {
+        fprintf(f, " %g", (double)c->image_tgc_db[i]);
+    }
+    fprintf(f, "\nimage.dynamic_range_db = %g\n", (double)c->image_dynamic_range_db);
+    fprintf(f, "rt.sched_fifo = %s\n", c->rt_sched_fifo ? "true" : "false");
+    fprintf(f, "rt.priority = %u\n", (unsigned)c->rt_priority);
+    fprintf(f, "rt.cpu = %d\n", (int)c->rt_cpu);
+    fprintf(f, "rt.mlock = %s\n", c->rt_mlock ? "true" : "false");
+    fprintf(f, "watchdog.device = %s\n", c->watchdog_device);
+    fprintf(f, "watchdog.timeout_ms = %u\n", (unsigned)c->watchdog_timeout_ms);
+    fprintf(f, "tracker.timeout_ms = %u\n", (unsigned)c->tracker_timeout_ms);
+    static const char *const levels[] = {"debug", "info", "warn", "error"};
+    static const char *const tri[] = {"auto", "on", "off"};
+    fprintf(f, "log.level = %s\n", c->log_level < 4u ? levels[c->log_level] : "?");
+    fprintf(f, "status.line = %s\n", c->status_line < 3u ? tri[c->status_line] : "?");
+}
+
+/* Read the configuration file and apply it; print every refused line. 0 or EXIT_CONFIG. */
+static int load_config(const char *path, sc_rtcfg *cfg)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        fprintf(stderr, "sonocomp: %s: %s\n", path, strerror(errno));
+        return EXIT_CONFIG;
+    }
+    static char text[CONFIG_FILE_MAX + 1u];
+    size_t n = fread(text, 1, sizeof text, f);
+    const int read_err = ferror(f);
+    fclose(f);
+    if (read_err) {
+        fprintf(stderr, "sonocomp: %s: read error\n", path);
+        return EXIT_CONFIG;
+    }
+    if (n > CONFIG_FILE_MAX) {
+        fprintf(stderr, "sonocomp: %s: larger than %u bytes\n", path, CONFIG_FILE_MAX);
+        return EXIT_CONFIG;
+    }
+    sc_rtcfg_error errs[32];
+    uint32_t stored = 0;
+    uint32_t bad = sc_rtcfg_parse(cfg, text, n, errs, 32u, &stored);
+    for (uint32_t i = 0; i < stored; i++) {
+        fprintf(stderr, "sonocomp: %s:%u: %s%s%s (%s)\n", path, (unsigned)errs[i].line, errs[i].key,
+                errs[i].key[0] ? ": " : "", errs[i].reason, sc_err_name(errs[i].err));
+    }
+    if (bad > stored) {
+        fprintf(stderr, "sonocomp: %s: %u more refused lines\n", path, (unsigned)(bad - stored));
+    }
+    return bad ? EXIT_CONFIG : 0;
+}
+
+static int apply_sets(const cli *a, sc_rtcfg *cfg)
+{
+    int rc = 0;
+    for (uint32_t i = 0; i < a->set_n; i++) {
+        char key[128];
+        const char *eq = strchr(a->sets[i], '=');
+        if (!eq || eq == a->sets[i] || (size_t)(eq - a->sets[i]) >= sizeof key) {
+            fprintf(stderr, "sonocomp: --set %s: expected KEY=VALUE\n", a->sets[i]);
+            rc = EXIT_CONFIG;
+            continue;
+        }
+        memcpy(key, a->sets[i], (size_t)(eq - a->sets[i]));
+        key[eq - a->sets[i]] = '\0';
+        sc_rtcfg_error e;
+        if (sc_rtcfg_set(cfg, key, eq + 1, &e) != 0) {
+            fprintf(stderr, "sonocomp: --set %s: %s (%s)\n", a->sets[i], e.reason,
+                    sc_err_name(e.err));
+            rc = EXIT_CONFIG;
+        }
+    }
+    return rc;
+}
+
+/* ---- engine definition from the configuration ------------------------------------------- */
+
+static sc_engine_def engine_def_from(const sc_rtcfg *c)
+{
+    sc_engine_def d = sc_engine_default_def();
+    d.sched.rate_hz = c->frame_rate_hz;
+    d.watchdog_timeout_ms = strcmp(c->watchdog_device, "none") == 0 ? 0u : c->watchdog_timeout_ms;
+    d.tracker.pose_timeout_ms = c->tracker_timeout_ms;
+    d.tissue.method = c->physics_method == SC_RTCFG_METHOD_FEM ? SC_TISSUE_FEM : SC_TISSUE_MSDS;
+    d.tissue.msds.iterations = c->physics_iterations;
+    d.tissue.msds.dt_s = c->physics_dt_s;
+    const sc_xform calib = d.bscan.scan.image_to_probe;
+    if (c->image_geometry == SC_RTCFG_GEOMETRY_CURVILINEAR) {
+        d.bscan.scan = sc_scan_curvilinear_default_def();
+        d.bscan.scan.sector_deg = c->image_sector_deg;
+    } else {
+        d.bscan.scan = sc_scan_default_def();
+        d.bscan.scan.width_mm = c->image_width_mm;
+    }
+    d.bscan.scan.image_to_probe = calib;
+    d.bscan.scan.lines_n = c->image_lines;
+    d.bscan.scan.samples_n = c->image_samples;
+    d.bscan.scan.depth_mm = c->image_depth_mm;
+    d.bscan.gain_db = c->image_gain_db;
+    for (uint32_t i = 0; i < SC_BSCAN_TGC_BANDS; i++) {
+        d.bscan.tgc_db[i] = c->image_tgc_db[i];
+    }
+    d.bscan.dynamic_range_db = c->image_dynamic_range_db;
+    d.case_names[0] = c->case_path;
+    d.case_count = 1u;
+    return d;
+}
+
+/* ---- status and final report ------------------------------------------------------------ */
+
+static double ms(uint64_t ns)
+{
+    return (double)ns / 1e6;
+}
+
+static const char *method_name(sc_tissue_method m)
+{
+    return m == SC_TISSUE_FEM ? "fem" : "msds";
+}
+
+static void status_tick(const sc_engine *e, double fps, const sc_rtcfg *cfg, int terminal)
+{
+    sc_engine_status st;
+    sc_engine_get_status(e, &st);
+    char comp[16] = "--";
+    if (st.vein_area_ratio >= 0.0f) {
+        double pct = 100.0 * (1.0 - (double)st.vein_area_ratio);
+        snprintf(comp, sizeof comp, "%.0f%%", pct < 0.0 ? 0.0 : pct);
+    }
+    const char *slash = strrchr(cfg->case_path, '/');
+    const char *case_name = st.case_loaded ? (slash ? slash + 1 : cfg->case_path) : "none";
+    if (terminal) {
+        char line[480];
+        snprintf(line, sizeof line,
+                 "%-8s %5.1f fps  worst %6.2f ms  p99 %6.2f ms  misses %llu  tracker %-6s  "
+                 "case %s  %s  vein compression %s",
+                 sc_health_state_name(st.state), fps, ms(st.worst_frame_ns), ms(st.p99_frame_ns),
+                 (unsigned long long)st.misses,
+                 st.probe_tracked ? (st.probe_contact ? "touch" : "ok") : "lifted", case_name,
+                 method_name(st.method), comp);
+        sc_log_linux_status(&g_log, line);
+    } else {
+        sc_log_linux_msg(&g_log, SC_LOG_INFO, "status",
+                         "state=%s fps=%.1f worst_ms=%.3f p99_ms=%.3f misses=%llu tracker=%s "
+                         "contact=%d case=%s method=%s vein_compression=%s faults=0x%x",
+                         sc_health_state_name(st.state), fps, ms(st.worst_frame_ns),
+                         ms(st.p99_frame_ns), (unsigned long long)st.misses,
+                         st.probe_tracked ? "ok" : "lifted", st.probe_contact,
+                         st.case_loaded ? cfg->case_path : "none", method_name(st.method), comp,
+                         (unsigned)st.faults);
+    }
+}
+
+static void print_stats_row(const char *name, const sc_stats *s)
+{
+    printf("  %-16s %9llu %9.3f %9.3f %9.3f %9.3f\n", name, (unsigned long long)s->count,
+           ms(sc_stats_mean_ns(s)), ms(sc_stats_percentile_ns(s, 500u)),
+           ms(sc_stats_percentile_ns(s, 990u)), ms(s->worst_ns));
+}
+
+static void final_report(const sc_engine *e, double wall_s, const char *stop_reason,
+                         const sc_display_dev *disp, const sc_rt_report *rt,
+                         const sc_udp_display *udp)
+{
+    const sc_sched *s = &e->sched;
+    const double period_ms = 1000.0 / (double)e->def.sched.rate_hz;
+    printf("sonocomp final statistics\n");
+    printf("  stopped by %s after %.1f s; %llu frames at %u Hz (period %.3f ms), %.2f fps\n",
+           stop_reason, wall_s, (unsigned long long)s->frames, (unsigned)e->def.sched.rate_hz,
+           period_ms, wall_s > 0.0 ? (double)s->frames / wall_s : 0.0);
+    printf("  deadline misses %llu (%.3f%%), release times skipped %llu\n",
+           (unsigned long long)s->misses,
+           s->frames ? 100.0 * (double)s->misses / (double)s->frames : 0.0,
+           (unsigned long long)s->periods_skipped);
+    printf("  real time: mlockall %s, SCHED_FIFO %s, pinned %s\n", rt->locked ? "yes" : "no",
+           rt->fifo ? "yes" : "no", rt->pinned ? "yes" : "no");
+    printf("  %-16s %9s %9s %9s %9s %9s   (ms)\n", "", "count", "mean", "p50", "p99", "worst");
+    print_stats_row("frame", &s->frame_stats);
+    print_stats_row("wake-up latency", &s->lateness_stats);
+    for (uint32_t i = 0; i < s->stage_count; i++) {
+        char name[40];
+        snprintf(name, sizeof name, "stage %s", s->stages[i].name ? s->stages[i].name : "?");
+        print_stats_row(name, &s->stages[i].stats);
+    }
+    sc_display_link_state ls;
+    if (sc_display_get_link_state(disp, &ls) == 0) {
+        printf("  display link: %s, %u lines sent, %u dropped\n", ls.up ? "up" : "down",
+               (unsigned)ls.lines_sent, (unsigned)ls.lines_dropped);
+    }
+    if (udp) {
+        printf("  display link lines_sent=%llu lines_dropped=%llu lines_injected=%llu "
+               "send_errors=%llu\n",
+               (unsigned long long)udp->lines_sent, (unsigned long long)udp->lines_dropped,
+               (unsigned long long)udp->lines_injected, (unsigned long long)udp->send_errors);
+    }
+    const sc_engine_counters *c = &e->counters;
+    printf("  CAN rx frames %llu (burst-limited frames %llu), tx failed %llu\n",
+           (unsigned long long)c->can_rx_frames, (unsigned long long)c->can_rx_burst_limited,
+           (unsigned long long)c->can_tx_failed);
+    printf("  commands applied %llu, refused %llu; case loads %llu, failures %llu; "
+           "physics resets %llu; imaging errors %llu; watchdog kicks %llu\n",
+           (unsigned long long)c->commands_applied, (unsigned long long)c->commands_refused,
+           (unsigned long long)c->case_loads, (unsigned long long)c->case_load_failures,
+           (unsigned long long)c->phys_resets, (unsigned long long)c->imaging_errors,
+           (unsigned long long)c->watchdog_kicks);
+    printf("  log records dropped %llu\n", (unsigned long long)sc_log_linux_dropped(&g_log));
+    fflush(stdout);
+    sc_log_linux_msg(&g_log, SC_LOG_INFO, "final_stats",
+                     "stop=%s frames=%llu misses=%llu skipped=%llu frame_mean_ms=%.3f "
+                     "frame_p99_ms=%.3f frame_worst_ms=%.3f wake_p99_ms=%.3f wake_worst_ms=%.3f",
+                     stop_reason, (unsigned long long)s->frames, (unsigned long long)s->misses,
+                     (unsigned long long)s->periods_skipped, ms(sc_stats_mean_ns(&s->frame_stats)),
+                     ms(sc_stats_percentile_ns(&s->frame_stats, 990u)), ms(s->frame_stats.worst_ns),
+                     ms(sc_stats_percentile_ns(&s->lateness_stats, 990u)),
+                     ms(s->lateness_stats.worst_ns));
+}
+
+/* ---- main ------------------------------------------------------------------------------- */
+
+int main(int argc, char **argv)
+{
+    cli a;
+    memset(&a, 0, sizeof a);
+    enum { OPT_CHECK = 1000, OPT_HELP_CONFIG, OPT_CASE_DIR, OPT_INJECT };
+    static const struct option lo[] = {{"config", required_argument, NULL, 'c'},
+                                       {"set", required_argument, NULL, 's'},
+                                       {"check-config", no_argument, NULL, OPT_CHECK},
+                                       {"help-config", no_argument, NULL, OPT_HELP_CONFIG},
+                                       {"case-dir", required_argument, NULL, OPT_CASE_DIR},
+                                       {"inject-loss", required_argument, NULL, OPT_INJECT},
+                                       {"frames", required_argument, NULL, 'n'},
+                                       {"seconds", required_argument, NULL, 't'},
+                                       {"help", no_argument, NULL, 'h'},
+                                       {"version", no_argument, NULL, 'V'},
+                                       {NULL, 0, NULL, 0}};
+    int opt;
+    while ((opt = getopt_long(argc, argv, "c:s:n:t:hV", lo, NULL)) != -1) {
+        char *end = NULL;
+        switch (opt) {
+        case 'c':
+            a.config_path = optarg;
+            break;
+        case 's':
+            if (a.set_n == sizeof a.sets / sizeof a.sets[0]) {
+                fprintf(stderr, "sonocomp: too many --set options\n");
+                return EXIT_USAGE;
+            }
+            a.sets[a.set_n++] = optarg;
+            break;
+        case OPT_CHECK:
+            a.check_config = 1;
+            break;
+        case OPT_HELP_CONFIG:
+            help_config();
+            return EXIT_OK;
+        case OPT_CASE_DIR:
+            a.case_dir = optarg;
+            break;
+        case OPT_INJECT: {
+            errno = 0;
+            unsigned long v = strtoul(optarg, &end, 10);
+            if (errno || !end || *end || optarg[0] == '-' || v > 1000u) {
+                fprintf(stderr, "sonocomp: --inject-loss %s: expected 0..1000\n", optarg);
+                return EXIT_USAGE;
+            }
+            a.inject_loss_permille = (uint32_t)v;
+            break;
+        }
+        case 'n':
+            errno = 0;
+            a.frames = strtoull(optarg, &end, 10);
+            if (errno || !end || *end || optarg[0] == '-' || a.frames == 0u) {
+                fprintf(stderr, "sonocomp: --frames %s: expected a positive count\n", optarg);
+                return EXIT_USAGE;
+            }
+            break;
+        case 't':
+            errno = 0;
+            a.seconds = strtod(optarg, &end);
+            if (errno || !end || *end || !(a.seconds > 0.0) || !isfinite(a.seconds)) {
+                fprintf(stderr, "sonocomp: --seconds %s: expected positive seconds\n", optarg);
+                return EXIT_USAGE;
+            }
+            break;
+        case 'h':
+            usage(stdout);
+            return EXIT_OK;
+        case 'V':
+            printf("sonocomp %s (display link v%u)\n", SONOCOMP_VERSION, SC_DLINK_VERSION);
+            return EXIT_OK;
+        default:
+            usage(stderr);
+            return EXIT_USAGE;
+        }
+    }
+    if (optind < argc) {
+        fprintf(stderr, "sonocomp: unexpected argument '%s' (see --help)\n", argv[optind]);
+        return EXIT_USAGE;
+    }
+
+    /* configuration: defaults, the file, then --set */
+    static sc_rtcfg cfg;
+    sc_rtcfg_default(&cfg);
+    if (a.config_path) {
+        int rc = load_config(a.config_path, &cfg);
+        if (rc) {
+            return rc;
+        }
+    }
+    if (apply_sets(&a, &cfg)) {
+        return EXIT_CONFIG;
+    }
+    if (a.check_config) {
+        print_config(stdout, &cfg);
+        return EXIT_OK;
+    }
+
+    /* logging and real-time set-up */
+    if (sc_log_linux_start(&g_log, 2, (sc_log_level)cfg.log_level) != 0) {
+        fprintf(stderr, "sonocomp: cannot start the log writer\n");
+        return EXIT_RUNTIME;
+    }
+    const int terminal =
+        cfg.status_line == SC_RTCFG_ON || (cfg.status_line == SC_RTCFG_AUTO && isatty(2));
+    const int status_records = cfg.status_line != SC_RTCFG_OFF;
+    sc_log_linux_set_status_mode(&g_log, terminal);
+    sc_log_linux_msg(&g_log, SC_LOG_INFO, "start", "version=%s config=%s rate_hz=%u",
+                     SONOCOMP_VERSION, a.config_path ? a.config_path : "(defaults)",
+                     (unsigned)cfg.frame_rate_hz);
+    if (sc_rt_install_signals() != 0) {
+        sc_log_linux_msg(&g_log, SC_LOG_WARN, "signals", "reason=\"cannot install handlers\"");
+    }
+    sc_rt_def rtd = sc_rt_default_def();
+    rtd.mlock = (int)cfg.rt_mlock;
+    rtd.sched_fifo = (int)cfg.rt_sched_fifo;
+    rtd.priority = (int)cfg.rt_priority;
+    rtd.cpu = cfg.rt_cpu;
+    sc_rt_report rtr;
+    sc_rt_apply(&rtd, &rtr);
+    if (rtd.mlock && !rtr.locked) {
+        sc_log_linux_msg(&g_log, SC_LOG_WARN, "rt_mlock_refused",
+                         "errno=%s action=\"running with pageable memory\"",
+                         strerror(rtr.lock_errno));
+    }
+    if (rtd.sched_fifo && !rtr.fifo) {
+        sc_log_linux_msg(&g_log, SC_LOG_WARN, "rt_fifo_refused",
+                         "priority=%d errno=\"%s\" action=\"normal priority\" hint=\"needs "
+                         "CAP_SYS_NICE or RLIMIT_RTPRIO\"",
+                         rtd.priority, strerror(rtr.fifo_errno));
+    }
+    if (rtd.cpu >= 0 && !rtr.pinned) {
+        sc_log_linux_msg(&g_log, SC_LOG_WARN, "rt_pin_refused", "cpu=%d errno=\"%s\"", rtd.cpu,
+                         strerror(rtr.pin_errno));
+    }
+    sc_rt_prefault(&g_engine, sizeof g_engine);
+
+    int exit_code = EXIT_OK;
+    /* devices */
+    static sc_hal hal;
+    memset(&hal, 0, sizeof hal);
+    hal.clock = sc_rt_clock_dev();
+    hal.log = sc_log_linux_dev(&g_log);
+
+    static sc_socketcan can;
+    int can_open = 0;
+    if (strcmp(cfg.can_interface, "none") == 0) {
+        hal.can.ops = &k_null_can;
+        sc_log_linux_msg(&g_log, SC_LOG_WARN, "can_none", "action=\"no tracker: probe lifted\"");
+    } else {
+        int rc = sc_socketcan_open(&can, sc_socketcan_sys_posix(), NULL, cfg.can_interface);
+        if (rc != 0) {
+            sc_log_linux_msg(&g_log, SC_LOG_ERROR, "can_open_failed",
+                             "interface=%s err=%s hint=\"ip link set %s up; or can.interface = "
+                             "none\"",
+                             cfg.can_interface, sc_err_name(rc), cfg.can_interface);
+            sc_log_linux_stop(&g_log);
+            return EXIT_RUNTIME;
+        }
+        can_open = 1;
+        hal.can = sc_socketcan_dev(&can);
+    }
+
+    static sc_udp_display udp;
+    sc_png_sink *png = NULL;
+    sc_kms_display *kms = NULL;
+    int udp_open = 0;
+    switch ((sc_rtcfg_target)cfg.display_target) {
+    case SC_RTCFG_TARGET_UDP: {
+        sc_udp_display_def ud = sc_udp_display_default_def();
+        ud.host = cfg.display_host;
+        ud.port = (uint16_t)cfg.display_port;
+        ud.inject_drop_permille = a.inject_loss_permille;
+        int rc = sc_udp_display_open(&udp, &ud);
+        if (rc != 0) {
+            sc_log_linux_msg(&g_log, SC_LOG_ERROR, "display_open_failed", "target=udp:%s:%u err=%s",
+                             cfg.display_host, (unsigned)cfg.display_port, sc_err_name(rc));
+            exit_code = EXIT_RUNTIME;
+        } else {
+            udp_open = 1;
+            hal.display = sc_udp_display_dev(&udp);
+        }
+        break;
+    }
+    case SC_RTCFG_TARGET_PNG: {
+        const sc_png_sink_def pd = {.dir = cfg.display_path};
+        int rc = sc_png_sink_open(&png, &pd);
+        if (rc != 0) {
+            sc_log_linux_msg(&g_log, SC_LOG_ERROR, "display_open_failed", "target=png:%s err=%s",
+                             cfg.display_path, sc_err_name(rc));
+            exit_code = EXIT_RUNTIME;
+        } else {
+            hal.display = sc_png_sink_dev(png);
+        }
+        break;
+    }
+    case SC_RTCFG_TARGET_DRM:
+    case SC_RTCFG_TARGET_FBDEV: {
+        const char *why = NULL;
+        const char *path = cfg.display_path[0] ? cfg.display_path : NULL;
+        int rc = cfg.display_target == SC_RTCFG_TARGET_DRM ? sc_kms_open_drm(&kms, path, &why)
+                                                           : sc_kms_open_fbdev(&kms, path, &why);
+        if (rc != 0 && cfg.display_target == SC_RTCFG_TARGET_DRM && !path) {
+            sc_log_linux_msg(&g_log, SC_LOG_WARN, "drm_unavailable",
+                             "reason=\"%s\" action=\"trying fbdev\"", why ? why : "?");
+            rc = sc_kms_open_fbdev(&kms, NULL, &why);
+        }
+        if (rc != 0) {
+            sc_log_linux_msg(
+                &g_log, SC_LOG_ERROR, "display_open_failed", "target=%s err=%s why=\"%s\"",
+                sc_rtcfg_target_name(cfg.display_target), sc_err_name(rc), why ? why : "?");
+            exit_code = EXIT_RUNTIME;
+        } else {
+            hal.display = sc_kms_display_dev(kms);
+        }
+        break;
+    }
+    case SC_RTCFG_TARGET_NONE:
+        hal.display.ops = &k_null_display;
+        break;
+    }
+
+    static sc_storage_linux storage;
+    sc_storage_linux_init(&storage, a.case_dir);
+    hal.storage = sc_storage_linux_dev(&storage);
+
+    static sc_soft_watchdog soft_wdg;
+    static sc_dev_watchdog dev_wdg;
+    int dev_wdg_open = 0, soft_wdg_used = 0;
+    if (strcmp(cfg.watchdog_device, "soft") == 0) {
+        sc_soft_watchdog_init(&soft_wdg, 1);
+        hal.watchdog = sc_soft_watchdog_dev(&soft_wdg);
+        soft_wdg_used = 1;
+    } else if (strcmp(cfg.watchdog_device, "none") != 0) {
+        int rc = sc_dev_watchdog_open(&dev_wdg, cfg.watchdog_device);
+        if (rc == 0) {
+            hal.watchdog = sc_dev_watchdog_dev(&dev_wdg);
+            dev_wdg_open = 1;
+        } else {
+            sc_log_linux_msg(&g_log, SC_LOG_WARN, "watchdog_unavailable",
+                             "device=%s errno=\"%s\" action=\"software watchdog\"",
+                             cfg.watchdog_device, strerror(dev_wdg.last_errno));
+            sc_soft_watchdog_init(&soft_wdg, 1);
+            hal.watchdog = sc_soft_watchdog_dev(&soft_wdg);
+            soft_wdg_used = 1;
+        }
+    }
+
+    sc_engine *e = &g_engine;
+    int engine_ok = 0;
+    if (exit_code == EXIT_OK) {
+        const sc_engine_def def = engine_def_from(&cfg);
+        int rc = sc_engine_init(e, &def, &hal);
+        if (rc != 0) {
+            sc_log_linux_msg(&g_log, SC_LOG_ERROR, "engine_init_failed", "err=%s (%s)",
+                             sc_err_name(rc), sc_err_str(rc));
+            exit_code = EXIT_RUNTIME;
+        } else {
+            engine_ok = 1;
+            rc = sc_engine_load_case(e, cfg.case_path);
+            if (rc != 0) {
+                sc_log_linux_msg(&g_log, SC_LOG_ERROR, "case_load_failed",
+                                 "case=%s err=%s (%s) action=\"running without a case until a "
+                                 "select-case command\"",
+                                 cfg.case_path, sc_err_name(rc), sc_err_str(rc));
+            } else {
+                sc_log_linux_msg(&g_log, SC_LOG_INFO, "case_loaded", "case=%s", cfg.case_path);
+            }
+        }
+    }
+
+    const char *stop_reason = "error";
+    double wall_s = 0.0;
+    if (engine_ok) {
+        const uint64_t t0 = sc_rt_now_ns();
+        uint64_t next_status = t0 + 1000000000u;
+        uint64_t frames_at_status = 0;
+        uint64_t t_status = t0;
+        double fps = 0.0;
+        sc_frame_result fr;
+        for (;;) {
+            if (sc_rt_stop_requested()) {
+                stop_reason = sc_rt_stop_signal() == 15 ? "SIGTERM" : "SIGINT";
+                break;
+            }
+            sc_engine_step(e, &fr);
+            if (udp_open) {
+                sc_engine_status st;
+                sc_engine_get_status(e, &st);
+                const float r = st.vein_area_ratio;
+                sc_udp_display_set_compression(
+                    &udp, r >= 0.0f ? (uint16_t)(1000.0f * fminf(1.0f, fmaxf(0.0f, 1.0f - r)))
+                                    : SC_DLINK_COMPRESSION_UNKNOWN);
+            }
+            const uint64_t now = sc_rt_now_ns();
+            if (now >= next_status) {
+                fps = (double)(e->sched.frames - frames_at_status) * 1e9 / (double)(now - t_status);
+                frames_at_status = e->sched.frames;
+                t_status = now;
+                next_status += 1000000000u;
+                if (next_status <= now) {
+                    next_status = now + 1000000000u;
+                }
+                if (status_records) {
+                    status_tick(e, fps, &cfg, terminal);
+                }
+            }
+            if (a.frames && e->sched.frames >= a.frames) {
+                stop_reason = "frame limit";
+                break;
+            }
+            if (a.seconds > 0.0 && (double)(now - t0) / 1e9 >= a.seconds) {
+                stop_reason = "time limit";
+                break;
+            }
+        }
+        wall_s = (double)(sc_rt_now_ns() - t0) / 1e9;
+        sc_log_linux_status_done(&g_log);
+        final_report(e, wall_s, stop_reason, &hal.display, &rtr, udp_open ? &udp : NULL);
+    }
+
+    /* clean shutdown: a stopped engine must not be reset by its watchdog */
+    if (soft_wdg_used) {
+        sc_soft_watchdog_stop(&soft_wdg);
+    }
+    if (dev_wdg_open) {
+        sc_dev_watchdog_close(&dev_wdg, 1);
+    }
+    if (png) {
+        sc_png_sink_stats ps;
+        sc_png_sink_get_stats(png, &ps);
+        sc_png_sink_close(png);
+        sc_log_linux_msg(&g_log, SC_LOG_INFO, "png_sink",
+                         "frames=%llu written=%llu busy=%llu "
+                         "errors=%llu",
+                         (unsigned long long)ps.frames, (unsigned long long)ps.frames_written,
+                         (unsigned long long)ps.frames_busy, (unsigned long long)ps.write_errors);
+    }
+    if (kms) {
+        sc_kms_close(kms);
+    }
+    if (udp_open) {
+        sc_udp_display_close(&udp);
+    }
+    if (can_open) {
+        sc_socketcan_close(&can);
+    }
+    sc_log_linux_msg(&g_log, SC_LOG_INFO, "stop", "reason=\"%s\" exit=%d", stop_reason, exit_code);
+    sc_log_linux_stop(&g_log);
+    return exit_code;
+}

@@ -1,0 +1,79 @@
+#!/bin/sh
+# sonocomp_cli.sh SONOCOMP SOURCE_DIR WORKDIR: the engine binary's command line and exit
+# conventions: --help/--version, usage errors (2), every refused configuration line reported
+# with file:line: key: reason (3), --check-config, a bounded run with a final report (0), a clean
+# stop on SIGTERM (0), a missing CAN interface (1).
+set -u
+BIN=$1
+SRC=$2
+WORK=$3
+rm -rf "$WORK" && mkdir -p "$WORK"
+fails=0
+check() { # check DESCRIPTION EXPECTED_STATUS ACTUAL_STATUS
+    if [ "$2" != "$3" ]; then
+        echo "FAIL: $1: exit $3, expected $2"
+        fails=$((fails + 1))
+    else
+        echo "ok: $1"
+    fi
+}
+contains() { # contains DESCRIPTION FILE TEXT
+    if grep -qF -- "$3" "$2"; then echo "ok: $1"; else
+        echo "FAIL: $1: '$3' not in $2:"; sed 's/^/    /' "$2"; fails=$((fails + 1)); fi
+}
+# no RT privileges asked for, no devices: runs anywhere
+NODEV="-s can.interface=none -s display.target=none -s rt.sched_fifo=false -s rt.mlock=false -s status.line=off -s case=$WORK/none.scase"
+
+"$BIN" --help > "$WORK/help" 2>&1; check "--help" 0 $?
+contains "--help text" "$WORK/help" "usage: sonocomp"
+"$BIN" --version > "$WORK/version" 2>&1; check "--version" 0 $?
+contains "--version text" "$WORK/version" "sonocomp "
+"$BIN" --no-such-option > /dev/null 2>&1; check "unknown option" 2 $?
+"$BIN" extra-argument > /dev/null 2>&1; check "stray argument" 2 $?
+"$BIN" --frames -3 > /dev/null 2>&1; check "--frames -3" 2 $?
+"$BIN" --help-config > "$WORK/keys" 2>&1; check "--help-config" 0 $?
+contains "--help-config lists ranges" "$WORK/keys" "integer 1 .. 240"
+
+cat > "$WORK/bad.conf" <<'CONF'
+# three bad lines among good ones
+image.depth_mm = 50
+frame_rate_hz = 500
+physics.method = sph
+
+display.target = udp:127.0.0.1
+CONF
+"$BIN" -c "$WORK/bad.conf" > "$WORK/bad.out" 2> "$WORK/bad.err"; check "bad configuration" 3 $?
+contains "line 3 reported" "$WORK/bad.err" "bad.conf:3: frame_rate_hz: 500 is outside 1 .. 240 (SC_ERR_CFG_RANGE)"
+contains "line 4 reported" "$WORK/bad.err" "bad.conf:4: physics.method: sph is not one of msds | fem (SC_ERR_CFG_VALUE)"
+contains "line 6 reported" "$WORK/bad.err" "bad.conf:6: display.target:"
+"$BIN" -c "$WORK/missing.conf" > /dev/null 2>&1; check "missing configuration file" 3 $?
+"$BIN" -s frame_rate_hz=0 --check-config > /dev/null 2>&1; check "--set out of range" 3 $?
+"$BIN" -s nokey > /dev/null 2>&1; check "--set without =" 3 $?
+"$BIN" -c "$SRC/config/sonocomp.conf" -s frame_rate_hz=30 --check-config > "$WORK/eff" 2>&1
+check "--check-config of the default file" 0 $?
+contains "--set overrides the file" "$WORK/eff" "frame_rate_hz = 30"
+contains "file values shown" "$WORK/eff" "display.target = udp:127.0.0.1:5600"
+
+# shellcheck disable=SC2086
+"$BIN" $NODEV --frames 5 > "$WORK/run.out" 2> "$WORK/run.err"; check "bounded run" 0 $?
+contains "final report" "$WORK/run.out" "sonocomp final statistics"
+contains "stopped by the frame limit" "$WORK/run.out" "stopped by frame limit"
+contains "5 frames run" "$WORK/run.out" "; 5 frames at 60 Hz"
+contains "structured log" "$WORK/run.err" "level=info event=start"
+contains "missing case logged" "$WORK/run.err" "event=case_load_failed"
+
+# shellcheck disable=SC2086
+"$BIN" $NODEV > "$WORK/term.out" 2> "$WORK/term.err" &
+pid=$!
+sleep 1.5
+kill -TERM "$pid"
+wait "$pid"; check "SIGTERM stops cleanly" 0 $?
+contains "stopped by SIGTERM" "$WORK/term.out" "stopped by SIGTERM"
+contains "stop record logged" "$WORK/term.err" "event=stop reason=\"SIGTERM\""
+
+"$BIN" -s can.interface=nosuchcan0 -s display.target=none -s rt.sched_fifo=false \
+    -s rt.mlock=false --frames 1 > /dev/null 2> "$WORK/can.err"; check "missing CAN interface" 1 $?
+contains "CAN failure named" "$WORK/can.err" "event=can_open_failed interface=nosuchcan0"
+
+[ "$fails" = 0 ] && echo "PASS" && exit 0
+echo "$fails checks failed"; exit 1
