@@ -9,12 +9,14 @@
 
 /* grid direction (di, dj, dk) of each family, all with a positive index offset */
 static const int8_t s_dir[SC_MSDS_FAMILIES][3] = {
-    {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}, {-1, 1, 0},
+    {1, 0, 0}, {0, 1, 0},  {0, 0, 1}, {1, 1, 0},  {-1, 1, 0},
     {1, 0, 1}, {-1, 0, 1}, {0, 1, 1}, {0, -1, 1},
 };
 
 /* added to |d|^2 in the force law (mm^2): guards 1/|d| in a collapsed spring */
 #define SC_MSDS_MIN_LEN2_MM2 1e-12f
+/* power iterations of the spectral mass scale (see compute_mass_scale) */
+#define SC_MSDS_POWER_ITERATIONS 100u
 /* velocities below this are set to 0 (see integrate) */
 #define SC_MSDS_V_FLUSH_MM_S 1e-12f
 
@@ -23,9 +25,10 @@ sc_msds_def sc_msds_default_def(void)
     sc_msds_def d;
     d.dt_s = SC_PHYS_DT_DEFAULT_S;
     d.iterations = SC_PHYS_ITERATIONS_DEFAULT;
-    d.mass_per_stiffness_s2 = 2e-3f;
-    d.drag_per_s = 0.0f;
+    d.mass_per_stiffness_s2 = 1.2e-3f;
+    d.drag_per_s = 2.5f;
     d.contact_stiffness_ratio = 0.5f;
+    d.volume_stiffness_ratio = 6.0f;
     return d;
 }
 
@@ -35,19 +38,20 @@ int sc_msds_def_validate(const sc_msds_def *d)
         return SC_ERR_INVALID_ARG;
     }
     if (!isfinite(d->dt_s) || !isfinite(d->mass_per_stiffness_s2) || !isfinite(d->drag_per_s) ||
-        !isfinite(d->contact_stiffness_ratio)) {
+        !isfinite(d->contact_stiffness_ratio) || !isfinite(d->volume_stiffness_ratio)) {
         return SC_ERR_NOT_FINITE;
     }
     if (!(d->dt_s > 0.0f) || d->dt_s > 1.0f || d->iterations < 1u ||
         d->iterations > SC_PHYS_ITERATIONS_MAX || !(d->mass_per_stiffness_s2 > 0.0f) ||
-        d->drag_per_s < 0.0f || d->contact_stiffness_ratio < 0.0f) {
+        d->drag_per_s < 0.0f || d->contact_stiffness_ratio < 0.0f ||
+        d->volume_stiffness_ratio < 0.0f || d->volume_stiffness_ratio > 100.0f) {
         return SC_ERR_RANGE;
     }
     /* explicit stability (sc_msds.h): largest eigenvalue of M^-1 K incl. contact, and the
      * largest damping rate */
     const float lam = (2.0f + d->contact_stiffness_ratio) / d->mass_per_stiffness_s2;
-    const float a = d->dt_s * (SC_SPRINGS_GAMMA_PER_K_S * 2.0f / d->mass_per_stiffness_s2 +
-                               d->drag_per_s);
+    const float a =
+        d->dt_s * (SC_SPRINGS_GAMMA_PER_K_S * 2.0f / d->mass_per_stiffness_s2 + d->drag_per_s);
     const float b = d->dt_s * d->dt_s * lam;
     if (!(a < 2.0f) || !(2.0f * a + b < 4.0f)) {
         return SC_ERR_RANGE;
@@ -55,27 +59,278 @@ int sc_msds_def_validate(const sc_msds_def *d)
     return SC_OK;
 }
 
+/* stiffness bound of node i (N/mm): its springs plus the volume term's Gershgorin share */
+static float node_stiffness(const sc_msds *s, uint32_t i)
+{
+    return s->ksum_n_per_mm[i] + s->def.volume_stiffness_ratio * s->kvsum_n_per_mm[i];
+}
+
 static void compute_masses(sc_msds *s)
 {
     for (uint32_t i = 0; i < s->node_count; i++) {
-        /* ksum in N/mm -> N/m (x 1e3) times s^2 gives kg */
-        const float scaled = s->def.mass_per_stiffness_s2 * s->ksum_n_per_mm[i] * 1e3f;
+        /* stiffness in N/mm -> N/m (x 1e3) times s^2 gives kg */
+        const float kref = s->mass_scale * node_stiffness(s, i);
+        const float scaled = s->def.mass_per_stiffness_s2 * kref * 1e3f;
         const float m = scaled > s->phys_mass_kg[i] ? scaled : s->phys_mass_kg[i];
         s->mass_kg[i] = m;
+        s->kref_n_per_mm[i] = m / (s->def.mass_per_stiffness_s2 * 1e3f);
+    }
+}
+
+/* rest position of grid node i relative to the grid origin (mm) */
+static void rest_pos(const sc_msds *s, uint32_t i, float p[3])
+{
+    p[0] = (float)(i % s->nx) * s->cell_mm[0];
+    p[1] = (float)((i / s->nx) % (s->nxy / s->nx)) * s->cell_mm[1];
+    p[2] = (float)(i / s->nxy) * s->cell_mm[2];
+}
+
+/* 6 grad V of the corners of tet t at rest (mm^2) */
+static void rest_gradients(const sc_msds *s, uint32_t t, float g[4][3])
+{
+    float p[4][3];
+    for (uint32_t v = 0; v < 4u; v++) {
+        rest_pos(s, s->tv[v][t], p[v]);
+    }
+    float e[3][3];
+    for (uint32_t a = 0; a < 3u; a++) {
+        for (uint32_t c = 0; c < 3u; c++) {
+            e[a][c] = p[a + 1u][c] - p[0][c];
+        }
+    }
+    for (uint32_t a = 0; a < 3u; a++) {
+        const float *u = e[(a + 1u) % 3u], *w = e[(a + 2u) % 3u];
+        g[a + 1u][0] = u[1] * w[2] - u[2] * w[1];
+        g[a + 1u][1] = u[2] * w[0] - u[0] * w[2];
+        g[a + 1u][2] = u[0] * w[1] - u[1] * w[0];
+    }
+    for (uint32_t c = 0; c < 3u; c++) {
+        g[0][c] = -(g[1][c] + g[2][c] + g[3][c]);
+    }
+}
+
+/* y = K u at rest (springs k e e^T, volume term k_vol grad V grad V^T), u in tx/ty/tz, y in
+ * fx/fy/fz (both scratch). O(9 N + tets). */
+static void stiffness_apply(sc_msds *s)
+{
+    const uint32_t nn = s->node_count;
+    for (uint32_t i = 0; i < nn; i++) {
+        s->fx[i] = s->fy[i] = s->fz[i] = 0.0f;
+    }
+    for (uint32_t d = 0; d < SC_MSDS_FAMILIES; d++) {
+        const uint32_t o = s->off[d];
+        float e[3] = {(float)s_dir[d][0] * s->cell_mm[0], (float)s_dir[d][1] * s->cell_mm[1],
+                      (float)s_dir[d][2] * s->cell_mm[2]};
+        const float len = sqrtf(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+        for (uint32_t c = 0; c < 3u; c++) {
+            e[c] /= len;
+        }
+        for (uint32_t i = 0; o < nn && i < nn - o; i++) {
+            const float k = s->k_n_per_mm[d][i];
+            const uint32_t j = i + o;
+            const float f = k * ((s->tx[j] - s->tx[i]) * e[0] + (s->ty[j] - s->ty[i]) * e[1] +
+                                 (s->tz[j] - s->tz[i]) * e[2]);
+            s->fx[i] -= f * e[0];
+            s->fy[i] -= f * e[1];
+            s->fz[i] -= f * e[2];
+            s->fx[j] += f * e[0];
+            s->fy[j] += f * e[1];
+            s->fz[j] += f * e[2];
+        }
+    }
+    const float vr = s->def.volume_stiffness_ratio;
+    for (uint32_t t = 0; vr > 0.0f && t < s->vol_count; t++) {
+        float g[4][3];
+        rest_gradients(s, t, g);
+        float dd = 0.0f;
+        for (uint32_t v = 0; v < 4u; v++) {
+            const uint32_t a = s->tv[v][t];
+            dd += g[v][0] * s->tx[a] + g[v][1] * s->ty[a] + g[v][2] * s->tz[a];
+        }
+        const float c = vr * s->kvol36[t] * dd;
+        for (uint32_t v = 0; v < 4u; v++) {
+            const uint32_t a = s->tv[v][t];
+            s->fx[a] += c * g[v][0];
+            s->fy[a] += c * g[v][1];
+            s->fz[a] += c * g[v][2];
+        }
+    }
+}
+
+/* mass_scale sigma: the largest eigenvalue mu of W^-1 K (free nodes; W = diag of the
+ * Gershgorin weights node_stiffness) by a fixed number of power iterations on the symmetric
+ * W^-1/2 K W^-1/2 from a fixed start (Rayleigh quotients approach mu from below; 100
+ * iterations reach it within 0.5% on the default mesh, the factor 1.1 covers that), then
+ * sigma = min(1, max(0.05, 1.1 mu / 2)); Gershgorin guarantees mu <= 2. Deterministic.
+ * Uses the scratch arrays. O(SC_MSDS_POWER_ITERATIONS (9 N + tets)). */
+static void compute_mass_scale(sc_msds *s)
+{
+    const uint32_t nn = s->node_count;
+    uint32_t r = 12345u;
+    for (uint32_t i = 0; i < nn; i++) {
+        float v[3];
+        for (uint32_t c = 0; c < 3u; c++) {
+            r = r * 1664525u + 1013904223u;
+            v[c] = (float)(r >> 8) * (1.0f / 16777216.0f) - 0.5f;
+        }
+        const int free_node = s->inv_mass[i] > 0.0f;
+        s->tx[i] = free_node ? v[0] : 0.0f;
+        s->ty[i] = free_node ? v[1] : 0.0f;
+        s->tz[i] = free_node ? v[2] : 0.0f;
+    }
+    double mu = 0.0;
+    for (uint32_t it = 0; it < SC_MSDS_POWER_ITERATIONS; it++) {
+        double xx = 0.0;
+        for (uint32_t i = 0; i < nn; i++) {
+            xx += (double)s->tx[i] * (double)s->tx[i] + (double)s->ty[i] * (double)s->ty[i] +
+                  (double)s->tz[i] * (double)s->tz[i];
+            const float w = node_stiffness(s, i);
+            const float dsc = (s->inv_mass[i] > 0.0f && w > 0.0f) ? 1.0f / sqrtf(w) : 0.0f;
+            s->tx[i] *= dsc;
+            s->ty[i] *= dsc;
+            s->tz[i] *= dsc;
+        }
+        stiffness_apply(s);
+        double uy = 0.0, yy = 0.0;
+        for (uint32_t i = 0; i < nn; i++) {
+            uy += (double)s->tx[i] * (double)s->fx[i] + (double)s->ty[i] * (double)s->fy[i] +
+                  (double)s->tz[i] * (double)s->fz[i];
+            const float w = node_stiffness(s, i);
+            const float dsc = (s->inv_mass[i] > 0.0f && w > 0.0f) ? 1.0f / sqrtf(w) : 0.0f;
+            s->tx[i] = dsc * s->fx[i];
+            s->ty[i] = dsc * s->fy[i];
+            s->tz[i] = dsc * s->fz[i];
+            yy += (double)s->tx[i] * (double)s->tx[i] + (double)s->ty[i] * (double)s->ty[i] +
+                  (double)s->tz[i] * (double)s->tz[i];
+        }
+        if (!(xx > 0.0) || !(yy > 0.0)) {
+            mu = 2.0; /* nothing to estimate: keep the Gershgorin bound */
+            break;
+        }
+        mu = uy / xx;
+        const float inv = (float)(1.0 / sqrt(yy));
+        for (uint32_t i = 0; i < nn; i++) {
+            s->tx[i] *= inv;
+            s->ty[i] *= inv;
+            s->tz[i] *= inv;
+        }
+    }
+    float sigma = 1.1f * (float)mu * 0.5f;
+    sigma = sigma > 1.0f ? 1.0f : sigma;
+    sigma = sigma < 0.05f ? 0.05f : sigma;
+    s->mass_scale = sigma;
+    for (uint32_t i = 0; i < nn; i++) {
+        s->fx[i] = s->fy[i] = s->fz[i] = 0.0f;
+        s->tx[i] = s->ty[i] = s->tz[i] = 0.0f;
     }
 }
 
 static void compute_inv_mass(sc_msds *s, const sc_mesh *m)
 {
     for (uint32_t i = 0; i < s->node_count; i++) {
-        s->inv_mass[i] = (m->node_fixed[i] != 0u || !(s->mass_kg[i] > 0.0f))
-                             ? 0.0f
-                             : 1e3f / s->mass_kg[i];
+        s->inv_mass[i] =
+            (m->node_fixed[i] != 0u || !(s->mass_kg[i] > 0.0f)) ? 0.0f : 1e3f / s->mass_kg[i];
     }
 }
 
-int sc_msds_init(sc_msds *s, const sc_mesh *m, const sc_springs *sp,
-                 const sc_material_table *mat, const sc_msds_def *def)
+/* 6 V of a tet, exactly as volume_forces computes it */
+static inline float tet_d6(const float *x, const float *y, const float *z, uint32_t a0, uint32_t a1,
+                           uint32_t a2, uint32_t a3)
+{
+    const float x0 = x[a0], y0 = y[a0], z0 = z[a0];
+    const float e1x = x[a1] - x0, e1y = y[a1] - y0, e1z = z[a1] - z0;
+    const float e2x = x[a2] - x0, e2y = y[a2] - y0, e2z = z[a2] - z0;
+    const float e3x = x[a3] - x0, e3y = y[a3] - y0, e3z = z[a3] - z0;
+    const float g1x = e2y * e3z - e2z * e3y, g1y = e2z * e3x - e2x * e3z,
+                g1z = e2x * e3y - e2y * e3x;
+    return e1x * g1x + e1y * g1y + e1z * g1z;
+}
+
+/* |grad V| of each corner of tet (mm^2) */
+static void volume_gradients(const float *x, const float *y, const float *z, const uint32_t tet[4],
+                             float gn[4])
+{
+    const float e1x = x[tet[1]] - x[tet[0]], e1y = y[tet[1]] - y[tet[0]],
+                e1z = z[tet[1]] - z[tet[0]];
+    const float e2x = x[tet[2]] - x[tet[0]], e2y = y[tet[2]] - y[tet[0]],
+                e2z = z[tet[2]] - z[tet[0]];
+    const float e3x = x[tet[3]] - x[tet[0]], e3y = y[tet[3]] - y[tet[0]],
+                e3z = z[tet[3]] - z[tet[0]];
+    const float g1[3] = {e2y * e3z - e2z * e3y, e2z * e3x - e2x * e3z, e2x * e3y - e2y * e3x};
+    const float g2[3] = {e3y * e1z - e3z * e1y, e3z * e1x - e3x * e1z, e3x * e1y - e3y * e1x};
+    const float g3[3] = {e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x};
+    const float g0[3] = {-g1[0] - g2[0] - g3[0], -g1[1] - g2[1] - g3[1], -g1[2] - g2[2] - g3[2]};
+    const float *g[4] = {g0, g1, g2, g3};
+    for (uint32_t v = 0; v < 4u; v++) {
+        gn[v] = sqrtf(g[v][0] * g[v][0] + g[v][1] * g[v][1] + g[v][2] * g[v][2]) / 6.0f;
+    }
+}
+
+/* the kernel's tets in the corner numbering of a cell (bit 0: +x, bit 1: +y, bit 2: +z),
+ * even template; the mesh's tet q of an even cell has these nodes, of an odd cell the nodes
+ * of corners c ^ 1 */
+static const uint8_t s_cell_tet[5][4] = {
+    {0u, 1u, 2u, 4u}, {3u, 2u, 1u, 7u}, {5u, 4u, 7u, 1u}, {6u, 7u, 4u, 2u}, {1u, 2u, 4u, 7u},
+};
+
+static int same_node_set(const uint32_t a[4], const uint32_t b[4])
+{
+    for (uint32_t i = 0; i < 4u; i++) {
+        int hit = 0;
+        for (uint32_t j = 0; j < 4u; j++) {
+            hit |= a[i] == b[j];
+        }
+        if (!hit) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* Fill the per-cell volume data from the per-tet data (kvol36, labels). O(N). */
+static int init_cells(sc_msds *s, const sc_mesh *m)
+{
+    const uint32_t nx = m->nx, ny = m->ny, nz = m->nz, nxy = nx * ny;
+    const uint32_t oc[8] = {0u, 1u, nx, nx + 1u, nxy, nxy + 1u, nxy + nx, nxy + nx + 1u};
+    for (uint32_t q = 0; q < 5u; q++) {
+        for (uint32_t i = 0; i < SC_MAX_NODES; i++) {
+            s->cell_k[q][i] = 0.0f;
+            s->cell_d0[q][i] = 0.0f;
+        }
+    }
+    for (uint32_t i = 0; i < SC_MAX_NODES; i++) {
+        s->cell_par[i] = 0.0f;
+    }
+    s->cell_end = (nx < 2u || ny < 2u || nz < 2u) ? 0u : m->node_count - oc[7];
+    for (uint32_t k = 0; k + 1u < nz; k++) {
+        for (uint32_t j = 0; j + 1u < ny; j++) {
+            for (uint32_t i = 0; i + 1u < nx; i++) {
+                const uint32_t n = i + nx * (j + ny * k);
+                const uint32_t par = (i + j + k) & 1u;
+                const uint32_t cell = i + (nx - 1u) * (j + (ny - 1u) * k);
+                s->cell_par[n] = par != 0u ? 1.0f : 0.0f;
+                for (uint32_t q = 0; q < 5u; q++) {
+                    const uint32_t t = 5u * cell + q;
+                    uint32_t v[4];
+                    for (uint32_t a = 0; a < 4u; a++) {
+                        v[a] = n + oc[s_cell_tet[q][a] ^ par];
+                    }
+                    if (t >= m->tet_count || !same_node_set(v, m->tet[t])) {
+                        return SC_ERR_INVALID_ARG; /* not the mesh of sc_mesh_build */
+                    }
+                    s->cell_k[q][n] = s->kvol36[t];
+                    /* the kernel's formula on the rest positions: exact equilibrium */
+                    s->cell_d0[q][n] =
+                        tet_d6(m->rest_x, m->rest_y, m->rest_z, v[0], v[1], v[2], v[3]);
+                }
+            }
+        }
+    }
+    return SC_OK;
+}
+
+int sc_msds_init(sc_msds *s, const sc_mesh *m, const sc_springs *sp, const sc_material_table *mat,
+                 const sc_msds_def *def)
 {
     if (s == NULL || m == NULL || sp == NULL || mat == NULL || def == NULL) {
         return SC_ERR_INVALID_ARG;
@@ -97,6 +352,7 @@ int sc_msds_init(sc_msds *s, const sc_mesh *m, const sc_springs *sp,
     }
     for (uint32_t i = 0; i < SC_MAX_NODES; i++) {
         s->ksum_n_per_mm[i] = 0.0f;
+        s->kvsum_n_per_mm[i] = 0.0f;
         s->phys_mass_kg[i] = 0.0f;
         s->fx[i] = s->fy[i] = s->fz[i] = 0.0f;
         s->tx[i] = s->ty[i] = s->tz[i] = 0.0f;
@@ -137,7 +393,6 @@ int sc_msds_init(sc_msds *s, const sc_mesh *m, const sc_springs *sp,
         energy_ref += 0.5 * (double)kmm * (double)len * (double)len * 1e-3;
     }
     s->spring_count = sp->count;
-    s->energy_limit_j = (float)energy_ref;
     for (uint32_t t = 0; t < m->tet_count; t++) {
         if (m->tet_label[t] >= mat->count) {
             return SC_ERR_CASE_LABEL;
@@ -148,7 +403,44 @@ int sc_msds_init(sc_msds *s, const sc_mesh *m, const sc_springs *sp,
         for (uint32_t v = 0; v < 4u; v++) {
             s->phys_mass_kg[m->tet[t][v]] += quarter;
         }
+        /* volume term at ratio 1: energy 1/2 lambda V0 (dV / V0)^2 = 1/2 k_vol dV^2 with
+         * k_vol = lambda / V0 (lambda: Pa -> N/mm^2 x 1e-6) */
+        const sc_material *r = &mat->row[m->tet_label[t]];
+        const float lam_n_mm2 =
+            r->e_pa * r->poisson / ((1.0f + r->poisson) * (1.0f - 2.0f * r->poisson)) * 1e-6f;
+        const float kvol = v_mm3 > 0.0f ? lam_n_mm2 / v_mm3 : 0.0f;
+        s->kvol36[t] = kvol / 36.0f;
+        /* the step's own formula (same float operations): the rest state is an exact
+         * equilibrium of the volume term too */
+        s->d0_mm3[t] = tet_d6(m->rest_x, m->rest_y, m->rest_z, m->tet[t][0], m->tet[t][1],
+                              m->tet[t][2], m->tet[t][3]);
+        float gn[4];
+        volume_gradients(m->rest_x, m->rest_y, m->rest_z, m->tet[t], gn);
+        const float gsum = gn[0] + gn[1] + gn[2] + gn[3];
+        for (uint32_t v = 0; v < 4u; v++) {
+            s->tv[v][t] = m->tet[t][v];
+            /* block Gershgorin: |K_ij| = k_vol |g_i| |g_j| (g = grad V); the springs' bound
+             * is 2 ksum, so half of the row sum is added to ksum's place */
+            s->kvsum_n_per_mm[m->tet[t][v]] += 0.5f * kvol * gn[v] * gsum;
+        }
+        energy_ref += 0.5 * (double)kvol * (double)v_mm3 * (double)v_mm3 * 1e-3;
     }
+    s->vol_count = m->tet_count;
+    s->energy_limit_j = (float)energy_ref;
+    s->nx = m->nx;
+    s->nxy = m->nx * m->ny;
+    for (uint32_t c = 0; c < 3u; c++) {
+        s->cell_mm[c] = m->cell_mm[c];
+    }
+    rc = init_cells(s, m);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    /* free-node flags first (inv_mass > 0), then sigma, then the masses */
+    s->mass_scale = 1.0f;
+    compute_masses(s);
+    compute_inv_mass(s, m);
+    compute_mass_scale(s);
     compute_masses(s);
     compute_inv_mass(s, m);
     /* keep the fixed flags: inv_mass is 0 there; remember them through inv_mass only */
@@ -165,13 +457,19 @@ int sc_msds_set_def(sc_msds *s, const sc_msds_def *def)
         return rc;
     }
     const int remass = !(s->def.mass_per_stiffness_s2 <= def->mass_per_stiffness_s2 &&
-                         s->def.mass_per_stiffness_s2 >= def->mass_per_stiffness_s2);
+                         s->def.mass_per_stiffness_s2 >= def->mass_per_stiffness_s2 &&
+                         s->def.volume_stiffness_ratio <= def->volume_stiffness_ratio &&
+                         s->def.volume_stiffness_ratio >= def->volume_stiffness_ratio);
+    const int new_vr = !(s->def.volume_stiffness_ratio <= def->volume_stiffness_ratio &&
+                         s->def.volume_stiffness_ratio >= def->volume_stiffness_ratio);
     s->def = *def;
+    if (new_vr) {
+        compute_mass_scale(s); /* uses the free-node flags (inv_mass > 0) only */
+    }
     if (remass) {
+        compute_masses(s);
         for (uint32_t i = 0; i < s->node_count; i++) {
             const int fixed = !(s->inv_mass[i] > 0.0f);
-            const float scaled = s->def.mass_per_stiffness_s2 * s->ksum_n_per_mm[i] * 1e3f;
-            s->mass_kg[i] = scaled > s->phys_mass_kg[i] ? scaled : s->phys_mass_kg[i];
             s->inv_mass[i] = fixed || !(s->mass_kg[i] > 0.0f) ? 0.0f : 1e3f / s->mass_kg[i];
         }
     }
@@ -225,11 +523,307 @@ static void scatter_back(uint32_t cnt, const float *restrict tx, const float *re
     }
 }
 
+/* Volume term, per grid cell: the cell's 8 corners are loaded from straight rows (offsets
+ * o0..o7); an odd cell is mirrored in x (corner c <-> c ^ 1: the mesh's odd template is the
+ * even one mirrored) by selects, so that one branch-free body handles all five tets of every
+ * cell, with no gather by index. Per block of SC_MSDS_CELL_BLOCK cells: the mirrored corners
+ * go to a small buffer (L1), each of the five tets is one straight loop over the block that
+ * adds its corner forces to a second buffer, and 8 straight passes add those (mirrored back)
+ * to the nodes. Cells that do not exist (the last node of a row/plane) have k = 0.
+ * f_a = -(k_vol / 36) (D - D0) G_a per tet, see sc_msds.h. */
+static void volume_forces_cells(sc_msds *restrict s, float ratio, const float *restrict x,
+                                const float *restrict y, const float *restrict z,
+                                float *restrict fx, float *restrict fy, float *restrict fz)
+{
+    const uint32_t nx = s->nx, nxy = s->nxy;
+    const uint32_t o0 = 0u, o1 = 1u, o2 = nx, o3 = nx + 1u, o4 = nxy, o5 = nxy + 1u, o6 = nxy + nx,
+                   o7 = nxy + nx + 1u;
+    const uint32_t oc[8] = {o0, o1, o2, o3, o4, o5, o6, o7};
+    const float *restrict k0 = s->cell_k[0], *restrict k1 = s->cell_k[1],
+                          *restrict k2 = s->cell_k[2], *restrict k3 = s->cell_k[3],
+                          *restrict k4 = s->cell_k[4];
+    const float *restrict d00 = s->cell_d0[0], *restrict d01 = s->cell_d0[1],
+                          *restrict d02 = s->cell_d0[2], *restrict d03 = s->cell_d0[3],
+                          *restrict d04 = s->cell_d0[4];
+    const float *restrict parv = s->cell_par;
+    float *const qb = &s->cell_q[0][0][0];
+    float *const gb = &s->cell_g[0][0][0];
+#define SC_MSDS_Q(c, j) (qb + ((c)*3u + (j)) * SC_MSDS_CELL_BLOCK)
+#define SC_MSDS_G(c, j) (gb + ((c)*3u + (j)) * SC_MSDS_CELL_BLOCK)
+    for (uint32_t n0 = 0; n0 < s->cell_end; n0 += SC_MSDS_CELL_BLOCK) {
+        const uint32_t cnt =
+            s->cell_end - n0 < SC_MSDS_CELL_BLOCK ? s->cell_end - n0 : SC_MSDS_CELL_BLOCK;
+        const float *restrict od = parv + n0;
+        for (uint32_t j = 0; j < 3u; j++) {
+            const float *restrict p = (j == 0u ? x : j == 1u ? y : z) + n0;
+            float *restrict r0 = SC_MSDS_Q(0u, j), *restrict r1 = SC_MSDS_Q(1u, j);
+            float *restrict r2 = SC_MSDS_Q(2u, j), *restrict r3 = SC_MSDS_Q(3u, j);
+            float *restrict r4 = SC_MSDS_Q(4u, j), *restrict r5 = SC_MSDS_Q(5u, j);
+            float *restrict r6 = SC_MSDS_Q(6u, j), *restrict r7 = SC_MSDS_Q(7u, j);
+            for (uint32_t i = 0; i < cnt; i++) {
+                const float o = od[i], e = 1.0f - o; /* exactly 0 / 1: an exact blend */
+                const float p0 = p[i + o0], p1 = p[i + o1];
+                r0[i] = e * p0 + o * p1;
+                r1[i] = e * p1 + o * p0;
+                const float p2 = p[i + o2], p3 = p[i + o3];
+                r2[i] = e * p2 + o * p3;
+                r3[i] = e * p3 + o * p2;
+                const float p4 = p[i + o4], p5 = p[i + o5];
+                r4[i] = e * p4 + o * p5;
+                r5[i] = e * p5 + o * p4;
+                const float p6 = p[i + o6], p7 = p[i + o7];
+                r6[i] = e * p6 + o * p7;
+                r7[i] = e * p7 + o * p6;
+            }
+        }
+        for (uint32_t i = 0; i < 24u * SC_MSDS_CELL_BLOCK; i++) {
+            gb[i] = 0.0f;
+        }
+        { /* tet 0: corners 0 1 2 4 */
+            const float *restrict q0x = SC_MSDS_Q(0u, 0u), *restrict q0y = SC_MSDS_Q(0u, 1u),
+                                  *restrict q0z = SC_MSDS_Q(0u, 2u);
+            float *restrict w0x = SC_MSDS_G(0u, 0u), *restrict w0y = SC_MSDS_G(0u, 1u),
+                            *restrict w0z = SC_MSDS_G(0u, 2u);
+            const float *restrict q1x = SC_MSDS_Q(1u, 0u), *restrict q1y = SC_MSDS_Q(1u, 1u),
+                                  *restrict q1z = SC_MSDS_Q(1u, 2u);
+            float *restrict w1x = SC_MSDS_G(1u, 0u), *restrict w1y = SC_MSDS_G(1u, 1u),
+                            *restrict w1z = SC_MSDS_G(1u, 2u);
+            const float *restrict q2x = SC_MSDS_Q(2u, 0u), *restrict q2y = SC_MSDS_Q(2u, 1u),
+                                  *restrict q2z = SC_MSDS_Q(2u, 2u);
+            float *restrict w2x = SC_MSDS_G(2u, 0u), *restrict w2y = SC_MSDS_G(2u, 1u),
+                            *restrict w2z = SC_MSDS_G(2u, 2u);
+            const float *restrict q4x = SC_MSDS_Q(4u, 0u), *restrict q4y = SC_MSDS_Q(4u, 1u),
+                                  *restrict q4z = SC_MSDS_Q(4u, 2u);
+            float *restrict w4x = SC_MSDS_G(4u, 0u), *restrict w4y = SC_MSDS_G(4u, 1u),
+                            *restrict w4z = SC_MSDS_G(4u, 2u);
+            const float *restrict kq = k0 + n0, *restrict dq = d00 + n0;
+            for (uint32_t i = 0; i < cnt; i++) {
+                const float e1x = q1x[i] - q0x[i], e1y = q1y[i] - q0y[i], e1z = q1z[i] - q0z[i];
+                const float e2x = q2x[i] - q0x[i], e2y = q2y[i] - q0y[i], e2z = q2z[i] - q0z[i];
+                const float e3x = q4x[i] - q0x[i], e3y = q4y[i] - q0y[i], e3z = q4z[i] - q0z[i];
+                const float g1x = e2y * e3z - e2z * e3y, g1y = e2z * e3x - e2x * e3z,
+                            g1z = e2x * e3y - e2y * e3x;
+                const float g2x = e3y * e1z - e3z * e1y, g2y = e3z * e1x - e3x * e1z,
+                            g2z = e3x * e1y - e3y * e1x;
+                const float g3x = e1y * e2z - e1z * e2y, g3y = e1z * e2x - e1x * e2z,
+                            g3z = e1x * e2y - e1y * e2x;
+                const float d = e1x * g1x + e1y * g1y + e1z * g1z;
+                const float c = -ratio * kq[i] * (d - dq[i]);
+                w1x[i] += c * g1x;
+                w1y[i] += c * g1y;
+                w1z[i] += c * g1z;
+                w2x[i] += c * g2x;
+                w2y[i] += c * g2y;
+                w2z[i] += c * g2z;
+                w4x[i] += c * g3x;
+                w4y[i] += c * g3y;
+                w4z[i] += c * g3z;
+                w0x[i] -= c * (g1x + g2x + g3x);
+                w0y[i] -= c * (g1y + g2y + g3y);
+                w0z[i] -= c * (g1z + g2z + g3z);
+            }
+        }
+        { /* tet 1: corners 3 2 1 7 */
+            const float *restrict q3x = SC_MSDS_Q(3u, 0u), *restrict q3y = SC_MSDS_Q(3u, 1u),
+                                  *restrict q3z = SC_MSDS_Q(3u, 2u);
+            float *restrict w3x = SC_MSDS_G(3u, 0u), *restrict w3y = SC_MSDS_G(3u, 1u),
+                            *restrict w3z = SC_MSDS_G(3u, 2u);
+            const float *restrict q2x = SC_MSDS_Q(2u, 0u), *restrict q2y = SC_MSDS_Q(2u, 1u),
+                                  *restrict q2z = SC_MSDS_Q(2u, 2u);
+            float *restrict w2x = SC_MSDS_G(2u, 0u), *restrict w2y = SC_MSDS_G(2u, 1u),
+                            *restrict w2z = SC_MSDS_G(2u, 2u);
+            const float *restrict q1x = SC_MSDS_Q(1u, 0u), *restrict q1y = SC_MSDS_Q(1u, 1u),
+                                  *restrict q1z = SC_MSDS_Q(1u, 2u);
+            float *restrict w1x = SC_MSDS_G(1u, 0u), *restrict w1y = SC_MSDS_G(1u, 1u),
+                            *restrict w1z = SC_MSDS_G(1u, 2u);
+            const float *restrict q7x = SC_MSDS_Q(7u, 0u), *restrict q7y = SC_MSDS_Q(7u, 1u),
+                                  *restrict q7z = SC_MSDS_Q(7u, 2u);
+            float *restrict w7x = SC_MSDS_G(7u, 0u), *restrict w7y = SC_MSDS_G(7u, 1u),
+                            *restrict w7z = SC_MSDS_G(7u, 2u);
+            const float *restrict kq = k1 + n0, *restrict dq = d01 + n0;
+            for (uint32_t i = 0; i < cnt; i++) {
+                const float e1x = q2x[i] - q3x[i], e1y = q2y[i] - q3y[i], e1z = q2z[i] - q3z[i];
+                const float e2x = q1x[i] - q3x[i], e2y = q1y[i] - q3y[i], e2z = q1z[i] - q3z[i];
+                const float e3x = q7x[i] - q3x[i], e3y = q7y[i] - q3y[i], e3z = q7z[i] - q3z[i];
+                const float g1x = e2y * e3z - e2z * e3y, g1y = e2z * e3x - e2x * e3z,
+                            g1z = e2x * e3y - e2y * e3x;
+                const float g2x = e3y * e1z - e3z * e1y, g2y = e3z * e1x - e3x * e1z,
+                            g2z = e3x * e1y - e3y * e1x;
+                const float g3x = e1y * e2z - e1z * e2y, g3y = e1z * e2x - e1x * e2z,
+                            g3z = e1x * e2y - e1y * e2x;
+                const float d = e1x * g1x + e1y * g1y + e1z * g1z;
+                const float c = -ratio * kq[i] * (d - dq[i]);
+                w2x[i] += c * g1x;
+                w2y[i] += c * g1y;
+                w2z[i] += c * g1z;
+                w1x[i] += c * g2x;
+                w1y[i] += c * g2y;
+                w1z[i] += c * g2z;
+                w7x[i] += c * g3x;
+                w7y[i] += c * g3y;
+                w7z[i] += c * g3z;
+                w3x[i] -= c * (g1x + g2x + g3x);
+                w3y[i] -= c * (g1y + g2y + g3y);
+                w3z[i] -= c * (g1z + g2z + g3z);
+            }
+        }
+        { /* tet 2: corners 5 4 7 1 */
+            const float *restrict q5x = SC_MSDS_Q(5u, 0u), *restrict q5y = SC_MSDS_Q(5u, 1u),
+                                  *restrict q5z = SC_MSDS_Q(5u, 2u);
+            float *restrict w5x = SC_MSDS_G(5u, 0u), *restrict w5y = SC_MSDS_G(5u, 1u),
+                            *restrict w5z = SC_MSDS_G(5u, 2u);
+            const float *restrict q4x = SC_MSDS_Q(4u, 0u), *restrict q4y = SC_MSDS_Q(4u, 1u),
+                                  *restrict q4z = SC_MSDS_Q(4u, 2u);
+            float *restrict w4x = SC_MSDS_G(4u, 0u), *restrict w4y = SC_MSDS_G(4u, 1u),
+                            *restrict w4z = SC_MSDS_G(4u, 2u);
+            const float *restrict q7x = SC_MSDS_Q(7u, 0u), *restrict q7y = SC_MSDS_Q(7u, 1u),
+                                  *restrict q7z = SC_MSDS_Q(7u, 2u);
+            float *restrict w7x = SC_MSDS_G(7u, 0u), *restrict w7y = SC_MSDS_G(7u, 1u),
+                            *restrict w7z = SC_MSDS_G(7u, 2u);
+            const float *restrict q1x = SC_MSDS_Q(1u, 0u), *restrict q1y = SC_MSDS_Q(1u, 1u),
+                                  *restrict q1z = SC_MSDS_Q(1u, 2u);
+            float *restrict w1x = SC_MSDS_G(1u, 0u), *restrict w1y = SC_MSDS_G(1u, 1u),
+                            *restrict w1z = SC_MSDS_G(1u, 2u);
+            const float *restrict kq = k2 + n0, *restrict dq = d02 + n0;
+            for (uint32_t i = 0; i < cnt; i++) {
+                const float e1x = q4x[i] - q5x[i], e1y = q4y[i] - q5y[i], e1z = q4z[i] - q5z[i];
+                const float e2x = q7x[i] - q5x[i], e2y = q7y[i] - q5y[i], e2z = q7z[i] - q5z[i];
+                const float e3x = q1x[i] - q5x[i], e3y = q1y[i] - q5y[i], e3z = q1z[i] - q5z[i];
+                const float g1x = e2y * e3z - e2z * e3y, g1y = e2z * e3x - e2x * e3z,
+                            g1z = e2x * e3y - e2y * e3x;
+                const float g2x = e3y * e1z - e3z * e1y, g2y = e3z * e1x - e3x * e1z,
+                            g2z = e3x * e1y - e3y * e1x;
+                const float g3x = e1y * e2z - e1z * e2y, g3y = e1z * e2x - e1x * e2z,
+                            g3z = e1x * e2y - e1y * e2x;
+                const float d = e1x * g1x + e1y * g1y + e1z * g1z;
+                const float c = -ratio * kq[i] * (d - dq[i]);
+                w4x[i] += c * g1x;
+                w4y[i] += c * g1y;
+                w4z[i] += c * g1z;
+                w7x[i] += c * g2x;
+                w7y[i] += c * g2y;
+                w7z[i] += c * g2z;
+                w1x[i] += c * g3x;
+                w1y[i] += c * g3y;
+                w1z[i] += c * g3z;
+                w5x[i] -= c * (g1x + g2x + g3x);
+                w5y[i] -= c * (g1y + g2y + g3y);
+                w5z[i] -= c * (g1z + g2z + g3z);
+            }
+        }
+        { /* tet 3: corners 6 7 4 2 */
+            const float *restrict q6x = SC_MSDS_Q(6u, 0u), *restrict q6y = SC_MSDS_Q(6u, 1u),
+                                  *restrict q6z = SC_MSDS_Q(6u, 2u);
+            float *restrict w6x = SC_MSDS_G(6u, 0u), *restrict w6y = SC_MSDS_G(6u, 1u),
+                            *restrict w6z = SC_MSDS_G(6u, 2u);
+            const float *restrict q7x = SC_MSDS_Q(7u, 0u), *restrict q7y = SC_MSDS_Q(7u, 1u),
+                                  *restrict q7z = SC_MSDS_Q(7u, 2u);
+            float *restrict w7x = SC_MSDS_G(7u, 0u), *restrict w7y = SC_MSDS_G(7u, 1u),
+                            *restrict w7z = SC_MSDS_G(7u, 2u);
+            const float *restrict q4x = SC_MSDS_Q(4u, 0u), *restrict q4y = SC_MSDS_Q(4u, 1u),
+                                  *restrict q4z = SC_MSDS_Q(4u, 2u);
+            float *restrict w4x = SC_MSDS_G(4u, 0u), *restrict w4y = SC_MSDS_G(4u, 1u),
+                            *restrict w4z = SC_MSDS_G(4u, 2u);
+            const float *restrict q2x = SC_MSDS_Q(2u, 0u), *restrict q2y = SC_MSDS_Q(2u, 1u),
+                                  *restrict q2z = SC_MSDS_Q(2u, 2u);
+            float *restrict w2x = SC_MSDS_G(2u, 0u), *restrict w2y = SC_MSDS_G(2u, 1u),
+                            *restrict w2z = SC_MSDS_G(2u, 2u);
+            const float *restrict kq = k3 + n0, *restrict dq = d03 + n0;
+            for (uint32_t i = 0; i < cnt; i++) {
+                const float e1x = q7x[i] - q6x[i], e1y = q7y[i] - q6y[i], e1z = q7z[i] - q6z[i];
+                const float e2x = q4x[i] - q6x[i], e2y = q4y[i] - q6y[i], e2z = q4z[i] - q6z[i];
+                const float e3x = q2x[i] - q6x[i], e3y = q2y[i] - q6y[i], e3z = q2z[i] - q6z[i];
+                const float g1x = e2y * e3z - e2z * e3y, g1y = e2z * e3x - e2x * e3z,
+                            g1z = e2x * e3y - e2y * e3x;
+                const float g2x = e3y * e1z - e3z * e1y, g2y = e3z * e1x - e3x * e1z,
+                            g2z = e3x * e1y - e3y * e1x;
+                const float g3x = e1y * e2z - e1z * e2y, g3y = e1z * e2x - e1x * e2z,
+                            g3z = e1x * e2y - e1y * e2x;
+                const float d = e1x * g1x + e1y * g1y + e1z * g1z;
+                const float c = -ratio * kq[i] * (d - dq[i]);
+                w7x[i] += c * g1x;
+                w7y[i] += c * g1y;
+                w7z[i] += c * g1z;
+                w4x[i] += c * g2x;
+                w4y[i] += c * g2y;
+                w4z[i] += c * g2z;
+                w2x[i] += c * g3x;
+                w2y[i] += c * g3y;
+                w2z[i] += c * g3z;
+                w6x[i] -= c * (g1x + g2x + g3x);
+                w6y[i] -= c * (g1y + g2y + g3y);
+                w6z[i] -= c * (g1z + g2z + g3z);
+            }
+        }
+        { /* tet 4: corners 1 2 4 7 */
+            const float *restrict q1x = SC_MSDS_Q(1u, 0u), *restrict q1y = SC_MSDS_Q(1u, 1u),
+                                  *restrict q1z = SC_MSDS_Q(1u, 2u);
+            float *restrict w1x = SC_MSDS_G(1u, 0u), *restrict w1y = SC_MSDS_G(1u, 1u),
+                            *restrict w1z = SC_MSDS_G(1u, 2u);
+            const float *restrict q2x = SC_MSDS_Q(2u, 0u), *restrict q2y = SC_MSDS_Q(2u, 1u),
+                                  *restrict q2z = SC_MSDS_Q(2u, 2u);
+            float *restrict w2x = SC_MSDS_G(2u, 0u), *restrict w2y = SC_MSDS_G(2u, 1u),
+                            *restrict w2z = SC_MSDS_G(2u, 2u);
+            const float *restrict q4x = SC_MSDS_Q(4u, 0u), *restrict q4y = SC_MSDS_Q(4u, 1u),
+                                  *restrict q4z = SC_MSDS_Q(4u, 2u);
+            float *restrict w4x = SC_MSDS_G(4u, 0u), *restrict w4y = SC_MSDS_G(4u, 1u),
+                            *restrict w4z = SC_MSDS_G(4u, 2u);
+            const float *restrict q7x = SC_MSDS_Q(7u, 0u), *restrict q7y = SC_MSDS_Q(7u, 1u),
+                                  *restrict q7z = SC_MSDS_Q(7u, 2u);
+            float *restrict w7x = SC_MSDS_G(7u, 0u), *restrict w7y = SC_MSDS_G(7u, 1u),
+                            *restrict w7z = SC_MSDS_G(7u, 2u);
+            const float *restrict kq = k4 + n0, *restrict dq = d04 + n0;
+            for (uint32_t i = 0; i < cnt; i++) {
+                const float e1x = q2x[i] - q1x[i], e1y = q2y[i] - q1y[i], e1z = q2z[i] - q1z[i];
+                const float e2x = q4x[i] - q1x[i], e2y = q4y[i] - q1y[i], e2z = q4z[i] - q1z[i];
+                const float e3x = q7x[i] - q1x[i], e3y = q7y[i] - q1y[i], e3z = q7z[i] - q1z[i];
+                const float g1x = e2y * e3z - e2z * e3y, g1y = e2z * e3x - e2x * e3z,
+                            g1z = e2x * e3y - e2y * e3x;
+                const float g2x = e3y * e1z - e3z * e1y, g2y = e3z * e1x - e3x * e1z,
+                            g2z = e3x * e1y - e3y * e1x;
+                const float g3x = e1y * e2z - e1z * e2y, g3y = e1z * e2x - e1x * e2z,
+                            g3z = e1x * e2y - e1y * e2x;
+                const float d = e1x * g1x + e1y * g1y + e1z * g1z;
+                const float c = -ratio * kq[i] * (d - dq[i]);
+                w2x[i] += c * g1x;
+                w2y[i] += c * g1y;
+                w2z[i] += c * g1z;
+                w4x[i] += c * g2x;
+                w4y[i] += c * g2y;
+                w4z[i] += c * g2z;
+                w7x[i] += c * g3x;
+                w7y[i] += c * g3y;
+                w7z[i] += c * g3z;
+                w1x[i] -= c * (g1x + g2x + g3x);
+                w1y[i] -= c * (g1y + g2y + g3y);
+                w1z[i] -= c * (g1z + g2z + g3z);
+            }
+        }
+        for (uint32_t c = 0; c < 8u; c++) {
+            float *restrict hx = fx + n0 + oc[c];
+            float *restrict hy = fy + n0 + oc[c];
+            float *restrict hz = fz + n0 + oc[c];
+            const float *restrict ax = SC_MSDS_G(c, 0u), *restrict ay = SC_MSDS_G(c, 1u),
+                                  *restrict az = SC_MSDS_G(c, 2u);
+            const float *restrict bx = SC_MSDS_G(c ^ 1u, 0u), *restrict by = SC_MSDS_G(c ^ 1u, 1u),
+                                  *restrict bz = SC_MSDS_G(c ^ 1u, 2u);
+            /* od is exactly 0 or 1: (1 - od) a + od b is a or b exactly (finite) */
+            for (uint32_t i = 0; i < cnt; i++) {
+                const float o = od[i], e = 1.0f - o;
+                hx[i] += e * ax[i] + o * bx[i];
+                hy[i] += e * ay[i] + o * by[i];
+                hz[i] += e * az[i] + o * bz[i];
+            }
+        }
+    }
+#undef SC_MSDS_Q
+#undef SC_MSDS_G
+}
+
 static void integrate(uint32_t cnt, float dt, float drag, const float *restrict inv_m,
-                      const float *restrict fx, const float *restrict fy,
-                      const float *restrict fz, float *restrict vx, float *restrict vy,
-                      float *restrict vz, float *restrict x, float *restrict y,
-                      float *restrict z)
+                      const float *restrict fx, const float *restrict fy, const float *restrict fz,
+                      float *restrict vx, float *restrict vy, float *restrict vz, float *restrict x,
+                      float *restrict y, float *restrict z)
 {
     const float keep = 1.0f - dt * drag;
     for (uint32_t i = 0; i < cnt; i++) {
@@ -271,12 +865,16 @@ void sc_msds_substep(sc_msds *s, sc_nodes *n)
             continue;
         }
         const uint32_t cnt = nn - o;
-        family_forces(cnt, o, s->gamma_per_k_s, s->k_n_per_mm[d], s->l0_mm[d], n->x, n->y,
-                      n->z, n->vx, n->vy, n->vz, s->tx, s->ty, s->tz, s->fx, s->fy, s->fz);
+        family_forces(cnt, o, s->gamma_per_k_s, s->k_n_per_mm[d], s->l0_mm[d], n->x, n->y, n->z,
+                      n->vx, n->vy, n->vz, s->tx, s->ty, s->tz, s->fx, s->fy, s->fz);
         scatter_back(cnt, s->tx, s->ty, s->tz, s->fx + o, s->fy + o, s->fz + o);
     }
-    integrate(nn, s->def.dt_s, s->def.drag_per_s, s->inv_mass, s->fx, s->fy, s->fz, n->vx,
-              n->vy, n->vz, n->x, n->y, n->z);
+    if (s->def.volume_stiffness_ratio > 0.0f) {
+        volume_forces_cells(s, s->def.volume_stiffness_ratio, n->x, n->y, n->z, s->fx, s->fy,
+                            s->fz);
+    }
+    integrate(nn, s->def.dt_s, s->def.drag_per_s, s->inv_mass, s->fx, s->fy, s->fz, n->vx, n->vy,
+              n->vz, n->x, n->y, n->z);
 }
 
 void sc_msds_step(sc_msds *s, sc_nodes *n)
@@ -291,8 +889,7 @@ float sc_msds_kinetic_energy_j(const sc_msds *s, const sc_nodes *n)
     double e = 0.0;
     for (uint32_t i = 0; i < s->node_count; i++) {
         const double v2 = (double)n->vx[i] * (double)n->vx[i] +
-                          (double)n->vy[i] * (double)n->vy[i] +
-                          (double)n->vz[i] * (double)n->vz[i];
+                          (double)n->vy[i] * (double)n->vy[i] + (double)n->vz[i] * (double)n->vz[i];
         e += 0.5 * (double)s->mass_kg[i] * v2 * 1e-6; /* (mm/s)^2 -> (m/s)^2 */
     }
     return (float)e;
@@ -311,6 +908,14 @@ float sc_msds_elastic_energy_j(const sc_msds *s, const sc_nodes *n)
                                (double)s->l0_mm[d][i];
             e += 0.5 * (double)s->k_n_per_mm[d][i] * ext * ext * 1e-3;
         }
+    }
+    for (uint32_t t = 0; t < s->vol_count; t++) {
+        const uint32_t tet[4] = {s->tv[0][t], s->tv[1][t], s->tv[2][t], s->tv[3][t]};
+        const double dv =
+            (double)sc_mesh_tet_volume_mm3(n->x, n->y, n->z, tet) - (double)s->d0_mm3[t] / 6.0;
+        /* k_vol = 36 kvol36 */
+        e += 0.5 * (double)s->def.volume_stiffness_ratio * 36.0 * (double)s->kvol36[t] * dv * dv *
+             1e-3;
     }
     return (float)e;
 }

@@ -9,25 +9,50 @@
  * Units: mm, s, N, kg. Spring constants are Algorithm 1's N/m converted to N/mm (x 1e-3);
  * a [mm/s^2] = 1e3 * F [N] / m [kg].
  *
+ * Volume term (an extension of the paper, default on; the appendix itself notes that
+ * "generalized springs may be employed to preserve areas and volumes"): Algorithm 1's springs
+ * are kept exactly, and every tet adds the volume spring of Teschner et al. 2004,
+ *   f_a = -k_vol (V - V0) grad_a V,  k_vol = volume_stiffness_ratio * lambda / V0,
+ * lambda = E nu / ((1 + nu)(1 - 2 nu)) of the tet's material (energy 1/2 lambda V0 (dV/V0)^2).
+ * Without it the spring lattice has no resistance to a tet turning inside out (a folded mesh
+ * is a spring equilibrium) and behaves like Poisson ratio 1/4, so the tissue around the vein
+ * gives way instead of the vein; the clinical test fails (vein -17%, 7.9 mm left 2 s after
+ * the lift). The default ratio 6 (with drag 2.5 / s and mass scaling 1.2e-3 s^2) is a
+ * calibration against the clinical scene and the FEM (tests/unit/test_sc_tissue.c): lambda
+ * alone on top of the lattice leaves the block more compressible than the FEM's nu = 0.45.
+ * volume_stiffness_ratio = 0 gives the paper's MSDS exactly. The volume term is undamped.
+ *
  * Masses: explicit Euler is stable only if dt^2 k/m and dt gamma/m are small. With the
  * paper's constants (k = 0.002 E, gamma = 0.1 k, dt = 0.01 s) and real tissue masses (a few mg
  * per node) it diverges at once, so, as the paper says ("we choose appropriately small time
  * steps and we overdamp"), the particle mass is scaled: m_i = max(physical mass,
- * mass_per_stiffness_s2 * sum of k_ij over the springs at i). With gamma = 0.1 k every
- * eigenvalue lambda of M^-1 K is <= 2 / mass_per_stiffness_s2 (Gershgorin), and the damped
+ * mass_per_stiffness_s2 * sigma * w_i), w_i = (sum of k_ij over the springs at i) + (the
+ * volume term's block-Gershgorin row sum at i) / 2, so that by Gershgorin every eigenvalue of
+ * W^-1 K is <= 2. Gershgorin is loose on this mesh (the true largest eigenvalue mu of W^-1 K
+ * is 0.5..0.95 of the bound), which made the masses, and the block's response, needlessly
+ * slow; sigma = min(1, 1.1 mu / 2) with mu estimated at load time by 100 power iterations
+ * (deterministic; Rayleigh quotients approach mu from below, within 0.5% here; the 1.1
+ * covers the rest). Then every eigenvalue lambda of M^-1 K is <= 2 / mass_per_stiffness_s2
+ * as before, and the springs' damping (gamma = 0.1 k, a part of K) too, and the damped
  * explicit scheme is stable for (0.1 dt + dt^2) lambda < 2 (per mode: z^2 - (2 - a - b) z +
  * 1 - a = 0, a = 0.1 dt lambda, b = dt^2 lambda), i.e. mass_per_stiffness_s2 > 1.05e-3 s^2 at
- * dt = 0.01 s: the default 2e-3 s^2 leaves a factor ~1.9. sc_msds_def_validate() refuses
- * settings outside the stable region (with the contact stiffness of sc_tissue included).
- * An optional mass-proportional drag (friction with the surroundings, an external force of
- * eq. 2) damps the slow modes that gamma = 0.1 k leaves under-damped.
+ * dt = 0.01 s; the default 1.2e-3 s^2 with sigma's 1.1 leaves a factor ~1.25 (the volume
+ * modes are undamped and stable up to dt^2 lambda < 4). sc_msds_def_validate() refuses
+ * settings outside the stable region (with the contact stiffness of sc_tissue included: the
+ * penalty contact uses kref = m / mps, so its eigenvalue is contact_stiffness_ratio / mps).
+ * The mass-proportional drag (friction with the surroundings, an external force of eq. 2)
+ * damps the slow modes that gamma = 0.1 k leaves under-damped (default 2.5 / s).
  *
  * Layout (hot data, float32 SoA): the springs of the regular grid fall into 9 families by
  * grid direction (x, y, z and the six face diagonals); spring (n, n + off[d]) of family d is
  * stored at index n of family d's arrays (k = 0 where the grid has no such spring). A step
- * is then 9 straight, vectorisable passes with no gather/scatter by index.
- * Memory (N = SC_MAX_NODES): k, L0: 9 x 2 x 4 B; mass, 1/m, sum k: 12 B; forces and spring
- * scratch 24 B: 108 B per node, 0.88 MB at 8,192 nodes.
+ * is then 9 straight, vectorisable passes with no gather/scatter by index. The volume term
+ * runs per grid cell (origin node n): the 8 corners are loaded from straight rows, an odd
+ * cell is mirrored in x by an exact 0/1 blend, so one branch-free body computes all five
+ * tets, and the corner forces are added back by 8 straight passes per block of 64 cells.
+ * Memory (N = SC_MAX_NODES, T = SC_MAX_TETS): springs 72 B, masses/sums 24 B, scratch 24 B,
+ * cells 44 B per node; per tet 24 B (k, V0, nodes: load time and energy only):
+ * sizeof(sc_msds) about 2.2 MB at 8,192 nodes.
  *
  * Thread rules: one writer. Never allocates, never calls the OS. Deterministic (fixed loop
  * order, no reductions across threads).
@@ -42,59 +67,84 @@
 #include "sc_mesh.h"
 #include "sc_springs.h"
 
-#define SC_MSDS_FAMILIES 9u
+#define SC_MSDS_FAMILIES   9u
+#define SC_MSDS_CELL_BLOCK 64u /* cells per block of the volume term (scratch 12 KB) */
 
 typedef struct sc_msds_def {
-    float dt_s;                   /* explicit Euler step, > 0 (default SC_PHYS_DT_DEFAULT_S) */
-    uint32_t iterations;          /* Euler steps per frame, 1..SC_PHYS_ITERATIONS_MAX */
-    float mass_per_stiffness_s2;  /* mass scaling (see above), >= 0 */
-    float drag_per_s;             /* mass-proportional drag, >= 0 */
+    float dt_s;                    /* explicit Euler step, > 0 (default SC_PHYS_DT_DEFAULT_S) */
+    uint32_t iterations;           /* Euler steps per frame, 1..SC_PHYS_ITERATIONS_MAX */
+    float mass_per_stiffness_s2;   /* mass scaling (see above), > 0 */
+    float drag_per_s;              /* mass-proportional drag, >= 0 */
     float contact_stiffness_ratio; /* contact spring per node / its summed spring k, >= 0 */
+    float volume_stiffness_ratio;  /* volume term (see above) / Lame lambda, 0..100; 0: off */
 } sc_msds_def;
 
 typedef struct sc_msds {
     sc_msds_def def;
     uint32_t node_count;
-    uint32_t spring_count;              /* springs of Algorithm 1 mapped into the families */
-    uint32_t off[SC_MSDS_FAMILIES];     /* node index offset of each family, > 0 */
-    float gamma_per_k_s;                /* gamma / k, the same for every spring (0.1 s) */
-    float energy_limit_j;               /* runaway bound, see sc_msds_energy_ok() */
+    uint32_t spring_count;          /* springs of Algorithm 1 mapped into the families */
+    uint32_t off[SC_MSDS_FAMILIES]; /* node index offset of each family, > 0 */
+    float gamma_per_k_s;            /* gamma / k, the same for every spring (0.1 s) */
+    float energy_limit_j;           /* runaway bound, see sc_msds_energy_ok() */
     SC_ALIGN_HOT float k_n_per_mm[SC_MSDS_FAMILIES][SC_MAX_NODES];
     SC_ALIGN_HOT float l0_mm[SC_MSDS_FAMILIES][SC_MAX_NODES];
     SC_ALIGN_HOT float mass_kg[SC_MAX_NODES];
-    SC_ALIGN_HOT float inv_mass[SC_MAX_NODES]; /* 1e3 / m (mm/s^2 per N); 0: fixed node */
+    SC_ALIGN_HOT float inv_mass[SC_MAX_NODES];      /* 1e3 / m (mm/s^2 per N); 0: fixed node */
     SC_ALIGN_HOT float ksum_n_per_mm[SC_MAX_NODES]; /* sum of spring k at each node */
     SC_ALIGN_HOT float phys_mass_kg[SC_MAX_NODES];  /* density x volume / 4 per tet corner */
-    SC_ALIGN_HOT float fx[SC_MAX_NODES]; /* scratch: net force of the current step, N */
+    SC_ALIGN_HOT float fx[SC_MAX_NODES];            /* scratch: net force of the current step, N */
     SC_ALIGN_HOT float fy[SC_MAX_NODES];
     SC_ALIGN_HOT float fz[SC_MAX_NODES];
     SC_ALIGN_HOT float tx[SC_MAX_NODES]; /* scratch: spring forces of one family, N */
     SC_ALIGN_HOT float ty[SC_MAX_NODES];
     SC_ALIGN_HOT float tz[SC_MAX_NODES];
+    /* volume term (extension, see above): tets with a non-zero volume stiffness */
+    uint32_t vol_count;
+    SC_ALIGN_HOT float kvol36[SC_MAX_TETS];          /* k_vol / 36, N/mm^5 (6V and its gradient) */
+    SC_ALIGN_HOT float d0_mm3[SC_MAX_TETS];          /* rest 6V, mm^3 */
+    SC_ALIGN_HOT uint32_t tv[4][SC_MAX_TETS];        /* node indices (the mesh's tet, SoA) */
+    SC_ALIGN_HOT float kvsum_n_per_mm[SC_MAX_NODES]; /* volume term's Gershgorin share per node */
+    SC_ALIGN_HOT float kref_n_per_mm[SC_MAX_NODES];  /* mass-equivalent stiffness m / mps */
+    /* the volume term per grid cell (hot): cell with origin node n, its tet q (mesh order) */
+    SC_ALIGN_HOT float cell_k[5][SC_MAX_NODES];          /* k_vol / 36 at ratio 1; 0: no cell */
+    SC_ALIGN_HOT float cell_d0[5][SC_MAX_NODES];         /* rest 6V in the kernel's corner order */
+    SC_ALIGN_HOT float cell_par[SC_MAX_NODES];           /* 1: odd cell (mirrored template), 0 */
+    uint32_t cell_end;                                   /* origins 0..cell_end-1 are visited */
+    SC_ALIGN_HOT float cell_q[8][3][SC_MSDS_CELL_BLOCK]; /* scratch: mirrored corners */
+    SC_ALIGN_HOT float cell_g[8][3][SC_MSDS_CELL_BLOCK]; /* scratch: their forces */
+    float mass_scale; /* sigma (see above): 1.1 x spectral estimate / Gershgorin, <= 1 */
+    uint32_t nx, nxy; /* grid shape and cell (rest geometry for the spectral estimate) */
+    float cell_mm[3];
 } sc_msds;
 
-/* dt 0.01 s, 20 iterations (paper), mass scaling 2e-3 s^2, drag 0, contact ratio 0.5. */
+/* dt 0.01 s, 20 iterations (paper), mass scaling 1.2e-3 s^2, drag 2.5 / s, contact ratio
+ * 0.5, volume term ratio 6. */
 sc_msds_def sc_msds_default_def(void);
 
 /* Finite, ranges, and the explicit stability bound above. O(1).
  * Errors: SC_ERR_INVALID_ARG (NULL), SC_ERR_NOT_FINITE, SC_ERR_RANGE (incl. unstable). */
 int sc_msds_def_validate(const sc_msds_def *def);
 
-/* Map Algorithm 1's springs into the grid families, compute rest lengths from the mesh's rest
- * positions (so the rest state is an exact equilibrium), masses from the material densities
- * and the mass scaling. Call at case load. O(springs + tets + nodes). Never allocates.
- * Errors: SC_ERR_INVALID_ARG (NULL, mesh/spring mismatch), the def's errors,
+/* Map Algorithm 1's springs into the grid families, compute rest lengths and rest volumes
+ * from the mesh's rest positions with the step's own float operations (so the rest state is
+ * an exact equilibrium), the volume term per tet and per cell, masses from the material
+ * densities, the mass scaling and sigma (power iterations). Call at case load.
+ * O(springs + 100 (9 N + tets)). Never allocates.
+ * Errors: SC_ERR_INVALID_ARG (NULL, mesh/spring mismatch, a mesh that is not the regular
+ * 5-tet grid of sc_mesh_build), the def's errors,
  * SC_ERR_MESH_SPRINGS (a spring that is not between grid neighbours, or gamma / k not the same
  * for all springs), SC_ERR_CASE_LABEL. */
-int sc_msds_init(sc_msds *s, const sc_mesh *m, const sc_springs *sp,
-                 const sc_material_table *mat, const sc_msds_def *def);
+int sc_msds_init(sc_msds *s, const sc_mesh *m, const sc_springs *sp, const sc_material_table *mat,
+                 const sc_msds_def *def);
 
-/* Change dt / iterations / mass scaling / drag at run time (masses recomputed, O(N)).
+/* Change the settings at run time: masses recomputed if the mass scaling or the volume
+ * ratio changes (O(N); a new volume ratio also re-estimates sigma, O(100 (9 N + tets))).
  * Errors: as sc_msds_def_validate (the old settings stay). */
 int sc_msds_set_def(sc_msds *s, const sc_msds_def *def);
 
-/* One explicit Euler step (eqs. 3-5) with the external forces in n->f*; fixed nodes do not
- * move. O(9 N). Never allocates, cannot fail (divergence is detected by the caller). */
+/* One explicit Euler step (eqs. 3-5) with the external forces in n->f*, spring forces and
+ * the volume term; fixed nodes do not move. O(9 N + 5 N). Never allocates, cannot fail
+ * (divergence is detected by the caller). */
 void sc_msds_substep(sc_msds *s, sc_nodes *n);
 
 /* def.iterations substeps with constant external forces. O(iterations * 9 N). */
@@ -103,7 +153,7 @@ void sc_msds_step(sc_msds *s, sc_nodes *n);
 /* Kinetic energy 1/2 sum m v^2 (J, scaled masses). O(N). */
 float sc_msds_kinetic_energy_j(const sc_msds *s, const sc_nodes *n);
 
-/* Elastic energy 1/2 sum k (|d| - L0)^2 (J). O(9 N). */
+/* Elastic energy 1/2 sum k (|d| - L0)^2 + 1/2 sum k_vol (V - V0)^2 (J). O(9 N + tets). */
 float sc_msds_elastic_energy_j(const sc_msds *s, const sc_nodes *n);
 
 #endif /* SC_MSDS_H */

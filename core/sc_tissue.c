@@ -167,7 +167,7 @@ static void step_msds(sc_tissue *t)
     for (uint32_t it = 0; it < t->msds.def.iterations; it++) {
         if (t->def.msds_contact == SC_TISSUE_CONTACT_PENALTY) {
             sc_contact_clear_forces(&t->contacts, n->fx, n->fy, n->fz);
-            sc_contact_add_forces(&t->contacts, n->x, n->y, n->z, t->msds.ksum_n_per_mm, ratio,
+            sc_contact_add_forces(&t->contacts, n->x, n->y, n->z, t->msds.kref_n_per_mm, ratio,
                                   n->fx, n->fy, n->fz);
         }
         sc_msds_substep(&t->msds, n);

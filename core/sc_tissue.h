@@ -10,7 +10,8 @@
  *      that step (SC_TISSUE_CONTACT_PROJECT, default: x onto the plane, inward normal
  *      velocity removed), or, with SC_TISSUE_CONTACT_PENALTY, the paper's spring-like
  *      repulsion kappa * depth * normal before every step (kappa = contact_stiffness_ratio *
- *      sum of the node's spring constants; softer, the tissue sinks into the probe);
+ *      the node's mass-equivalent stiffness m / mass_per_stiffness, sc_msds.h; softer, the
+ *      tissue sinks into the probe);
  *      FEM: one implicit step of length iterations * dt (the same simulated time per frame
  *      as the MSDS) with `iterations` CG iterations; nodes in the probe or on its surface
  *      (depth > -SC_TISSUE_CONTACT_HOLD_MM) are moved onto the surface as kinematic
@@ -110,7 +111,7 @@ int sc_tissue_init(sc_tissue *t, const sc_tissue_def *def, const sc_volume *vol,
                    const sc_material_table *mat, uint8_t default_label);
 
 /* Run one frame with the probe at *probe (volume frame), or no contact (probe == NULL).
- * Cost: MSDS O(iterations * 9 N + iterations * contacts); FEM: see sc_fem_step; collider
+ * Cost: MSDS O(iterations * 14 N + iterations * contacts); FEM: see sc_fem_step; collider
  * O(contact-area candidates); skin O(iterations * skin particles); guard O(N).
  * Never allocates. Returns 0, SC_ERR_POSE_IMPLAUSIBLE (pose refused: frame run without
  * contact), or SC_ERR_PHYS_UNSTABLE (the guard reset the tissue to rest). */

@@ -182,17 +182,11 @@ static void clinical_fem_vein_collapses_artery_and_thrombus_resist(void **state)
 static void clinical_msds_vein_collapses_artery_and_thrombus_resist(void **state)
 {
     (void)state;
+    /* default MSDS: Algorithm 1's springs plus the volume term (sc_msds.h); without the
+     * volume term the top cell layer folds and this fails (vein -17%, 7.9 mm after 2 s) */
     int ok = 0;
     check_clinical(SC_TISSUE_MSDS, &ok);
-    if (!ok) {
-        /* KNOWN FAILURE, reported, not hidden: the MSDS of Algorithm 1 has no resistance to
-         * element inversion; under this 4.5 mm press the top cell layer (its surface springs
-         * carry half the summed stiffness, its even nodes only axial springs) folds and the
-         * folded state is a spring equilibrium, so the block neither compresses the vein
-         * enough nor returns to rest. */
-        print_message("MSDS does NOT meet the clinical criteria (see the numbers above)\n");
-        skip();
-    }
+    assert_true(ok);
 }
 
 /* ---- MSDS vs FEM ---------------------------------------------------------------------------- */
@@ -236,14 +230,14 @@ static void msds_and_fem_give_a_similar_indentation_response(void **state)
     print_message("5%% press: relative L2 difference MSDS vs FEM displacement %.2f; max |uz| "
                   "FEM %.2f MSDS %.2f mm; mean uz at 10 mm depth under the probe FEM %.2f MSDS "
                   "%.2f mm\n", rel, uf_max, um_max, depth_f / nd, depth_m / nd);
-    /* Bound: the two models differ by construction (the MSDS has an effective Poisson ratio
-     * of 1/4 and no volume stiffness, the FEM's tissue has 0.45), so the fields cannot agree
-     * closely; "similar" is asserted as: the same press transmitted to 10 mm depth within a
-     * factor of 2, and a field difference below 100% of the FEM field (a sign error, a
-     * scale error of 2x or a missing load path all break one of them). */
+    /* Bound: the two models still differ by construction (a spring lattice with a volume
+     * term against linear tets; measured: L2 difference 0.15, depth ratio 1.12), so
+     * "similar" is asserted as: the press transmitted to 10 mm depth within 25% (ratio
+     * 0.8..1.25) and a field difference below 30% of the FEM field (a sign error, a 2x
+     * scale error or a missing load path all break one of them). */
     assert_true(depth_f > 0.0 && depth_m > 0.0);
-    assert_true(depth_m / depth_f >= 0.5 && depth_m / depth_f <= 2.0);
-    assert_true(rel < 1.0);
+    assert_true(depth_m / depth_f >= 0.8 && depth_m / depth_f <= 1.25);
+    assert_true(rel < 0.3);
 }
 
 /* ---- determinism, switch, guard --------------------------------------------------------------- */
@@ -277,7 +271,7 @@ static void same_inputs_give_a_bit_identical_state_hash(void **state)
 /* MSDS only (the FEM's numerics belong to its own test): a fixed press-and-lift script gives
  * a stored hash in every build type, so that a change in the MSDS/collider/skin numerics is a
  * visible decision (update the constant with the printed value when it is intended). */
-#define SC_TISSUE_MSDS_HASH UINT64_C(0xfc579def65361424)
+#define SC_TISSUE_MSDS_HASH UINT64_C(0xb471b8d79992d059)
 static void msds_script_matches_the_stored_state_hash(void **state)
 {
     (void)state;

@@ -4,7 +4,8 @@
  * muscle, vein, artery) with the probe held 3 mm (10%) into the skin, so that contacts exist
  * every frame. Per mesh size and method: `frames` frames after a warm-up; wall time of
  * sc_tissue_step (solver + collision, skin off) and of the collision detection alone; one
- * thread. Usage: bench-physics [frames]   (default 200) */
+ * thread. Then the MSDS at 32x16x16 with the volume term off and on (sc_msds.h).
+ * Usage: bench-physics [frames]   (default 200) */
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
@@ -33,8 +34,8 @@ typedef struct result {
     uint32_t contacts, mpr;
 } result;
 
-static int run(uint32_t nx, uint32_t ny, uint32_t nz, sc_tissue_method m, int frames,
-               result *out)
+static int run(uint32_t nx, uint32_t ny, uint32_t nz, sc_tissue_method m, float volume_ratio,
+               int frames, result *out)
 {
     sc_test_scene_params p = sc_test_scene_default_params();
     p.nx = nx;
@@ -47,6 +48,7 @@ static int run(uint32_t nx, uint32_t ny, uint32_t nz, sc_tissue_method m, int fr
     d.collider = sc_test_scene_collider(&scene);
     d.skin_enabled = 0u;
     d.method = m;
+    d.msds.volume_stiffness_ratio = volume_ratio;
     sc_material_table mat;
     sc_material_table_default(&mat);
     int rc = sc_tissue_init(&g_t, &d, &scene.vol, &mat, SC_LABEL_FAT);
@@ -97,8 +99,9 @@ int main(int argc, char **argv)
            "MSDS mean/p99 [paper]", "FEM mean/p99 [paper]", "collision ms (contacts) [paper]");
     for (int s = 0; s < 4; s++) {
         result a, b;
-        int rc = run(sizes[s][0], sizes[s][1], sizes[s][2], SC_TISSUE_MSDS, frames, &a);
-        rc |= run(sizes[s][0], sizes[s][1], sizes[s][2], SC_TISSUE_FEM, frames, &b);
+        const float vr = sc_msds_default_def().volume_stiffness_ratio;
+        int rc = run(sizes[s][0], sizes[s][1], sizes[s][2], SC_TISSUE_MSDS, vr, frames, &a);
+        rc |= run(sizes[s][0], sizes[s][1], sizes[s][2], SC_TISSUE_FEM, vr, frames, &b);
         if (rc != 0) {
             fprintf(stderr, "run failed: %d\n", rc);
             return 1;
@@ -110,6 +113,18 @@ int main(int argc, char **argv)
                name, g_t.mesh.node_count, g_t.mesh.tet_count, a.mean_ms, a.p99_ms, paper_msds[s],
                b.mean_ms, b.p99_ms, paper_fem[s], a.coll_ms, a.contacts, a.mpr, paper_coll[s]);
     }
+    /* the MSDS's cost split at the largest size: Algorithm 1's springs alone (the paper's
+     * MSDS, volume term off) against the default (springs + volume term) */
+    result a0, a1;
+    if (run(32u, 16u, 16u, SC_TISSUE_MSDS, 0.0f, frames, &a0) != 0 ||
+        run(32u, 16u, 16u, SC_TISSUE_MSDS, sc_msds_default_def().volume_stiffness_ratio, frames,
+            &a1) != 0) {
+        fprintf(stderr, "run failed\n");
+        return 1;
+    }
+    printf("MSDS 32x16x16 mean/p99 ms: springs only (volume term off) %.2f / %.2f, springs + "
+           "volume term (default) %.2f / %.2f; target 2 ms\n",
+           a0.mean_ms, a0.p99_ms, a1.mean_ms, a1.p99_ms);
     printf("sizeof(sc_tissue) = %zu bytes (sc_msds %zu, sc_fem %zu, sc_springs %zu)\n",
            sizeof(sc_tissue), sizeof(sc_msds), sizeof(sc_fem), sizeof(sc_springs));
     return 0;
