@@ -486,18 +486,22 @@ static void family_forces(uint32_t cnt, uint32_t o, float gk, const float *restr
                           float *restrict tz, float *restrict fx, float *restrict fy,
                           float *restrict fz)
 {
+    /* the far ends as pointers: an index i + o in 32-bit unsigned arithmetic may wrap, which
+     * keeps the vectoriser from using straight vector loads */
+    const float *restrict xo = x + o, *restrict yo = y + o, *restrict zo = z + o;
+    const float *restrict vxo = vx + o, *restrict vyo = vy + o, *restrict vzo = vz + o;
     for (uint32_t i = 0; i < cnt; i++) {
-        const float dx = x[i + o] - x[i];
-        const float dy = y[i + o] - y[i];
-        const float dz = z[i + o] - z[i];
+        const float dx = xo[i] - x[i];
+        const float dy = yo[i] - y[i];
+        const float dz = zo[i] - z[i];
         const float len2 = dx * dx + dy * dy + dz * dz;
         /* guard of 1/|d| for a collapsed spring without a branch or fmaxf (either stops the
          * vectoriser); the same formula gives the rest lengths in sc_msds_init */
         const float len = sqrtf(len2 + SC_MSDS_MIN_LEN2_MM2);
         const float inv = 1.0f / len;
-        const float dvx = vx[i + o] - vx[i];
-        const float dvy = vy[i + o] - vy[i];
-        const float dvz = vz[i + o] - vz[i];
+        const float dvx = vxo[i] - vx[i];
+        const float dvy = vyo[i] - vy[i];
+        const float dvz = vzo[i] - vz[i];
         const float rate = (dx * dvx + dy * dvy + dz * dvz) * inv; /* d|d|/dt, mm/s */
         /* Voigt element (eq. 1): k (|d| - L0) + gamma d|d|/dt with gamma = 0.1 k */
         const float mag = k[i] * ((len - l0[i]) + gk * rate);
@@ -528,9 +532,9 @@ static void scatter_back(uint32_t cnt, const float *restrict tx, const float *re
  * even one mirrored) by selects, so that one branch-free body handles all five tets of every
  * cell, with no gather by index. Per block of SC_MSDS_CELL_BLOCK cells: the mirrored corners
  * go to a small buffer (L1), each of the five tets is one straight loop over the block that
- * adds its corner forces to a second buffer, and 8 straight passes add those (mirrored back)
- * to the nodes. Cells that do not exist (the last node of a row/plane) have k = 0.
- * f_a = -(k_vol / 36) (D - D0) G_a per tet, see sc_msds.h. */
+ * adds its corner forces to a second buffer (the first tet to reach a corner writes it), and 8
+ * straight passes add those (mirrored back) to the nodes. Cells that do not exist (the last node of
+ * a row/plane) have k = 0. f_a = -(k_vol / 36) (D - D0) G_a per tet, see sc_msds.h. */
 static void volume_forces_cells(sc_msds *restrict s, float ratio, const float *restrict x,
                                 const float *restrict y, const float *restrict z,
                                 float *restrict fx, float *restrict fy, float *restrict fz)
@@ -556,28 +560,30 @@ static void volume_forces_cells(sc_msds *restrict s, float ratio, const float *r
         const float *restrict od = parv + n0;
         for (uint32_t j = 0; j < 3u; j++) {
             const float *restrict p = (j == 0u ? x : j == 1u ? y : z) + n0;
+            /* corner rows as pointers (see family_forces) */
+            const float *restrict p0r = p + o0, *restrict p1r = p + o1, *restrict p2r = p + o2,
+                                  *restrict p3r = p + o3, *restrict p4r = p + o4,
+                                  *restrict p5r = p + o5, *restrict p6r = p + o6,
+                                  *restrict p7r = p + o7;
             float *restrict r0 = SC_MSDS_Q(0u, j), *restrict r1 = SC_MSDS_Q(1u, j);
             float *restrict r2 = SC_MSDS_Q(2u, j), *restrict r3 = SC_MSDS_Q(3u, j);
             float *restrict r4 = SC_MSDS_Q(4u, j), *restrict r5 = SC_MSDS_Q(5u, j);
             float *restrict r6 = SC_MSDS_Q(6u, j), *restrict r7 = SC_MSDS_Q(7u, j);
             for (uint32_t i = 0; i < cnt; i++) {
                 const float o = od[i], e = 1.0f - o; /* exactly 0 / 1: an exact blend */
-                const float p0 = p[i + o0], p1 = p[i + o1];
+                const float p0 = p0r[i], p1 = p1r[i];
                 r0[i] = e * p0 + o * p1;
                 r1[i] = e * p1 + o * p0;
-                const float p2 = p[i + o2], p3 = p[i + o3];
+                const float p2 = p2r[i], p3 = p3r[i];
                 r2[i] = e * p2 + o * p3;
                 r3[i] = e * p3 + o * p2;
-                const float p4 = p[i + o4], p5 = p[i + o5];
+                const float p4 = p4r[i], p5 = p5r[i];
                 r4[i] = e * p4 + o * p5;
                 r5[i] = e * p5 + o * p4;
-                const float p6 = p[i + o6], p7 = p[i + o7];
+                const float p6 = p6r[i], p7 = p7r[i];
                 r6[i] = e * p6 + o * p7;
                 r7[i] = e * p7 + o * p6;
             }
-        }
-        for (uint32_t i = 0; i < 24u * SC_MSDS_CELL_BLOCK; i++) {
-            gb[i] = 0.0f;
         }
         { /* tet 0: corners 0 1 2 4 */
             const float *restrict q0x = SC_MSDS_Q(0u, 0u), *restrict q0y = SC_MSDS_Q(0u, 1u),
@@ -609,18 +615,18 @@ static void volume_forces_cells(sc_msds *restrict s, float ratio, const float *r
                             g3z = e1x * e2y - e1y * e2x;
                 const float d = e1x * g1x + e1y * g1y + e1z * g1z;
                 const float c = -ratio * kq[i] * (d - dq[i]);
-                w1x[i] += c * g1x;
-                w1y[i] += c * g1y;
-                w1z[i] += c * g1z;
-                w2x[i] += c * g2x;
-                w2y[i] += c * g2y;
-                w2z[i] += c * g2z;
-                w4x[i] += c * g3x;
-                w4y[i] += c * g3y;
-                w4z[i] += c * g3z;
-                w0x[i] -= c * (g1x + g2x + g3x);
-                w0y[i] -= c * (g1y + g2y + g3y);
-                w0z[i] -= c * (g1z + g2z + g3z);
+                w1x[i] = c * g1x;
+                w1y[i] = c * g1y;
+                w1z[i] = c * g1z;
+                w2x[i] = c * g2x;
+                w2y[i] = c * g2y;
+                w2z[i] = c * g2z;
+                w4x[i] = c * g3x;
+                w4y[i] = c * g3y;
+                w4z[i] = c * g3z;
+                w0x[i] = -(c * (g1x + g2x + g3x));
+                w0y[i] = -(c * (g1y + g2y + g3y));
+                w0z[i] = -(c * (g1z + g2z + g3z));
             }
         }
         { /* tet 1: corners 3 2 1 7 */
@@ -659,12 +665,12 @@ static void volume_forces_cells(sc_msds *restrict s, float ratio, const float *r
                 w1x[i] += c * g2x;
                 w1y[i] += c * g2y;
                 w1z[i] += c * g2z;
-                w7x[i] += c * g3x;
-                w7y[i] += c * g3y;
-                w7z[i] += c * g3z;
-                w3x[i] -= c * (g1x + g2x + g3x);
-                w3y[i] -= c * (g1y + g2y + g3y);
-                w3z[i] -= c * (g1z + g2z + g3z);
+                w7x[i] = c * g3x;
+                w7y[i] = c * g3y;
+                w7z[i] = c * g3z;
+                w3x[i] = -(c * (g1x + g2x + g3x));
+                w3y[i] = -(c * (g1y + g2y + g3y));
+                w3z[i] = -(c * (g1z + g2z + g3z));
             }
         }
         { /* tet 2: corners 5 4 7 1 */
@@ -706,9 +712,9 @@ static void volume_forces_cells(sc_msds *restrict s, float ratio, const float *r
                 w1x[i] += c * g3x;
                 w1y[i] += c * g3y;
                 w1z[i] += c * g3z;
-                w5x[i] -= c * (g1x + g2x + g3x);
-                w5y[i] -= c * (g1y + g2y + g3y);
-                w5z[i] -= c * (g1z + g2z + g3z);
+                w5x[i] = -(c * (g1x + g2x + g3x));
+                w5y[i] = -(c * (g1y + g2y + g3y));
+                w5z[i] = -(c * (g1z + g2z + g3z));
             }
         }
         { /* tet 3: corners 6 7 4 2 */
@@ -750,9 +756,9 @@ static void volume_forces_cells(sc_msds *restrict s, float ratio, const float *r
                 w2x[i] += c * g3x;
                 w2y[i] += c * g3y;
                 w2z[i] += c * g3z;
-                w6x[i] -= c * (g1x + g2x + g3x);
-                w6y[i] -= c * (g1y + g2y + g3y);
-                w6z[i] -= c * (g1z + g2z + g3z);
+                w6x[i] = -(c * (g1x + g2x + g3x));
+                w6y[i] = -(c * (g1y + g2y + g3y));
+                w6z[i] = -(c * (g1z + g2z + g3z));
             }
         }
         { /* tet 4: corners 1 2 4 7 */
