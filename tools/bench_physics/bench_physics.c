@@ -5,9 +5,12 @@
  * every frame. Per mesh size and method: `frames` frames after a warm-up; wall time of
  * sc_tissue_step (solver + collision, skin off) and of the collision detection alone; one
  * thread. Then the MSDS at 32x16x16 with the volume term off and on (sc_msds.h).
- * Usage: bench-physics [frames]   (default 200) */
+ * Usage: bench-physics [frames]   (default 200)
+ *        bench-physics frames msds   (the MSDS solver alone, see msds_only) */
 #include <stdio.h>
+#include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 #include "sc_labels.h"
@@ -87,9 +90,41 @@ static int run(uint32_t nx, uint32_t ny, uint32_t nz, sc_tissue_method m, float 
     return 0;
 }
 
+/* The MSDS solver alone (sc_msds_step: 20 substeps, no collision, no contact handling) at
+ * 32x16x16 after the press of run(): min over 5 batches of frames / 5 frames, springs only
+ * and default. For instruction counts: valgrind --tool=callgrind
+ * --toggle-collect=sc_msds_step bench-physics 10 msds (Ir / 10 = per frame, both runs). */
+static int msds_only(int frames)
+{
+    const float ratios[2] = {0.0f, sc_msds_default_def().volume_stiffness_ratio};
+    const int batch = frames >= 5 ? frames / 5 : 1;
+    for (int r = 0; r < 2; r++) {
+        result a;
+        if (run(32u, 16u, 16u, SC_TISSUE_MSDS, ratios[r], 1, &a) != 0) {
+            return 1;
+        }
+        uint64_t best = UINT64_MAX;
+        for (int b = 0; b < 5; b++) {
+            const uint64_t t0 = now_ns();
+            for (int f = 0; f < batch; f++) {
+                sc_msds_step(&g_t.msds, &g_t.nodes);
+            }
+            const uint64_t t = (now_ns() - t0) / (uint64_t)batch;
+            best = t < best ? t : best;
+        }
+        printf("sc_msds_step 32x16x16, volume ratio %.1f%s: %.3f ms per frame (min of 5 "
+               "batches of %d)\n",
+               (double)ratios[r], r ? " (default)" : " (springs only)", ms(best), batch);
+    }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     const int frames = argc > 1 ? atoi(argv[1]) : 200;
+    if (argc > 2 && strcmp(argv[2], "msds") == 0) {
+        return msds_only(frames);
+    }
     static const uint32_t sizes[4][3] = {{20, 10, 10}, {24, 12, 12}, {28, 14, 14}, {32, 16, 16}};
     static const double paper_msds[4] = {10, 17, 27, 40}, paper_fem[4] = {30, 60, 100, 150},
                         paper_coll[4] = {0.1, 0.2, 0.2, 0.3};
