@@ -3,6 +3,7 @@
 # run, builds the static binaries the VM needs (preset "hil"), then runs the named test.
 #   tools/hil/ctest-hil.sh display HOST_BUILD_DIR
 #   tools/hil/ctest-hil.sh can HOST_BUILD_DIR
+#   tools/hil/ctest-hil.sh engine HOST_BUILD_DIR
 set -euo pipefail
 top=$(cd "$(dirname "$0")/../.." && pwd)
 what=${1:?test name}
@@ -32,6 +33,9 @@ display)
     ;;
 can)
     exec "$top/tools/hil/can-test.sh" "$hil_build" "$work"
+    ;;
+engine)
+    exec "$top/tools/hil/engine-can-test.sh" "$hil_build" "$host_build" "$work"
     ;;
 *)
     echo "unknown HIL test $what" >&2
