@@ -1,6 +1,7 @@
 # Unit tests of platform/linux pieces link the Linux platform library too (they are registered
 # by the tests/unit glob like every other unit test).
-foreach(_t test_sc_udp_display test_sc_png_write test_sc_png_sink test_sc_log_linux test_sc_rt)
+foreach(_t test_sc_udp_display test_sc_png_write test_sc_png_sink test_sc_log_linux test_sc_rt
+           test_sc_can_replay)
   if(TARGET ${_t} AND TARGET sc_linux)
     target_link_libraries(${_t} PRIVATE sc_linux)
     target_compile_definitions(${_t} PRIVATE _GNU_SOURCE)
