@@ -75,5 +75,18 @@ contains "stop record logged" "$WORK/term.err" "event=stop reason=\"SIGTERM\""
     -s rt.mlock=false --frames 1 > /dev/null 2> "$WORK/can.err"; check "missing CAN interface" 1 $?
 contains "CAN failure named" "$WORK/can.err" "event=can_open_failed interface=nosuchcan0"
 
+# --can-replay: a missing log is a runtime error with the file named; a short log replays
+# (can.interface ignored: a missing interface does not matter then)
+# shellcheck disable=SC2086
+"$BIN" $NODEV --can-replay "$WORK/no-such.log" --frames 1 > /dev/null 2> "$WORK/replay.err"
+check "--can-replay of a missing file" 1 $?
+contains "missing replay file named" "$WORK/replay.err" "sonocomp: --can-replay $WORK/no-such.log: No such file or directory"
+printf '(1700000000.000000) vcan0 123#0102\nnot a line\n' > "$WORK/short.log"
+# shellcheck disable=SC2086
+"$BIN" $NODEV -s can.interface=nosuchcan0 --can-replay "$WORK/short.log" --frames 3 \
+    > "$WORK/replay.out" 2> "$WORK/replay2.err"; check "--can-replay of a short log" 0 $?
+contains "replay reported" "$WORK/replay.out" "1 frames over 0.000 s, 1 delivered (end of log reached), 1 malformed lines refused"
+contains "replay rejects logged" "$WORK/replay2.err" "event=can_replay_rejected"
+
 [ "$fails" = 0 ] && echo "PASS" && exit 0
 echo "$fails checks failed"; exit 1

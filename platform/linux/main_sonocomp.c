@@ -21,6 +21,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "sc_can_replay.h"
 #include "sc_engine.h"
 #include "sc_err.h"
 #include "sc_kms_display.h"
@@ -99,6 +100,7 @@ typedef struct cli {
     double seconds;
     const char *case_dir;
     uint32_t inject_loss_permille; /* test option: display link lines lost on purpose */
+    const char *can_replay_path;   /* --can-replay: a candump -l log instead of SocketCAN */
 } cli;
 
 static void usage(FILE *f)
@@ -116,6 +118,9 @@ static void usage(FILE *f)
            "  -t, --seconds S       stop after S seconds\n"
            "      --inject-loss P   (tests) lose P permille of the display link lines on\n"
            "                        purpose, counted, as a lossy network would\n"
+           "      --can-replay FILE play a candump -l log (sc-tracker-emu --log) in real\n"
+           "                        time as the CAN bus, for hosts without SocketCAN;\n"
+           "                        can.interface is then ignored; the log's end is a lift\n"
            "  -h, --help            this help\n"
            "  -V, --version         version\n\n"
            "Stops cleanly on SIGINT or SIGTERM and prints its final statistics on stdout.\n"
@@ -384,13 +389,14 @@ int main(int argc, char **argv)
 {
     cli a;
     memset(&a, 0, sizeof a);
-    enum { OPT_CHECK = 1000, OPT_HELP_CONFIG, OPT_CASE_DIR, OPT_INJECT };
+    enum { OPT_CHECK = 1000, OPT_HELP_CONFIG, OPT_CASE_DIR, OPT_INJECT, OPT_CAN_REPLAY };
     static const struct option lo[] = {{"config", required_argument, NULL, 'c'},
                                        {"set", required_argument, NULL, 's'},
                                        {"check-config", no_argument, NULL, OPT_CHECK},
                                        {"help-config", no_argument, NULL, OPT_HELP_CONFIG},
                                        {"case-dir", required_argument, NULL, OPT_CASE_DIR},
                                        {"inject-loss", required_argument, NULL, OPT_INJECT},
+                                       {"can-replay", required_argument, NULL, OPT_CAN_REPLAY},
                                        {"frames", required_argument, NULL, 'n'},
                                        {"seconds", required_argument, NULL, 't'},
                                        {"help", no_argument, NULL, 'h'},
@@ -429,6 +435,9 @@ int main(int argc, char **argv)
             a.inject_loss_permille = (uint32_t)v;
             break;
         }
+        case OPT_CAN_REPLAY:
+            a.can_replay_path = optarg;
+            break;
         case 'n':
             errno = 0;
             a.frames = strtoull(optarg, &end, 10);
@@ -525,8 +534,37 @@ int main(int argc, char **argv)
     hal.log = sc_log_linux_dev(&g_log);
 
     static sc_socketcan can;
-    int can_open = 0;
-    if (strcmp(cfg.can_interface, "none") == 0) {
+    static sc_can_replay replay;
+    int can_open = 0, replay_open = 0;
+    if (a.can_replay_path) {
+        errno = 0;
+        int rc = sc_can_replay_open(&replay, a.can_replay_path, NULL, NULL);
+        if (rc != 0) {
+            const int err = errno;
+            fprintf(stderr, "sonocomp: --can-replay %s: %s\n", a.can_replay_path,
+                    rc == SC_ERR_NOT_FOUND && err ? strerror(err)
+                    : rc == SC_ERR_PARSE          ? "no valid candump -l frame in the log"
+                                                  : sc_err_str(rc));
+            sc_log_linux_msg(&g_log, SC_LOG_ERROR, "can_replay_failed", "file=\"%s\" err=%s",
+                             a.can_replay_path, sc_err_name(rc));
+            sc_log_linux_stop(&g_log);
+            return EXIT_RUNTIME;
+        }
+        replay_open = 1;
+        hal.can = sc_can_replay_dev(&replay);
+        sc_log_linux_msg(&g_log, SC_LOG_INFO, "can_replay",
+                         "file=\"%s\" frames=%zu duration_s=%.3f lines=%u rejected=%u "
+                         "can_interface_ignored=%s",
+                         a.can_replay_path, replay.count, (double)replay.duration_ns / 1e9,
+                         (unsigned)replay.lines, (unsigned)replay.rejected, cfg.can_interface);
+        if (replay.rejected > 0u) {
+            sc_log_linux_msg(&g_log, SC_LOG_WARN, "can_replay_rejected",
+                             "file=\"%s\" rejected=%u last_line=%u reason=%s",
+                             a.can_replay_path, (unsigned)replay.rejected,
+                             (unsigned)replay.last_reject_line,
+                             sc_candump_reject_name(replay.last_reject));
+        }
+    } else if (strcmp(cfg.can_interface, "none") == 0) {
         hal.can.ops = &k_null_can;
         sc_log_linux_msg(&g_log, SC_LOG_WARN, "can_none", "action=\"no tracker: probe lifted\"");
     } else {
@@ -726,6 +764,24 @@ int main(int argc, char **argv)
     }
     if (can_open) {
         sc_socketcan_close(&can);
+    }
+    if (replay_open) {
+        sc_log_linux_msg(&g_log, SC_LOG_INFO, "can_replay_done",
+                         "frames=%zu delivered=%llu sent_discarded=%llu rejected_lines=%u "
+                         "end_reached=%s",
+                         replay.count, (unsigned long long)replay.received,
+                         (unsigned long long)replay.sent, (unsigned)replay.rejected,
+                         sc_can_replay_done(&replay) ? "yes" : "no");
+        if (engine_ok) {
+            printf("  CAN replay %s: %zu frames over %.3f s, %llu delivered%s, %u malformed "
+                   "lines refused, %llu sent frames discarded\n",
+                   a.can_replay_path, replay.count, (double)replay.duration_ns / 1e9,
+                   (unsigned long long)replay.received,
+                   sc_can_replay_done(&replay) ? " (end of log reached)" : "",
+                   (unsigned)replay.rejected, (unsigned long long)replay.sent);
+            fflush(stdout);
+        }
+        sc_can_replay_close(&replay);
     }
     sc_log_linux_msg(&g_log, SC_LOG_INFO, "stop", "reason=\"%s\" exit=%d", stop_reason, exit_code);
     sc_log_linux_stop(&g_log);
