@@ -14,7 +14,7 @@ LIVE=$OUT/live
 cat "$LIVE/summary.txt"
 field() { tr ' ' '\n' < "$2" | sed -n "s/^$1=//p"; }
 frames=$(field frames "$LIVE/viewer.out")
-[ -n "$frames" ] && [ "$frames" -gt 0 ] || fail "viewer received no frame"
+[ "${frames:-0}" -gt 0 ] || fail "viewer received no frame"
 [ "$(field lines_lost "$LIVE/viewer.out")" = 0 ] || fail "display link lines lost"
 [ "$(field incomplete "$LIVE/viewer.out")" = 0 ] || fail "incomplete frames"
 [ "$(field lines_received "$LIVE/viewer.out")" -gt 0 ] || fail "no line received"

@@ -87,6 +87,6 @@ pngs=$(find "$LIVE" -name 'view_*.png' | wc -l)
     echo "PNGs written: $pngs (every $PNG_EVERY-th frame) in $LIVE"
 } > "$LIVE/summary.txt"
 
-[ -n "$frames" ] && [ "$frames" -gt 0 ] || die "the viewer received no frame"
+[ "${frames:-0}" -gt 0 ] || die "the viewer received no frame"
 [ "$pngs" -gt 0 ] || die "no PNG written"
 echo "demo-live: $frames frames received, $lost lines lost, $pngs PNGs; summary $LIVE/summary.txt"

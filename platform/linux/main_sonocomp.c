@@ -559,9 +559,8 @@ int main(int argc, char **argv)
                          (unsigned)replay.lines, (unsigned)replay.rejected, cfg.can_interface);
         if (replay.rejected > 0u) {
             sc_log_linux_msg(&g_log, SC_LOG_WARN, "can_replay_rejected",
-                             "file=\"%s\" rejected=%u last_line=%u reason=%s",
-                             a.can_replay_path, (unsigned)replay.rejected,
-                             (unsigned)replay.last_reject_line,
+                             "file=\"%s\" rejected=%u last_line=%u reason=%s", a.can_replay_path,
+                             (unsigned)replay.rejected, (unsigned)replay.last_reject_line,
                              sc_candump_reject_name(replay.last_reject));
         }
     } else if (strcmp(cfg.can_interface, "none") == 0) {

@@ -15,8 +15,7 @@ static uint64_t rt_now(void *ctx)
     return sc_rt_now_ns();
 }
 
-int sc_can_replay_open(sc_can_replay *r, const char *path, sc_can_replay_now_fn now,
-                       void *now_ctx)
+int sc_can_replay_open(sc_can_replay *r, const char *path, sc_can_replay_now_fn now, void *now_ctx)
 {
     memset(r, 0, sizeof *r);
     r->now = now ? now : rt_now;

@@ -38,8 +38,8 @@ typedef struct sc_can_replay {
     void *now_ctx;
     int started;
     uint64_t start_ns;
-    uint64_t sent;     /* frames accepted by send() */
-    uint64_t received; /* frames handed out by recv() */
+    uint64_t sent;                 /* frames accepted by send() */
+    uint64_t received;             /* frames handed out by recv() */
     uint64_t duration_ns;          /* offset of the last frame */
     uint32_t lines;                /* lines read from the log */
     uint32_t rejected;             /* malformed lines refused */
@@ -51,8 +51,7 @@ typedef struct sc_can_replay {
  * SC_ERR_NOT_FOUND when the file cannot be opened (errno kept); SC_ERR_IO on a read error;
  * SC_ERR_PARSE when the log holds no valid frame; SC_ERR_NO_SPACE when memory runs out.
  * O(log size); allocates (open time only). */
-int sc_can_replay_open(sc_can_replay *r, const char *path, sc_can_replay_now_fn now,
-                       void *now_ctx);
+int sc_can_replay_open(sc_can_replay *r, const char *path, sc_can_replay_now_fn now, void *now_ctx);
 /* The hal device; r must outlive it. */
 sc_can_dev sc_can_replay_dev(sc_can_replay *r);
 /* 1 when every frame has been handed out. */

@@ -110,12 +110,12 @@ static void malformed_lines_are_refused_and_counted(void **state)
     (void)state;
     char path[64];
     write_log(path, sizeof path,
-              "(1.000000) can0 101#01\n"          /* good */
-              "garbage\n"                         /* no time stamp */
-              "(1.100000) can0 1#01\n"            /* id not 3 or 8 digits */
-              "(1.200000) can0 102#0\n"           /* odd hex digits */
+              "(1.000000) can0 101#01\n"                 /* good */
+              "garbage\n"                                /* no time stamp */
+              "(1.100000) can0 1#01\n"                   /* id not 3 or 8 digits */
+              "(1.200000) can0 102#0\n"                  /* odd hex digits */
               "(1.300000) can0 103#010203040506070809\n" /* 9 bytes classic */
-              "(1.400000) can0 104#AA\n");        /* good */
+              "(1.400000) can0 104#AA\n");               /* good */
     uint64_t now = 0;
     sc_can_replay r;
     assert_int_equal(sc_can_replay_open(&r, path, fake_now, &now), 0);
