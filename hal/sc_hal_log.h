@@ -19,6 +19,22 @@ typedef enum sc_log_level {
     SC_LOG_ERROR,
 } sc_log_level;
 
+/* The level's lower-case name ("debug", "info", "warn", "error"), "?" otherwise. O(1). */
+static inline const char *sc_log_level_name(sc_log_level level)
+{
+    switch (level) {
+    case SC_LOG_DEBUG:
+        return "debug";
+    case SC_LOG_INFO:
+        return "info";
+    case SC_LOG_WARN:
+        return "warn";
+    case SC_LOG_ERROR:
+        return "error";
+    }
+    return "?";
+}
+
 typedef struct sc_log_ops {
     void (*write)(void *ctx, sc_log_level level, const char *event, int err, int64_t a,
                   int64_t b);

@@ -7,21 +7,6 @@
 
 #include "sc_err.h"
 
-static const char *level_name(sc_log_level l)
-{
-    switch (l) {
-    case SC_LOG_DEBUG:
-        return "debug";
-    case SC_LOG_INFO:
-        return "info";
-    case SC_LOG_WARN:
-        return "warn";
-    case SC_LOG_ERROR:
-        return "error";
-    }
-    return "?";
-}
-
 static void hs_write(void *ctx, sc_log_level level, const char *event, int err, int64_t a,
                      int64_t b)
 {
@@ -34,7 +19,7 @@ static void hs_write(void *ctx, sc_log_level level, const char *event, int err, 
     }
     if (l->print) {
         fprintf(stderr, "level=%s event=%s err=%s a=%" PRId64 " b=%" PRId64 "\n",
-                level_name(level), event, sc_err_name(err), a, b);
+                sc_log_level_name(level), event, sc_err_name(err), a, b);
     }
 }
 

@@ -11,21 +11,6 @@
 
 static const char k_clear[] = "\r\033[K";
 
-const char *sc_log_linux_level_name(sc_log_level level)
-{
-    switch (level) {
-    case SC_LOG_DEBUG:
-        return "debug";
-    case SC_LOG_INFO:
-        return "info";
-    case SC_LOG_WARN:
-        return "warn";
-    case SC_LOG_ERROR:
-        return "error";
-    }
-    return "?";
-}
-
 static size_t format_ts(char *buf, size_t cap, int64_t wall_ns)
 {
     time_t s = (time_t)(wall_ns / 1000000000);
@@ -50,11 +35,11 @@ size_t sc_log_linux_format(char *buf, size_t cap, const sc_log_linux_rec *r)
     int m;
     if (r->err) {
         m = snprintf(buf + n, cap - n, " level=%s event=%s err=%s a=%lld b=%lld",
-                     sc_log_linux_level_name(r->level), r->event ? r->event : "?",
+                     sc_log_level_name(r->level), r->event ? r->event : "?",
                      sc_err_name(r->err), (long long)r->a, (long long)r->b);
     } else {
         m = snprintf(buf + n, cap - n, " level=%s event=%s a=%lld b=%lld",
-                     sc_log_linux_level_name(r->level), r->event ? r->event : "?", (long long)r->a,
+                     sc_log_level_name(r->level), r->event ? r->event : "?", (long long)r->a,
                      (long long)r->b);
     }
     if (m > 0) {
@@ -199,7 +184,7 @@ void sc_log_linux_msg(sc_log_linux *l, sc_log_level level, const char *event, co
     char line[512];
     size_t n = format_ts(line, sizeof line, wall_now_ns());
     int m = snprintf(line + n, sizeof line - n, " level=%s event=%s",
-                     sc_log_linux_level_name(level), event);
+                     sc_log_level_name(level), event);
     if (m > 0) {
         n += (size_t)m < sizeof line - n ? (size_t)m : sizeof line - n - 1u;
     }

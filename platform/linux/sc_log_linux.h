@@ -70,8 +70,6 @@ void sc_log_linux_status(sc_log_linux *l, const char *text);
 void sc_log_linux_status_done(sc_log_linux *l);
 uint64_t sc_log_linux_dropped(sc_log_linux *l);
 
-/* Level name as written ("debug", "info", "warn", "error"). */
-const char *sc_log_linux_level_name(sc_log_level level);
 /* Format one record into buf (no newline); returns its length. Exposed for tests. */
 size_t sc_log_linux_format(char *buf, size_t cap, const sc_log_linux_rec *r);
 

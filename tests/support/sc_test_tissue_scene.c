@@ -108,3 +108,17 @@ sc_collider_def sc_test_scene_collider(const sc_test_scene *s)
     d.round_radius_mm = s->p.probe_round_mm;
     return d;
 }
+
+sc_tissue_def sc_test_scene_tissue_def(const sc_test_scene *s, sc_tissue_method m)
+{
+    sc_tissue_def d = sc_tissue_default_def();
+    d.mesh = s->mesh;
+    d.collider = sc_test_scene_collider(s);
+    d.skin.origin_mm[0] = 0.0f;
+    d.skin.origin_mm[1] = 0.0f;
+    d.skin.size_mm[0] = s->p.size_mm[0];
+    d.skin.size_mm[1] = s->p.size_mm[1];
+    d.skin.z_mm = 0.0f;
+    d.method = m;
+    return d;
+}

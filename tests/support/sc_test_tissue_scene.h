@@ -11,6 +11,7 @@
 #include <stdint.h>
 
 #include "sc_mesh.h"
+#include "sc_tissue.h"
 #include "sc_pose.h"
 #include "sc_volume.h"
 
@@ -49,5 +50,9 @@ sc_collider_def sc_test_scene_collider(const sc_test_scene *s);
 /* Probe pose pressing straight down (+z) with its face centre at depth face_z_mm, over the
  * vessels (identity orientation: probe x = volume x). */
 sc_pose sc_test_scene_probe(const sc_test_scene *s, float face_z_mm);
+
+/* The tissue definition of the scene: default solvers, the scene's mesh, its probe as the
+ * collider, the skin over the top of the block, method m. */
+sc_tissue_def sc_test_scene_tissue_def(const sc_test_scene *s, sc_tissue_method m);
 
 #endif /* SC_TEST_TISSUE_SCENE_H */

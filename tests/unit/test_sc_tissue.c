@@ -26,15 +26,7 @@ static void init_scene_n(uint8_t vein_label, sc_tissue_method m, uint32_t nx, ui
     p.ny = ny;
     p.nz = nz;
     sc_test_scene_build(&g_scene, &p);
-    sc_tissue_def d = sc_tissue_default_def();
-    d.mesh = g_scene.mesh;
-    d.collider = sc_test_scene_collider(&g_scene);
-    d.skin.origin_mm[0] = 0.0f;
-    d.skin.origin_mm[1] = 0.0f;
-    d.skin.size_mm[0] = p.size_mm[0];
-    d.skin.size_mm[1] = p.size_mm[1];
-    d.skin.z_mm = 0.0f;
-    d.method = m;
+    sc_tissue_def d = sc_test_scene_tissue_def(&g_scene, m);
     sc_material_table mat;
     sc_material_table_default(&mat);
     assert_int_equal(sc_tissue_init(&g_t, &d, &g_scene.vol, &mat, SC_LABEL_FAT), SC_OK);
