@@ -177,7 +177,7 @@ static void stage_rx(void *user)
         e->probe_tracker = pose;
         if (e->case_loaded) {
             const sc_xform t = sc_xform_from_pose(&pose);
-            e->probe_to_volume = sc_xform_compose(&e->cas.tracker_to_volume, &t);
+            e->probe_to_volume = sc_xform_compose(&e->slot.c.tracker_to_volume, &t);
             e->probe_volume = sc_pose_from_xform(&e->probe_to_volume);
         }
     }
@@ -226,7 +226,7 @@ static void stage_imaging(void *user)
     if (!e->case_loaded) {
         return;
     }
-    const int rc = sc_bscan_frame(&e->bscan, &e->tissue.mesh, &e->tissue.nodes, &e->cas.volume,
+    const int rc = sc_bscan_frame(&e->bscan, &e->tissue.mesh, &e->tissue.nodes, &e->slot.c.volume,
                                   &e->probe_to_volume, e->probe_contact, &e->hal->display,
                                   e->frame_no);
     if (rc != SC_OK) {
@@ -300,6 +300,18 @@ static int set_filters(sc_engine *e)
     return rc == SC_ERR_NOT_SUPPORTED ? SC_OK : rc;
 }
 
+/* No case runs: the status says none, the probe transform is valid (the imaging stage streams
+ * dark frames before the first pose), SC_FAULT_NO_CASE is raised. */
+static void set_no_case(sc_engine *e)
+{
+    e->case_loaded = 0;
+    e->case_id = (uint8_t)SC_STATUS_CASE_NONE;
+    e->probe_to_volume = sc_xform_identity();
+    e->probe_volume = sc_pose_identity();
+    e->probe_tracker = sc_pose_identity();
+    sc_health_raise(&e->health, SC_FAULT_NO_CASE);
+}
+
 int sc_engine_init(sc_engine *e, const sc_engine_def *def, const sc_hal *hal)
 {
     if (!e || !def || !hal || !hal->clock.ops || !hal->can.ops || !hal->can.ops->send ||
@@ -348,12 +360,8 @@ int sc_engine_init(sc_engine *e, const sc_engine_def *def, const sc_hal *hal)
             sc_log(&hal->log, SC_LOG_WARN, "watchdog_unavailable", wrc, 0, 0);
         }
     }
-    e->case_id = (uint8_t)SC_STATUS_CASE_NONE;
-    /* a valid transform before the first pose: the imaging stage streams dark frames */
-    e->probe_to_volume = sc_xform_identity();
-    e->probe_volume = sc_pose_identity();
-    e->probe_tracker = sc_pose_identity();
-    sc_health_raise(&e->health, SC_FAULT_NO_CASE);
+    sc_case_slot_init(&e->slot);
+    set_no_case(e);
     sc_health_set_ready(&e->health, 1);
     return SC_OK;
 }
@@ -368,37 +376,14 @@ static uint8_t catalogue_id(const sc_engine *e, const char *name)
     return (uint8_t)SC_ENGINE_CASE_UNLISTED;
 }
 
-static void drop_case(sc_engine *e)
-{
-    if (e->case_bytes) {
-        sc_storage_close(&e->hal->storage, e->case_bytes, e->case_size);
-    }
-    e->case_bytes = NULL;
-    e->case_size = 0;
-    e->case_loaded = 0;
-    e->case_id = (uint8_t)SC_STATUS_CASE_NONE;
-    /* a valid transform before the first pose: the imaging stage streams dark frames */
-    e->probe_to_volume = sc_xform_identity();
-    e->probe_volume = sc_pose_identity();
-    e->probe_tracker = sc_pose_identity();
-    sc_health_raise(&e->health, SC_FAULT_NO_CASE);
-}
 
 int sc_engine_load_case(sc_engine *e, const char *name)
 {
     if (!e || !name) {
         return SC_ERR_INVALID_ARG;
     }
-    const uint8_t *bytes = NULL;
-    size_t size = 0;
-    int rc = sc_storage_open(&e->hal->storage, name, &bytes, &size);
-    sc_case c;
-    if (rc == SC_OK) {
-        rc = sc_case_load(bytes, size, &c);
-        if (rc != SC_OK) {
-            sc_storage_close(&e->hal->storage, bytes, size);
-        }
-    }
+    /* open, validate, and only then replace the running case's mapping (sc_case_slot) */
+    int rc = sc_case_slot_switch(&e->slot, &e->hal->storage, name);
     if (rc != SC_OK) {
         /* refused before anything of the running case was touched */
         e->counters.case_load_failures++;
@@ -406,55 +391,51 @@ int sc_engine_load_case(sc_engine *e, const char *name)
         sc_log(&e->hal->log, SC_LOG_ERROR, "case_refused", rc, 0, 0);
         return rc;
     }
+    const sc_case *c = &e->slot.c;
 
     /* The case is valid: rebuild the tissue and attach imaging. Limits were checked by the
      * loader, so this fails only on a capacity the loader cannot see (then no case runs). */
     sc_material_table mat;
     memset(&mat, 0, sizeof(mat));
-    mat.count = c.material_count;
-    for (uint32_t i = 0; i < c.material_count; i++) {
-        mat.row[i] = (sc_material){.e_pa = c.materials[i].e_pa,
-                                   .poisson = c.materials[i].poisson,
-                                   .density_kg_m3 = c.materials[i].density_kg_m3};
+    mat.count = c->material_count;
+    for (uint32_t i = 0; i < c->material_count; i++) {
+        mat.row[i] = (sc_material){.e_pa = c->materials[i].e_pa,
+                                   .poisson = c->materials[i].poisson,
+                                   .density_kg_m3 = c->materials[i].density_kg_m3};
     }
     sc_tissue_def td = e->def.tissue;
-    td.mesh = c.mesh;
+    td.mesh = c->mesh;
     /* the skin surface: over the top of the mesh box and a margin around it, so that its
      * deformation has no edge where the tissue mesh ends (paper section V) */
     for (uint32_t a = 0; a < 2u; a++) {
-        td.skin.origin_mm[a] = c.mesh.origin_mm[a] - SC_ENGINE_SKIN_MARGIN_MM;
-        td.skin.size_mm[a] = c.mesh.size_mm[a] + 2.0f * SC_ENGINE_SKIN_MARGIN_MM;
+        td.skin.origin_mm[a] = c->mesh.origin_mm[a] - SC_ENGINE_SKIN_MARGIN_MM;
+        td.skin.size_mm[a] = c->mesh.size_mm[a] + 2.0f * SC_ENGINE_SKIN_MARGIN_MM;
     }
-    td.skin.z_mm = c.mesh.origin_mm[2];
-    rc = sc_tissue_init(&e->tissue, &td, &c.volume, &mat, (uint8_t)SC_LABEL_FAT);
+    td.skin.z_mm = c->mesh.origin_mm[2];
+    rc = sc_tissue_init(&e->tissue, &td, &c->volume, &mat, (uint8_t)SC_LABEL_FAT);
     if (rc == SC_OK) {
         sc_bscan_def bd = e->bscan.def;
-        bd.scan.image_to_probe = c.image_to_probe;
+        bd.scan.image_to_probe = c->image_to_probe;
         rc = sc_bscan_set_def(&e->bscan, &bd);
     }
     if (rc == SC_OK) {
         rc = sc_bscan_attach_mesh(&e->bscan, &e->tissue.mesh);
     }
     if (rc != SC_OK) {
-        sc_storage_close(&e->hal->storage, bytes, size);
-        drop_case(e);
+        /* the previous tissue is gone: no case runs */
+        sc_case_slot_close(&e->slot);
+        set_no_case(e);
         e->counters.case_load_failures++;
         e->counters.last_case_error = rc;
         sc_log(&e->hal->log, SC_LOG_ERROR, "case_rebuild_failed", rc, 0, 0);
         return rc;
     }
-    if (e->case_bytes) {
-        sc_storage_close(&e->hal->storage, e->case_bytes, e->case_size);
-    }
-    e->cas = c;
-    e->case_bytes = bytes;
-    e->case_size = size;
     e->case_loaded = 1;
     e->case_id = catalogue_id(e, name);
     e->probe_contact = 0;
     e->counters.case_loads++;
     sc_health_clear(&e->health, SC_FAULT_NO_CASE);
-    sc_log(&e->hal->log, SC_LOG_INFO, "case_loaded", SC_OK, (int64_t)e->cas.case_id,
+    sc_log(&e->hal->log, SC_LOG_INFO, "case_loaded", SC_OK, (int64_t)c->case_id,
            (int64_t)e->tissue.mesh.tet_count);
     return SC_OK;
 }

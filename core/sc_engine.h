@@ -97,10 +97,9 @@ typedef struct sc_engine {
     sc_health health;
     sc_engine_counters counters;
     sc_tracker tracker;
-    /* the running case: a validated view into storage bytes kept open while it runs */
-    sc_case cas;
-    const uint8_t *case_bytes;
-    size_t case_size;
+    /* the running case: a validated view into storage bytes kept open while it runs
+     * (slot.c); case_loaded once the tissue and imaging are built for it */
+    sc_case_slot slot;
     uint8_t case_loaded;
     uint8_t case_id;
     /* this frame's probe */

@@ -399,7 +399,7 @@ int main(int argc, char **argv)
                                        : "");
         return 1;
     }
-    const sc_case *cs = &rig.engine.cas;
+    const sc_case *cs = &rig.engine.slot.c;
 
     /* probe: emulator script or replay */
     FILE *replay = NULL;

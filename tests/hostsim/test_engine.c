@@ -427,11 +427,11 @@ static void a_bad_case_is_refused_and_the_running_case_stays(void **state)
     memcpy(bad_copy, block.bytes, block.size);
     bad_copy[block.size / 2u] ^= 0x10u; /* one bit in the voxels */
     assert_int_equal(sc_hs_storage_add(&rig.storage, "bad", bad_copy, block.size), SC_OK);
-    const uint32_t id_before = rig.engine.cas.case_id;
+    const uint32_t id_before = rig.engine.slot.c.case_id;
     assert_int_equal(sc_engine_load_case(&rig.engine, "bad"), SC_ERR_CASE_CRC);
     assert_int_equal(sc_engine_load_case(&rig.engine, "missing"), SC_ERR_NOT_FOUND);
     assert_true(rig.engine.case_loaded);
-    assert_int_equal(rig.engine.cas.case_id, id_before);
+    assert_int_equal(rig.engine.slot.c.case_id, id_before);
     assert_int_equal(rig.engine.counters.case_load_failures, 2);
     assert_int_equal(rig.engine.counters.last_case_error, SC_ERR_NOT_FOUND);
     run(5, 0, -1.0);
