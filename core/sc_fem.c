@@ -34,9 +34,10 @@ static const uint8_t k_pair_b[6] = {1u, 2u, 3u, 2u, 3u, 3u};
 #define SC_FEM_DET_MIN 1.0e-3f
 
 /* 4-lane float vectors: GCC/Clang vector extension (plain SIMD on SSE2 / NEON, lowered to
- * scalar code on targets without SIMD); other compilers take the scalar loops. Both do the
- * same IEEE operations per lane in the same order: results are bitwise identical. */
-#if defined(__GNUC__)
+ * scalar code on targets without SIMD); other compilers take the scalar loops (and so does a
+ * build with -DSC_FEM_SCALAR, to check that claim). Both do the same IEEE operations per
+ * lane in the same order: results are bitwise identical. */
+#if defined(__GNUC__) && !defined(SC_FEM_SCALAR)
 #define SC_FEM_VEC 1
 typedef float sc_fem_v4 __attribute__((vector_size(16)));
 static inline sc_fem_v4 v4_load(const float *p)
@@ -49,12 +50,191 @@ static inline void v4_store(float *p, sc_fem_v4 v)
 {
     memcpy(p, &v, sizeof v);
 }
+/* The same for 16-byte aligned p (block rows and solver vector nodes: SC_ALIGN_HOT arrays of
+ * 4-float rows): lets the compiler use aligned loads and fold them into the arithmetic. */
+static inline sc_fem_v4 v4_load_a(const float *p)
+{
+    sc_fem_v4 v;
+    memcpy(&v, __builtin_assume_aligned(p, 16), sizeof v);
+    return v;
+}
+static inline void v4_store_a(float *p, sc_fem_v4 v)
+{
+    memcpy(__builtin_assume_aligned(p, 16), &v, sizeof v);
+}
 static inline sc_fem_v4 v4_splat(float x)
 {
     const sc_fem_v4 v = {x, x, x, x};
     return v;
 }
 #endif
+
+/* Element lanes: the corotated element work (deformation gradient, polar factor, stress,
+ * rotated gradients) runs on SC_FEM_W tets at once, one tet per lane of sc_fem_vt: 4 with the
+ * vector extension, 1 (plain float) elsewhere. The code is written once against the vt_
+ * helpers; each lane does the same IEEE operations in the same order as a single-lane run,
+ * so both builds give bitwise the same results (sqrt and division are exactly rounded per
+ * lane, -ffp-contract=off keeps a * b + c unfused). Masks: all-ones / zero lanes (vector) or
+ * 1 / 0 (scalar). */
+#if defined(SC_FEM_VEC)
+#define SC_FEM_W 4u
+typedef sc_fem_v4 sc_fem_vt;
+typedef int sc_fem_mt __attribute__((vector_size(16)));
+static inline sc_fem_vt vt_splat(float x)
+{
+    return v4_splat(x);
+}
+static inline sc_fem_vt vt_load(const float *p)
+{
+    return v4_load(p);
+}
+static inline float vt_lane(sc_fem_vt v, uint32_t l)
+{
+    return v[l];
+}
+static inline sc_fem_vt vt_sqrt(sc_fem_vt v)
+{
+    const sc_fem_vt r = {sqrtf(v[0]), sqrtf(v[1]), sqrtf(v[2]), sqrtf(v[3])};
+    return r;
+}
+static inline sc_fem_mt vt_gt(sc_fem_vt a, sc_fem_vt b)
+{
+    return a > b;
+}
+static inline sc_fem_mt vt_lt(sc_fem_vt a, sc_fem_vt b)
+{
+    return a < b;
+}
+static inline sc_fem_vt vt_select(sc_fem_mt m, sc_fem_vt a, sc_fem_vt b)
+{
+    return (sc_fem_vt)((m & (sc_fem_mt)a) | (~m & (sc_fem_mt)b));
+}
+static inline sc_fem_mt mt_and_not(sc_fem_mt a, sc_fem_mt b)
+{
+    return a & ~b;
+}
+static inline int mt_lane(sc_fem_mt m, uint32_t l)
+{
+    return m[l] != 0;
+}
+static inline int mt_any(sc_fem_mt m)
+{
+    return ((m[0] | m[1]) | (m[2] | m[3])) != 0;
+}
+#else
+#define SC_FEM_W 1u
+typedef float sc_fem_vt;
+typedef int sc_fem_mt;
+static inline sc_fem_vt vt_splat(float x)
+{
+    return x;
+}
+static inline sc_fem_vt vt_load(const float *p)
+{
+    return *p;
+}
+static inline float vt_lane(sc_fem_vt v, uint32_t l)
+{
+    (void)l;
+    return v;
+}
+static inline sc_fem_vt vt_sqrt(sc_fem_vt v)
+{
+    return sqrtf(v);
+}
+static inline sc_fem_mt vt_gt(sc_fem_vt a, sc_fem_vt b)
+{
+    return a > b;
+}
+static inline sc_fem_mt vt_lt(sc_fem_vt a, sc_fem_vt b)
+{
+    return a < b;
+}
+static inline sc_fem_vt vt_select(sc_fem_mt m, sc_fem_vt a, sc_fem_vt b)
+{
+    return m ? a : b;
+}
+static inline sc_fem_mt mt_and_not(sc_fem_mt a, sc_fem_mt b)
+{
+    return a && !b;
+}
+static inline int mt_lane(sc_fem_mt m, uint32_t l)
+{
+    (void)l;
+    return m != 0;
+}
+static inline int mt_any(sc_fem_mt m)
+{
+    return m != 0;
+}
+#endif
+_Static_assert(SC_FEM_TET_LANES % SC_FEM_W == 0u, "element lanes must tile a tet group");
+
+/* Lane l's 3-vector (a[l], b[l], c[l]) as 4 floats (4th 0) in out[l], l < SC_FEM_W: the
+ * transpose between the element lanes and the 4-float rows of the blocks and vectors. */
+static inline void vt_to_rows(sc_fem_vt a, sc_fem_vt b, sc_fem_vt c, float out[SC_FEM_W][4])
+{
+#if defined(SC_FEM_VEC)
+    const sc_fem_v4 z = v4_splat(0.0f);
+    const sc_fem_v4 t0 = __builtin_shufflevector(a, b, 0, 4, 1, 5); /* a0 b0 a1 b1 */
+    const sc_fem_v4 t1 = __builtin_shufflevector(a, b, 2, 6, 3, 7); /* a2 b2 a3 b3 */
+    const sc_fem_v4 t2 = __builtin_shufflevector(c, z, 0, 4, 1, 5); /* c0 0 c1 0 */
+    const sc_fem_v4 t3 = __builtin_shufflevector(c, z, 2, 6, 3, 7); /* c2 0 c3 0 */
+    v4_store(out[0], __builtin_shufflevector(t0, t2, 0, 1, 4, 5));
+    v4_store(out[1], __builtin_shufflevector(t0, t2, 2, 3, 6, 7));
+    v4_store(out[2], __builtin_shufflevector(t1, t3, 0, 1, 4, 5));
+    v4_store(out[3], __builtin_shufflevector(t1, t3, 2, 3, 6, 7));
+#else
+    out[0][0] = a;
+    out[0][1] = b;
+    out[0][2] = c;
+    out[0][3] = 0.0f;
+#endif
+}
+
+/* The inverse: out[0..2] lane l = in[l][0..2], l < SC_FEM_W (rows of 4 floats). */
+static inline void rows_to_vt(const float in[SC_FEM_W][4], sc_fem_vt out[3])
+{
+#if defined(SC_FEM_VEC)
+    const sc_fem_v4 r0 = v4_load(in[0]), r1 = v4_load(in[1]);
+    const sc_fem_v4 r2 = v4_load(in[2]), r3 = v4_load(in[3]);
+    const sc_fem_v4 t0 = __builtin_shufflevector(r0, r1, 0, 4, 1, 5); /* x0 x1 y0 y1 */
+    const sc_fem_v4 t1 = __builtin_shufflevector(r2, r3, 0, 4, 1, 5); /* x2 x3 y2 y3 */
+    const sc_fem_v4 t2 = __builtin_shufflevector(r0, r1, 2, 6, 3, 7); /* z0 z1 w0 w1 */
+    const sc_fem_v4 t3 = __builtin_shufflevector(r2, r3, 2, 6, 3, 7); /* z2 z3 w2 w3 */
+    out[0] = __builtin_shufflevector(t0, t1, 0, 1, 4, 5);
+    out[1] = __builtin_shufflevector(t0, t1, 2, 3, 6, 7);
+    out[2] = __builtin_shufflevector(t2, t3, 0, 1, 4, 5);
+#else
+    out[0] = in[0][0];
+    out[1] = in[0][1];
+    out[2] = in[0][2];
+#endif
+}
+
+/* dst += src over 4 floats (one block row or one node of a solver vector). */
+static inline void add4(float *restrict dst, const float *restrict src)
+{
+#if defined(SC_FEM_VEC)
+    v4_store(dst, v4_load(dst) + v4_load(src));
+#else
+    for (uint32_t k = 0; k < 4u; k++) {
+        dst[k] += src[k];
+    }
+#endif
+}
+
+/* dst -= src over 4 floats. */
+static inline void sub4(float *restrict dst, const float *restrict src)
+{
+#if defined(SC_FEM_VEC)
+    v4_store(dst, v4_load(dst) - v4_load(src));
+#else
+    for (uint32_t k = 0; k < 4u; k++) {
+        dst[k] -= src[k];
+    }
+#endif
+}
 
 sc_fem_def sc_fem_default_def(void)
 {
@@ -82,29 +262,26 @@ int sc_fem_def_validate(const sc_fem_def *def)
 
 /* ---- small dense helpers ------------------------------------------------------------------ */
 
-static float det9(const float x[9])
+/* Rotation of the polar decomposition F = R S, lane-wise, by scaled Newton iteration
+ * X <- (g X + X^-T / g) / 2, g = sqrt(|X^-1|_F / |X|_F) (Higham 1986), started from F. A lane
+ * stops when its update falls below 1e-4 (|dX|_F^2 < 1e-8; quadratic convergence: the result
+ * is then good to about 1e-8) or after SC_FEM_POLAR_MAX_ITER iterations; a stopped lane keeps
+ * its X while the others go on, so a lane's result does not depend on the other lanes.
+ * Lanes with det F <= SC_FEM_DET_MIN (flat or inverted element: no proper rotation) get
+ * R = I and a zero in the returned mask. Bounded cost: at most SC_FEM_POLAR_MAX_ITER
+ * iterations of ~100 lane operations. */
+static sc_fem_mt polar_rotation_vt(const sc_fem_vt F[9], sc_fem_vt R[9])
 {
-    return x[0] * (x[4] * x[8] - x[5] * x[7]) + x[1] * (x[5] * x[6] - x[3] * x[8]) +
-           x[2] * (x[3] * x[7] - x[4] * x[6]);
-}
-
-/* Rotation of the polar decomposition F = R S by scaled Newton iteration
- * X <- (g X + X^-T / g) / 2, g = sqrt(|X^-1|_F / |X|_F) (Higham 1986). Returns 0 and R = I when
- * det F <= SC_FEM_DET_MIN (flat or inverted element: no proper rotation). Bounded cost. */
-static int polar_rotation(const float F[9], float R[9])
-{
-    float x[9];
+    const sc_fem_vt det_f = F[0] * (F[4] * F[8] - F[5] * F[7]) +
+                            F[1] * (F[5] * F[6] - F[3] * F[8]) + F[2] * (F[3] * F[7] - F[4] * F[6]);
+    const sc_fem_mt ok = vt_gt(det_f, vt_splat(SC_FEM_DET_MIN));
+    sc_fem_vt x[9];
     for (uint32_t i = 0; i < 9u; i++) {
-        x[i] = F[i];
+        x[i] = vt_select(ok, F[i], vt_splat((i % 4u == 0u) ? 1.0f : 0.0f));
     }
-    if (!(det9(x) > SC_FEM_DET_MIN)) {
-        for (uint32_t i = 0; i < 9u; i++) {
-            R[i] = (i % 4u == 0u) ? 1.0f : 0.0f;
-        }
-        return 0;
-    }
-    for (uint32_t it = 0; it < SC_FEM_POLAR_MAX_ITER; it++) {
-        float c[9];
+    sc_fem_mt active = ok;
+    for (uint32_t it = 0; it < SC_FEM_POLAR_MAX_ITER && mt_any(active); it++) {
+        sc_fem_vt c[9];
         c[0] = x[4] * x[8] - x[5] * x[7];
         c[1] = x[5] * x[6] - x[3] * x[8];
         c[2] = x[3] * x[7] - x[4] * x[6];
@@ -114,40 +291,55 @@ static int polar_rotation(const float F[9], float R[9])
         c[6] = x[1] * x[5] - x[2] * x[4];
         c[7] = x[2] * x[3] - x[0] * x[5];
         c[8] = x[0] * x[4] - x[1] * x[3];
-        const float det = x[0] * c[0] + x[1] * c[1] + x[2] * c[2];
-        float nx2 = 0.0f, nc2 = 0.0f;
-        for (uint32_t i = 0; i < 9u; i++) {
+        const sc_fem_vt det = x[0] * c[0] + x[1] * c[1] + x[2] * c[2];
+        sc_fem_vt nx2 = x[0] * x[0], nc2 = c[0] * c[0];
+        for (uint32_t i = 1; i < 9u; i++) {
             nx2 += x[i] * x[i];
             nc2 += c[i] * c[i];
         }
         /* |X^-1|_F = |C|_F / det (det > 0 is kept by the iteration) */
-        const float g = sqrtf(sqrtf(nc2) / (det * sqrtf(nx2)));
-        const float a = 0.5f * g;
-        const float b = 0.5f / (g * det);
-        float diff2 = 0.0f;
+        const sc_fem_vt g = vt_sqrt(vt_sqrt(nc2) / (det * vt_sqrt(nx2)));
+        const sc_fem_vt a = vt_splat(0.5f) * g;
+        const sc_fem_vt b = vt_splat(0.5f) / (g * det);
+        sc_fem_vt diff2 = vt_splat(0.0f);
         for (uint32_t i = 0; i < 9u; i++) {
-            const float nv = a * x[i] + b * c[i];
-            const float d = nv - x[i];
+            const sc_fem_vt nv = a * x[i] + b * c[i];
+            const sc_fem_vt d = nv - x[i];
             diff2 += d * d;
-            x[i] = nv;
+            x[i] = vt_select(active, nv, x[i]);
         }
-        if (diff2 < 1.0e-8f) {
-            break;
-        }
+        active = mt_and_not(active, vt_lt(diff2, vt_splat(1.0e-8f)));
     }
     for (uint32_t i = 0; i < 9u; i++) {
         R[i] = x[i];
     }
-    return 1;
+    return ok;
 }
 
+int sc_fem_polar_rotation(const float F[9], float R[9])
+{
+    SC_ASSERT(F != NULL && R != NULL);
+    sc_fem_vt fv[9], rv[9];
+    for (uint32_t i = 0; i < 9u; i++) {
+        fv[i] = vt_splat(F[i]);
+    }
+    const sc_fem_mt ok = polar_rotation_vt(fv, rv);
+    for (uint32_t i = 0; i < 9u; i++) {
+        R[i] = vt_lane(rv[i], 0u);
+    }
+    return mt_lane(ok, 0u);
+}
+
+/* Entry k of tet e's rest data in the lane-grouped arrays (tet_dmi, tet_vol). */
+#define SC_FEM_TET_AT(arr, e, k) ((arr)[(e) / SC_FEM_TET_LANES][k][(e) % SC_FEM_TET_LANES])
+
 /* Shape gradients of tet e (n[0] = -(n1 + n2 + n3)), 1/mm. */
-static void tet_grads(const float dmi[9], float n[4][4])
+static void tet_grads(const sc_fem *f, uint32_t e, float n[4][4])
 {
     for (uint32_t d = 0; d < 3u; d++) {
-        n[1][d] = dmi[d];
-        n[2][d] = dmi[3u + d];
-        n[3][d] = dmi[6u + d];
+        n[1][d] = SC_FEM_TET_AT(f->tet_dmi, e, d);
+        n[2][d] = SC_FEM_TET_AT(f->tet_dmi, e, 3u + d);
+        n[3][d] = SC_FEM_TET_AT(f->tet_dmi, e, 6u + d);
         n[0][d] = -(n[1][d] + n[2][d] + n[3][d]);
     }
     for (uint32_t a = 0; a < 4u; a++) {
@@ -155,7 +347,8 @@ static void tet_grads(const float dmi[9], float n[4][4])
     }
 }
 
-/* Add the element blocks built from gradients g (rest or rotated) into the matrix. */
+/* Add the element blocks built from the rest gradients g into the matrix (the corotated
+ * blocks are built lane-wise in corotated_lanes). */
 /* Unit rows: the scaled identity of a block is added as dd * k_eye[r] (exact: dd * 1 = dd and
  * x + dd * 0 = x), so that a block row is one straight 4-lane expression. */
 static const float k_eye[3][4] = {
@@ -224,76 +417,201 @@ static void assemble_rest(sc_fem *f, const sc_mesh *m)
     zero_floats(&f->blk[0][0], SC_FEM_BLK_FLOATS * f->nnz_blocks);
     for (uint32_t e = 0; e < f->tet_count; e++) {
         float n[4][4];
-        tet_grads(f->dm_inv[e], n);
+        tet_grads(f, e, n);
         const uint8_t lab = m->tet_label[e];
-        add_tet_blocks(f, m->tet[e], f->tet_blk[e], n, f->lambda_nmm2[lab] * f->vol_mm3[e],
-                       f->mu_nmm2[lab] * f->vol_mm3[e]);
+        const float vol = SC_FEM_TET_AT(f->tet_vol, e, 0u);
+        add_tet_blocks(f, m->tet[e], f->tet_blk[e], n, f->lambda_nmm2[lab] * vol,
+                       f->mu_nmm2[lab] * vol);
     }
     f->matrix_is_rest = 1u;
 }
 
-/* Corotated: warped K into blk and the elastic force -f_int into fel (3N). O(T). */
-static void assemble_corotated(sc_fem *f, const sc_mesh *m, float *restrict fel)
+/* Corotated element work of the lanes' tets e0 .. e0 + SC_FEM_W - 1 (lanes past the last tet
+ * compute on zero rest data and are not scattered). Per tet, with F = Ds Dm^-1, R = polar(F),
+ * rotated gradients g_a = R n_a and the element's share of the residual
+ *   dt f_int + ck K v0 = R Q n_a,  Q = V sigma(E),  E = R^T (dt F + ck L) - dt I,
+ * where L = Dv Dm^-1 is the velocity gradient of v0 and sigma(E) = lambda tr(E) I +
+ * mu (E + E^T): the elastic force V R sigma(sym(R^T F) - I) n_a and the warped stiffness
+ * times v0, V R sigma(R^T L) R^T g_a (sigma is isotropic), are one linear stress of one
+ * combined strain, so the r0 mat-vec of the step is folded into the assembly. Vertex 0's
+ * terms are minus the sum of the others' (n_0 = -(n_1 + n_2 + n_3)): the element's forces
+ * balance by construction.
+ * Scatters the blocks into blk and -R Q n_a into r3; returns the flat/inverted count. */
+static uint32_t corotated_lanes(sc_fem *f, const sc_mesh *m, uint32_t e0, float dt, float ck,
+                                float *restrict r3)
 {
-    zero_floats(&f->blk[0][0], SC_FEM_BLK_FLOATS * f->nnz_blocks);
-    zero_floats(fel, 4u * f->node_count);
-    uint32_t degenerate = 0;
+    const uint32_t nt = f->tet_count;
     const float *x3 = f->x3;
-    for (uint32_t e = 0; e < f->tet_count; e++) {
+    const float *v3 = f->v3;
+    /* edge vectors ds[k] = x_{k+1} - x_0 and y[k] = dt ds[k] + ck (v_{k+1} - v_0): per lane as
+     * 4-float rows (one node is one 16-byte load), then transposed to lanes */
+    float dsl[3][SC_FEM_W][4], yl[3][SC_FEM_W][4], laml[SC_FEM_W], mul[SC_FEM_W];
+    for (uint32_t l = 0; l < SC_FEM_W; l++) {
+        const uint32_t e = (e0 + l < nt) ? e0 + l : e0;
         const uint32_t *t = m->tet[e];
-        const float *dmi = f->dm_inv[e];
-        const float *p0 = &x3[4u * t[0]];
-        float ds[3][3]; /* ds[k] = x_{k+1} - x_0 (columns of Ds) */
+        const float *p0 = &x3[4u * t[0]], *w0 = &v3[4u * t[0]];
         for (uint32_t k = 0; k < 3u; k++) {
-            const float *pk = &x3[4u * t[k + 1u]];
-            for (uint32_t d = 0; d < 3u; d++) {
-                ds[k][d] = pk[d] - p0[d];
+            const float *pk = &x3[4u * t[k + 1u]], *wk = &v3[4u * t[k + 1u]];
+#if defined(SC_FEM_VEC)
+            const sc_fem_v4 dx = v4_load(pk) - v4_load(p0);
+            v4_store(dsl[k][l], dx);
+            v4_store(yl[k][l], v4_splat(dt) * dx + v4_splat(ck) * (v4_load(wk) - v4_load(w0)));
+#else
+            for (uint32_t d = 0; d < 4u; d++) {
+                const float dx = pk[d] - p0[d];
+                dsl[k][l][d] = dx;
+                yl[k][l][d] = dt * dx + ck * (wk[d] - w0[d]);
             }
-        }
-        float F[9];
-        for (uint32_t r = 0; r < 3u; r++) {
-            for (uint32_t c = 0; c < 3u; c++) {
-                F[3u * r + c] = ds[0][r] * dmi[c] + ds[1][r] * dmi[3u + c] + ds[2][r] * dmi[6u + c];
-            }
-        }
-        float R[9];
-        if (!polar_rotation(F, R)) {
-            degenerate++;
-        }
-        /* S = R^T F, eps = sym(S) - I */
-        float S[9];
-        for (uint32_t r = 0; r < 3u; r++) {
-            for (uint32_t c = 0; c < 3u; c++) {
-                S[3u * r + c] = R[r] * F[c] + R[3u + r] * F[3u + c] + R[6u + r] * F[6u + c];
-            }
+#endif
         }
         const uint8_t lab = m->tet_label[e];
-        const float vol = f->vol_mm3[e];
-        const float lam = f->lambda_nmm2[lab], mu = f->mu_nmm2[lab];
-        const float tr = S[0] + S[4] + S[8] - 3.0f;
-        float sig[9];
+        laml[l] = f->lambda_nmm2[lab];
+        mul[l] = f->mu_nmm2[lab];
+    }
+    sc_fem_vt dmi[9], ds[3][3], y[3][3];
+    for (uint32_t k = 0; k < 9u; k++) {
+        dmi[k] = vt_load(&SC_FEM_TET_AT(f->tet_dmi, e0, k));
+    }
+    for (uint32_t k = 0; k < 3u; k++) {
+        rows_to_vt(dsl[k], ds[k]);
+        rows_to_vt(yl[k], y[k]);
+    }
+    const sc_fem_vt vol = vt_load(&SC_FEM_TET_AT(f->tet_vol, e0, 0u));
+    const sc_fem_vt lamv = vt_load(laml) * vol, muv = vt_load(mul) * vol;
+    /* F = Ds Dm^-1 and Y Dm^-1 = dt F + ck L (rows of Dm^-1: n_1, n_2, n_3) */
+    sc_fem_vt F[9], My[9];
+    for (uint32_t r = 0; r < 3u; r++) {
+        for (uint32_t c = 0; c < 3u; c++) {
+            F[3u * r + c] = ds[0][r] * dmi[c] + ds[1][r] * dmi[3u + c] + ds[2][r] * dmi[6u + c];
+            My[3u * r + c] = y[0][r] * dmi[c] + y[1][r] * dmi[3u + c] + y[2][r] * dmi[6u + c];
+        }
+    }
+    sc_fem_vt R[9];
+    const sc_fem_mt ok = polar_rotation_vt(F, R);
+    /* E = R^T My - dt I; Q = lambda V tr(E) I + mu V (E + E^T) */
+    sc_fem_vt E[9];
+    for (uint32_t r = 0; r < 3u; r++) {
+        for (uint32_t c = 0; c < 3u; c++) {
+            E[3u * r + c] = R[r] * My[c] + R[3u + r] * My[3u + c] + R[6u + r] * My[6u + c];
+        }
+    }
+    const sc_fem_vt vdt = vt_splat(dt);
+    const sc_fem_vt tr = ((E[0] - vdt) + (E[4] - vdt)) + (E[8] - vdt);
+    sc_fem_vt Q[9];
+    for (uint32_t r = 0; r < 3u; r++) {
+        for (uint32_t c = r; c < 3u; c++) {
+            Q[3u * r + c] = muv * (E[3u * r + c] + E[3u * c + r]);
+            Q[3u * c + r] = Q[3u * r + c];
+        }
+        Q[4u * r] = muv * ((E[4u * r] - vdt) + (E[4u * r] - vdt)) + lamv * tr;
+    }
+    /* per vertex k = 1..3: g_k = R n_k, h_k = R (Q n_k); vertex 0 takes minus their sum */
+    sc_fem_vt g[4][3], h[4][3];
+    for (uint32_t k = 1; k < 4u; k++) {
+        const sc_fem_vt *n = &dmi[3u * (k - 1u)];
+        sc_fem_vt qn[3];
         for (uint32_t r = 0; r < 3u; r++) {
-            for (uint32_t c = 0; c < 3u; c++) {
-                sig[3u * r + c] = mu * (S[3u * r + c] + S[3u * c + r]);
-            }
-            sig[4u * r] += lam * tr - 2.0f * mu;
+            qn[r] = Q[3u * r] * n[0] + Q[3u * r + 1u] * n[1] + Q[3u * r + 2u] * n[2];
         }
-        float n[4][4], g[4][4];
-        tet_grads(dmi, n);
+        for (uint32_t r = 0; r < 3u; r++) {
+            g[k][r] = R[3u * r] * n[0] + R[3u * r + 1u] * n[1] + R[3u * r + 2u] * n[2];
+            h[k][r] = R[3u * r] * qn[0] + R[3u * r + 1u] * qn[1] + R[3u * r + 2u] * qn[2];
+        }
+    }
+    for (uint32_t r = 0; r < 3u; r++) {
+        g[0][r] = -((g[1][r] + g[2][r]) + g[3][r]);
+        h[0][r] = -((h[1][r] + h[2][r]) + h[3][r]);
+    }
+    /* Element blocks, lane-wise, then added lane by lane (3 rows of 4 floats per block):
+     *   K_aa = (lambda + mu) V g_a g_a^T + mu V |g_a|^2 I   (element (r, c) is lm (g_a[r] g_a[c]):
+     *          commutative, so the block is exactly symmetric)
+     *   K_ab = lambda V g_a g_b^T + mu V g_b g_a^T + mu V (g_a . g_b) I; where the stored block is
+     *          K_ba = K_ab^T (SC_FEM_BLK_TRANSPOSED), the same with lambda and mu swapped. */
+    const uint32_t lanes = (nt - e0 < SC_FEM_W) ? nt - e0 : SC_FEM_W;
+    uint32_t bidx[10][SC_FEM_W];
+    int trl[6][SC_FEM_W];
+    uint32_t degenerate = 0;
+    for (uint32_t l = 0; l < SC_FEM_W; l++) {
+        const uint32_t e = (l < lanes) ? e0 + l : e0;
         for (uint32_t a = 0; a < 4u; a++) {
-            float s[3];
-            for (uint32_t r = 0; r < 3u; r++) {
-                s[r] =
-                    sig[3u * r] * n[a][0] + sig[3u * r + 1u] * n[a][1] + sig[3u * r + 2u] * n[a][2];
-            }
-            float *fa = &fel[4u * t[a]];
-            for (uint32_t r = 0; r < 3u; r++) {
-                fa[r] -= vol * (R[3u * r] * s[0] + R[3u * r + 1u] * s[1] + R[3u * r + 2u] * s[2]);
-                g[a][r] = R[3u * r] * n[a][0] + R[3u * r + 1u] * n[a][1] + R[3u * r + 2u] * n[a][2];
-            }
-            g[a][3] = 0.0f;
+            bidx[a][l] = f->row_start[m->tet[e][a]]; /* the diagonal block leads its row */
         }
-        add_tet_blocks(f, t, f->tet_blk[e], g, lam * vol, mu * vol);
+        for (uint32_t p = 0; p < 6u; p++) {
+            const uint32_t bi = f->tet_blk[e][p];
+            bidx[4u + p][l] = bi & ~SC_FEM_BLK_TRANSPOSED;
+            trl[p][l] = (bi & SC_FEM_BLK_TRANSPOSED) != 0u;
+        }
+        degenerate += (l < lanes && !mt_lane(ok, l)) ? 1u : 0u;
+    }
+    const sc_fem_vt lm = lamv + muv;
+    float rows[10][3][SC_FEM_W][4]; /* block b's row r for lane l: rows[b][r][l] */
+    for (uint32_t a = 0; a < 4u; a++) {
+        const sc_fem_vt *ga = g[a];
+        const sc_fem_vt dd = muv * ((ga[0] * ga[0] + ga[1] * ga[1]) + ga[2] * ga[2]);
+        sc_fem_vt kb[9];
+        for (uint32_t r = 0; r < 3u; r++) {
+            for (uint32_t c = r; c < 3u; c++) {
+                kb[3u * r + c] = lm * (ga[r] * ga[c]);
+                kb[3u * c + r] = kb[3u * r + c];
+            }
+            kb[4u * r] += dd;
+        }
+        for (uint32_t r = 0; r < 3u; r++) {
+            vt_to_rows(kb[3u * r], kb[3u * r + 1u], kb[3u * r + 2u], rows[a][r]);
+        }
+    }
+    for (uint32_t p = 0; p < 6u; p++) {
+        const sc_fem_vt *ga = g[k_pair_a[p]], *gb = g[k_pair_b[p]];
+        sc_fem_mt trm;
+#if defined(SC_FEM_VEC)
+        memcpy(&trm, trl[p], sizeof trm);
+        trm = -trm; /* 1 -> all ones */
+#else
+        trm = trl[p][0];
+#endif
+        const sc_fem_vt c1 = vt_select(trm, muv, lamv), c2 = vt_select(trm, lamv, muv);
+        const sc_fem_vt dd = muv * ((ga[0] * gb[0] + ga[1] * gb[1]) + ga[2] * gb[2]);
+        sc_fem_vt kb[9];
+        for (uint32_t r = 0; r < 3u; r++) {
+            const sc_fem_vt ar = c1 * ga[r], br = c2 * gb[r];
+            for (uint32_t c = 0; c < 3u; c++) {
+                kb[3u * r + c] = ar * gb[c] + br * ga[c];
+            }
+            kb[4u * r] += dd;
+        }
+        for (uint32_t r = 0; r < 3u; r++) {
+            vt_to_rows(kb[3u * r], kb[3u * r + 1u], kb[3u * r + 2u], rows[4u + p][r]);
+        }
+    }
+    float hr[4][SC_FEM_W][4];
+    for (uint32_t a = 0; a < 4u; a++) {
+        vt_to_rows(h[a][0], h[a][1], h[a][2], hr[a]);
+    }
+    /* tet by tet, in the order of a one-lane build (a block or node shared by two tets of
+     * the lanes then receives their terms in the same order: bitwise the same sums) */
+    for (uint32_t l = 0; l < lanes; l++) {
+        for (uint32_t b = 0; b < 10u; b++) {
+            float *B = f->blk[bidx[b][l]];
+            for (uint32_t r = 0; r < 3u; r++) {
+                add4(&B[4u * r], rows[b][r][l]);
+            }
+        }
+        const uint32_t *t = m->tet[e0 + l];
+        for (uint32_t a = 0; a < 4u; a++) {
+            sub4(&r3[4u * t[a]], hr[a][l]);
+        }
+    }
+    return degenerate;
+}
+
+/* Corotated: the warped K into blk, and r3 -= dt f_int(x) + ck K v0 (see corotated_lanes).
+ * O(T). */
+static void assemble_corotated(sc_fem *f, const sc_mesh *m, float dt, float ck, float *restrict r3)
+{
+    zero_floats(&f->blk[0][0], SC_FEM_BLK_FLOATS * f->nnz_blocks);
+    uint32_t degenerate = 0;
+    for (uint32_t e0 = 0; e0 < f->tet_count; e0 += SC_FEM_W) {
+        degenerate += corotated_lanes(f, m, e0, dt, ck, r3);
     }
     f->stats.degenerate_tets = degenerate;
     f->matrix_is_rest = 0u;
@@ -322,20 +640,20 @@ static void matvec(const sc_fem *f, const float *restrict p, float *restrict q, 
         const float ci0 = ck * pi[0], ci1 = ck * pi[1], ci2 = ck * pi[2];
         float s0, s1, s2;
 #if defined(SC_FEM_VEC)
-        const sc_fem_v4 vpi = v4_load(pi);
+        const sc_fem_v4 vpi = v4_load_a(pi);
         const sc_fem_v4 c0 = v4_splat(ci0), c1 = v4_splat(ci1), c2 = v4_splat(ci2);
-        sc_fem_v4 a0 = v4_load(D) * vpi;
-        sc_fem_v4 a1 = v4_load(D + 4) * vpi;
-        sc_fem_v4 a2 = v4_load(D + 8) * vpi;
+        sc_fem_v4 a0 = v4_load_a(D) * vpi;
+        sc_fem_v4 a1 = v4_load_a(D + 4) * vpi;
+        sc_fem_v4 a2 = v4_load_a(D + 8) * vpi;
         for (uint32_t b = beg + 1u; b < end; b++) {
             const float *B = f->blk[b];
             const uint32_t j4 = 4u * col[b];
-            const sc_fem_v4 b0 = v4_load(B), b1 = v4_load(B + 4), b2 = v4_load(B + 8);
-            const sc_fem_v4 pj = v4_load(&p[j4]);
+            const sc_fem_v4 b0 = v4_load_a(B), b1 = v4_load_a(B + 4), b2 = v4_load_a(B + 8);
+            const sc_fem_v4 pj = v4_load_a(&p[j4]);
             a0 += b0 * pj;
             a1 += b1 * pj;
             a2 += b2 * pj;
-            v4_store(&q[j4], v4_load(&q[j4]) + ((b0 * c0 + b1 * c1) + b2 * c2));
+            v4_store_a(&q[j4], v4_load_a(&q[j4]) + ((b0 * c0 + b1 * c1) + b2 * c2));
         }
         s0 = (a0[0] + a0[1]) + (a0[2] + a0[3]);
         s1 = (a1[0] + a1[1]) + (a1[2] + a1[3]);
@@ -558,6 +876,13 @@ int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat, const
         f->rest3[4u * i + 2u] = m->rest_z[i];
         f->rest3[4u * i + 3u] = 0.0f;
     }
+    /* lanes past the last tet in its group: zero rest data (computed on, never scattered) */
+    for (uint32_t e = nt; e % SC_FEM_TET_LANES != 0u; e++) {
+        for (uint32_t k = 0; k < 9u; k++) {
+            SC_FEM_TET_AT(f->tet_dmi, e, k) = 0.0f;
+        }
+        SC_FEM_TET_AT(f->tet_vol, e, 0u) = 0.0f;
+    }
     for (uint32_t e = 0; e < nt; e++) {
         const uint32_t *t = m->tet[e];
         float ed[3][3];
@@ -580,18 +905,19 @@ int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat, const
         }
         for (uint32_t k = 0; k < 3u; k++) {
             for (uint32_t d = 0; d < 3u; d++) {
-                f->dm_inv[e][3u * k + d] = cr[k][d] / det;
+                SC_FEM_TET_AT(f->tet_dmi, e, 3u * k + d) = cr[k][d] / det;
             }
         }
-        f->vol_mm3[e] = det / 6.0f;
+        const float vol = det / 6.0f;
+        SC_FEM_TET_AT(f->tet_vol, e, 0u) = vol;
         for (uint32_t p = 0; p < 6u; p++) {
             const uint32_t a = t[k_pair_a[p]], b = t[k_pair_b[p]];
             const uint32_t bi = (a < b) ? find_block(f, a, b) : find_block(f, b, a);
             SC_ASSERT(bi != UINT32_MAX); /* every tet edge is in the pattern by construction */
             f->tet_blk[e][p] = (a < b) ? bi : (bi | SC_FEM_BLK_TRANSPOSED);
         }
-        const float mq = mat->row[m->tet_label[e]].density_kg_m3 * f->vol_mm3[e] *
-                         SC_FEM_RHO_VOL_TO_MASS * 0.25f;
+        const float mq =
+            mat->row[m->tet_label[e]].density_kg_m3 * vol * SC_FEM_RHO_VOL_TO_MASS * 0.25f;
         for (uint32_t v = 0; v < 4u; v++) {
             f->mass[t[v]] += mq;
         }
@@ -643,6 +969,9 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
      * a stale velocity, which overshoots and oscillates at 1-5 CG iterations. */
     const float damp_s = f->def.rayleigh_beta_s;
     const float warm = damp_s / (damp_s + dt_s);
+    const float cm = 1.0f + dt_s * f->def.rayleigh_alpha_per_s;
+    const float ck = dt_s * f->def.rayleigh_beta_s + dt_s * dt_s;
+    const float dta = dt_s * f->def.rayleigh_alpha_per_s;
     /* Gather the shared SoA state; Dirichlet DOFs: fixed (v = 0) and kinematic (v given). */
     for (uint32_t i = 0; i < nn; i++) {
         uint8_t con = 0u;
@@ -661,24 +990,17 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
         v3[4u * i + 1u] = keep * n->vy[i];
         v3[4u * i + 2u] = keep * n->vz[i];
         v3[4u * i + 3u] = 0.0f;
+        /* the node terms of r0 (below) */
+        r3[4u * i] = dt_s * n->fx[i] - dta * mass[i] * v3[4u * i];
+        r3[4u * i + 1u] = dt_s * n->fy[i] - dta * mass[i] * v3[4u * i + 1u];
+        r3[4u * i + 2u] = dt_s * n->fz[i] - dta * mass[i] * v3[4u * i + 2u];
+        r3[4u * i + 3u] = 0.0f;
     }
-
-    const float cm = 1.0f + dt_s * f->def.rayleigh_alpha_per_s;
-    const float ck = dt_s * f->def.rayleigh_beta_s + dt_s * dt_s;
-    const float dta = dt_s * f->def.rayleigh_alpha_per_s;
 
     /* r0 = b - A v0 with b = M v + dt (f_ext - f_int(x)) and v0 = v (warm start):
      *   r0 = dt f_ext - dt alpha M v0 - dt f_int(x) - ck K v0. */
     if (f->def.corotated != 0u) {
-        assemble_corotated(f, m, z3); /* z3 = -f_int */
-        matvec(f, v3, q3, 0.0f, 1.0f);
-        for (uint32_t i = 0; i < nn; i++) {
-            for (uint32_t d = 0; d < 3u; d++) {
-                const uint32_t k = 4u * i + d;
-                const float fe = (d == 0u) ? n->fx[i] : (d == 1u) ? n->fy[i] : n->fz[i];
-                r3[k] = dt_s * (fe + z3[k]) - dta * mass[i] * v3[k] - ck * q3[k];
-            }
-        }
+        assemble_corotated(f, m, dt_s, ck, r3); /* element terms, with K v0 folded in */
     } else {
         if (f->matrix_is_rest == 0u) {
             assemble_rest(f, m);
@@ -689,11 +1011,8 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
             p3[k] = dt_s * (x3[k] - rest3[k]) + ck * v3[k];
         }
         matvec(f, p3, q3, 0.0f, 1.0f);
-        for (uint32_t i = 0; i < nn; i++) {
-            r3[4u * i] = dt_s * n->fx[i] - dta * mass[i] * v3[4u * i] - q3[4u * i];
-            r3[4u * i + 1u] = dt_s * n->fy[i] - dta * mass[i] * v3[4u * i + 1u] - q3[4u * i + 1u];
-            r3[4u * i + 2u] = dt_s * n->fz[i] - dta * mass[i] * v3[4u * i + 2u] - q3[4u * i + 2u];
-            r3[4u * i + 3u] = 0.0f;
+        for (uint32_t k = 0; k < n3; k++) {
+            r3[k] -= q3[k]; /* lane 3: 0 - 0 */
         }
     }
 

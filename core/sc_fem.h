@@ -42,6 +42,15 @@
  *   scalar elsewhere, bitwise the same) and the gather of p_j is one 16-byte load. Per-tet
  *   rest data (Dm^-1, volume, 6 block indices) lets the corotated step re-assemble the
  *   warped matrix in place without any search.
+ * - Corotated re-assembly (the cost of that model: 34,875 tets per frame at 32x16x16): the
+ *   element work (F, polar factor, stress, rotated gradients, the 10 blocks) runs on 4 tets
+ *   at once, one per SIMD lane, on rest data stored 4 tets to a row; the results are added
+ *   tet by tet, so a one-lane build gives bitwise the same sums. The polar factor is the
+ *   exact one (scaled Newton to convergence, per lane), not an approximation: no per-tet
+ *   state is kept between frames. The step's r0 needs the warped K times v0; with sigma
+ *   linear and isotropic, dt f_int(x) + ck K v0 is per element R sigma(R^T (dt F + ck L) -
+ *   dt I) n_a V (L: velocity gradient), so it is computed in the same element pass instead
+ *   of by an extra mat-vec over the freshly assembled matrix.
  * - Use from the facade: sc_tissue runs one FEM step per frame of length iterations x dt
  *   (the simulated time of the MSDS's frame) with `iterations` CG iterations, and holds the
  *   nodes in contact with the probe as kinematic nodes.
@@ -51,7 +60,8 @@
  *                                             53,568 used by the 32x16x16 mesh)
  *   per node: row start, mass 8 B + 8 solver vectors of 4 floats 128 B + flags 2 B = 138 B
  *                                                                      (1.13 MB at 8,192)
- *   per tet: Dm^-1 + volume 40 B + 6 block indices 24 B = 64 B       (2.23 MB at 34,875)
+ *   per tet: Dm^-1 + volume 40 B + 6 block indices 24 B = 64 B       (2.23 MB at 34,875;
+ *            the first two in groups of 4 tets, the last group padded)
  *   total 6.35 MB at the default limits (sizeof(sc_fem) = 6,345,216 B on x86-64, printed by
  *   the benchmark and the tests). The MCU build shrinks the limits (all arrays scale).
  *
@@ -71,6 +81,9 @@
 /* A 3x3 block is stored as 3 rows of 4 floats (element (r, c) at [4 r + c], [4 r + 3] = 0):
  * one SIMD register per row. */
 #define SC_FEM_BLK_FLOATS 12u
+/* Per-tet rest data is stored in groups of 4 tets (padded: lanes past the last tet are 0). */
+#define SC_FEM_TET_LANES  4u
+#define SC_FEM_TET_GROUPS ((SC_MAX_TETS + SC_FEM_TET_LANES - 1u) / SC_FEM_TET_LANES)
 
 typedef struct sc_fem_def {
     float rayleigh_beta_s;      /* stiffness-proportional damping, >= 0 (MSDS: gamma = 0.1 k) */
@@ -117,9 +130,12 @@ typedef struct sc_fem {
     uint8_t constrained[SC_MAX_NODES];               /* this step: 1 fixed, 2 kinematic, 0 free */
     uint8_t node_used[SC_MAX_NODES];                 /* node belongs to at least one tet */
 
-    /* ---- per tet rest data (corotated re-assembly) ---- */
-    SC_ALIGN_HOT float dm_inv[SC_MAX_TETS][9]; /* rows: grad N1, grad N2, grad N3 (1/mm) */
-    SC_ALIGN_HOT float vol_mm3[SC_MAX_TETS];
+    /* ---- per tet rest data (corotated re-assembly), in groups of SC_FEM_TET_LANES tets with
+     * one float per tet in a row (tet e: [e / 4][k][e % 4]) so that the element work loads
+     * 4 tets' values as one SIMD register ---- */
+    SC_ALIGN_HOT float tet_dmi[SC_FEM_TET_GROUPS][9][SC_FEM_TET_LANES]; /* Dm^-1 rows: grad N1,
+                                                            grad N2, grad N3 (1/mm) */
+    SC_ALIGN_HOT float tet_vol[SC_FEM_TET_GROUPS][1][SC_FEM_TET_LANES]; /* rest volume, mm^3 */
     SC_ALIGN_HOT uint32_t tet_blk[SC_MAX_TETS][6]; /* block of each vertex pair, see sc_fem.c */
 } sc_fem;
 
@@ -146,8 +162,9 @@ int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat, const
  * writes n->x and n->v. Fixed nodes keep their position with zero velocity. Runs exactly
  * cg_iterations CG iterations (fewer only if r.z is exactly 0 or p.Ap <= 0, e.g. no free
  * DOF).
- * Cost: linear: (cg_iterations + 1) block mat-vecs, O(B) each, plus O(N); corotated: plus one
- * O(T) re-assembly with a polar decomposition per tet (bounded Newton iterations).
+ * Cost: linear: (cg_iterations + 1) block mat-vecs, O(B) each, plus O(N); corotated:
+ * cg_iterations mat-vecs plus one O(T) re-assembly with a polar decomposition per tet
+ * (at most 8 Newton iterations) that also yields r0.
  * Never allocates, cannot fail by contract: a non-finite solution leaves n unchanged, counts
  * stats.unstable_steps and sets the sticky status read by sc_fem_status().
  * Preconditions (SC_ASSERT): f initialised with m; dt_s finite and > 0;
@@ -166,5 +183,11 @@ void sc_fem_set_corotated(sc_fem *f, int on);
 
 /* 0, or SC_ERR_PHYS_UNSTABLE once a step produced a non-finite solution. O(1). */
 int sc_fem_status(const sc_fem *f);
+
+/* The corotated step's rotation of one element, exposed for tests: R = the rotation of the
+ * polar decomposition F = R S (row-major 3x3), by the same lane code the step runs. Returns
+ * 1, or 0 with R = I when det F <= 1e-3 (flat or inverted: no proper rotation). O(1)
+ * (at most 8 Newton iterations), never allocates. Precondition (SC_ASSERT): F, R non-NULL. */
+int sc_fem_polar_rotation(const float F[9], float R[9]);
 
 #endif /* SC_FEM_H */
