@@ -629,22 +629,26 @@ static void matvec(const sc_fem *f, const float *restrict p, float *restrict q, 
     const uint32_t *col = f->col;
     for (uint32_t i = 0; i < nn; i++) {
         const float mi = cm * f->mass[i];
+#if defined(SC_FEM_VEC)
+        v4_store_a(&q[4u * i], v4_splat(mi) * v4_load_a(&p[4u * i]));
+#else
         for (uint32_t k = 0; k < 4u; k++) {
             q[4u * i + k] = mi * p[4u * i + k];
         }
+#endif
     }
     for (uint32_t i = 0; i < nn; i++) {
         const uint32_t beg = rs[i], end = rs[i + 1u];
         const float *pi = &p[4u * i];
         const float *D = f->blk[beg];
         const float ci0 = ck * pi[0], ci1 = ck * pi[1], ci2 = ck * pi[2];
-        float s0, s1, s2;
 #if defined(SC_FEM_VEC)
         const sc_fem_v4 vpi = v4_load_a(pi);
         const sc_fem_v4 c0 = v4_splat(ci0), c1 = v4_splat(ci1), c2 = v4_splat(ci2);
         sc_fem_v4 a0 = v4_load_a(D) * vpi;
         sc_fem_v4 a1 = v4_load_a(D + 4) * vpi;
         sc_fem_v4 a2 = v4_load_a(D + 8) * vpi;
+#pragma GCC unroll 2
         for (uint32_t b = beg + 1u; b < end; b++) {
             const float *B = f->blk[b];
             const uint32_t j4 = 4u * col[b];
@@ -655,9 +659,18 @@ static void matvec(const sc_fem *f, const float *restrict p, float *restrict q, 
             a2 += b2 * pj;
             v4_store_a(&q[j4], v4_load_a(&q[j4]) + ((b0 * c0 + b1 * c1) + b2 * c2));
         }
-        s0 = (a0[0] + a0[1]) + (a0[2] + a0[3]);
-        s1 = (a1[0] + a1[1]) + (a1[2] + a1[3]);
-        s2 = (a2[0] + a2[1]) + (a2[2] + a2[3]);
+        /* the three row sums (a_k[0] + a_k[1]) + (a_k[2] + a_k[3]) at once: transpose
+         * (a0, a1, a2, 0) and add the columns in that order (the scalar path's sums) */
+        const sc_fem_v4 z = v4_splat(0.0f);
+        const sc_fem_v4 t0 = __builtin_shufflevector(a0, a1, 0, 4, 1, 5); /* a00 a10 a01 a11 */
+        const sc_fem_v4 t1 = __builtin_shufflevector(a0, a1, 2, 6, 3, 7); /* a02 a12 a03 a13 */
+        const sc_fem_v4 t2 = __builtin_shufflevector(a2, z, 0, 4, 1, 5);  /* a20 0 a21 0 */
+        const sc_fem_v4 t3 = __builtin_shufflevector(a2, z, 2, 6, 3, 7);  /* a22 0 a23 0 */
+        const sc_fem_v4 sum = (__builtin_shufflevector(t0, t2, 0, 1, 4, 5) +
+                               __builtin_shufflevector(t0, t2, 2, 3, 6, 7)) +
+                              (__builtin_shufflevector(t1, t3, 0, 1, 4, 5) +
+                               __builtin_shufflevector(t1, t3, 2, 3, 6, 7));
+        v4_store_a(&q[4u * i], v4_load_a(&q[4u * i]) + v4_splat(ck) * sum); /* lane 3: + 0 */
 #else
         float a0[4], a1[4], a2[4];
         for (uint32_t k = 0; k < 4u; k++) {
@@ -677,13 +690,13 @@ static void matvec(const sc_fem *f, const float *restrict p, float *restrict q, 
                 qj[k] += (B[k] * ci0 + B[4u + k] * ci1) + B[8u + k] * ci2;
             }
         }
-        s0 = (a0[0] + a0[1]) + (a0[2] + a0[3]);
-        s1 = (a1[0] + a1[1]) + (a1[2] + a1[3]);
-        s2 = (a2[0] + a2[1]) + (a2[2] + a2[3]);
-#endif
+        const float s0 = (a0[0] + a0[1]) + (a0[2] + a0[3]);
+        const float s1 = (a1[0] + a1[1]) + (a1[2] + a1[3]);
+        const float s2 = (a2[0] + a2[1]) + (a2[2] + a2[3]);
         q[4u * i] += ck * s0;
         q[4u * i + 1u] += ck * s1;
         q[4u * i + 2u] += ck * s2;
+#endif
     }
 }
 
