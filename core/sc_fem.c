@@ -33,11 +33,13 @@ static const uint8_t k_pair_b[6] = {1u, 2u, 3u, 2u, 3u, 3u};
 /* det F below this: the element is flat or inverted; polar factor undefined: use R = I. */
 #define SC_FEM_DET_MIN 1.0e-3f
 
-/* 4-lane float vectors: GCC/Clang vector extension (plain SIMD on SSE2 / NEON, lowered to
- * scalar code on targets without SIMD); other compilers take the scalar loops (and so does a
- * build with -DSC_FEM_SCALAR, to check that claim). Both do the same IEEE operations per
- * lane in the same order: results are bitwise identical. */
-#if defined(__GNUC__) && !defined(SC_FEM_SCALAR)
+/* 4-lane float vectors: GCC/Clang vector extension on targets with 128-bit SIMD (SSE2,
+ * NEON); other compilers and targets (the Cortex-M7: the extension would be lowered to 4x
+ * scalar code at twice the flash) take the scalar loops, and so does a build with
+ * -DSC_FEM_SCALAR, to check this claim: both do the same IEEE operations per lane in the
+ * same order, so the results are bitwise identical. */
+#if defined(__GNUC__) && !defined(SC_FEM_SCALAR) &&                                                \
+    (defined(__SSE2__) || defined(__ARM_NEON) || defined(__aarch64__))
 #define SC_FEM_VEC 1
 typedef float sc_fem_v4 __attribute__((vector_size(16)));
 static inline sc_fem_v4 v4_load(const float *p)
