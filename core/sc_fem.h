@@ -44,8 +44,9 @@
  *   warped matrix in place without any search.
  * - Corotated re-assembly (the cost of that model: 34,875 tets per frame at 32x16x16): the
  *   element work (F, polar factor, stress, rotated gradients, the 10 blocks) runs on 4 tets
- *   at once, one per SIMD lane, on rest data stored 4 tets to a row; the results are added
- *   tet by tet, so a one-lane build gives bitwise the same sums. The polar factor is the
+ *   at once, one per SIMD lane (SSE2/NEON targets; one tet at a time elsewhere, e.g. on the
+ *   Cortex-M7), on rest data stored 4 tets to a row; the results are added tet by tet, so
+ *   the one-lane build gives bitwise the same sums. The polar factor is the
  *   exact one (scaled Newton to convergence, per lane), not an approximation: no per-tet
  *   state is kept between frames. The step's r0 needs the warped K times v0; with sigma
  *   linear and isotropic, dt f_int(x) + ck K v0 is per element R sigma(R^T (dt F + ck L) -
@@ -133,8 +134,8 @@ typedef struct sc_fem {
     /* ---- per tet rest data (corotated re-assembly), in groups of SC_FEM_TET_LANES tets with
      * one float per tet in a row (tet e: [e / 4][k][e % 4]) so that the element work loads
      * 4 tets' values as one SIMD register ---- */
-    SC_ALIGN_HOT float tet_dmi[SC_FEM_TET_GROUPS][9][SC_FEM_TET_LANES]; /* Dm^-1 rows: grad N1,
-                                                            grad N2, grad N3 (1/mm) */
+    /* Dm^-1, k = 3 row + column; rows: grad N1, grad N2, grad N3 (1/mm) */
+    SC_ALIGN_HOT float tet_dmi[SC_FEM_TET_GROUPS][9][SC_FEM_TET_LANES];
     SC_ALIGN_HOT float tet_vol[SC_FEM_TET_GROUPS][1][SC_FEM_TET_LANES]; /* rest volume, mm^3 */
     SC_ALIGN_HOT uint32_t tet_blk[SC_MAX_TETS][6]; /* block of each vertex pair, see sc_fem.c */
 } sc_fem;
