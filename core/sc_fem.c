@@ -731,6 +731,55 @@ static float dot(const float *restrict a, const float *restrict b, uint32_t coun
     return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
 }
 
+/* The CG update v += alpha p, r -= alpha q, z = inv r over count floats, returning r . z
+ * summed exactly as dot(r, z, count) would (same partial sums, same order): one pass over
+ * the vectors instead of two. */
+static float cg_update(float *restrict v, float *restrict r, float *restrict z,
+                       const float *restrict p, const float *restrict q, const float *restrict inv,
+                       float alpha, uint32_t count)
+{
+    float s[8] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+    uint32_t i = 0;
+#if defined(SC_FEM_VEC)
+    const sc_fem_v4 va = v4_splat(alpha);
+    sc_fem_v4 s0 = v4_splat(0.0f), s1 = v4_splat(0.0f);
+    for (; i + 8u <= count; i += 8u) {
+        for (uint32_t h = 0; h < 8u; h += 4u) {
+            v4_store_a(&v[i + h], v4_load_a(&v[i + h]) + va * v4_load_a(&p[i + h]));
+            const sc_fem_v4 rv = v4_load_a(&r[i + h]) - va * v4_load_a(&q[i + h]);
+            const sc_fem_v4 zv = v4_load_a(&inv[i + h]) * rv;
+            v4_store_a(&r[i + h], rv);
+            v4_store_a(&z[i + h], zv);
+            if (h == 0u) {
+                s0 += rv * zv;
+            } else {
+                s1 += rv * zv;
+            }
+        }
+    }
+    for (uint32_t k = 0; k < 4u; k++) {
+        s[k] = s0[k];
+        s[4u + k] = s1[k];
+    }
+#else
+    for (; i + 8u <= count; i += 8u) {
+        for (uint32_t k = 0; k < 8u; k++) {
+            v[i + k] += alpha * p[i + k];
+            r[i + k] -= alpha * q[i + k];
+            z[i + k] = inv[i + k] * r[i + k];
+            s[k] += r[i + k] * z[i + k];
+        }
+    }
+#endif
+    for (; i < count; i++) {
+        v[i] += alpha * p[i];
+        r[i] -= alpha * q[i];
+        z[i] = inv[i] * r[i];
+        s[0] += r[i] * z[i];
+    }
+    return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
+}
+
 /* Column code of the 27-stencil: (di + 1) + 3 (dj + 1) + 9 (dk + 1); -1 when not neighbours. */
 static int32_t stencil_code(const sc_mesh *m, uint32_t a, uint32_t b)
 {
@@ -1058,12 +1107,7 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
             break;
         }
         const float alpha = rz / pq;
-        for (uint32_t k = 0; k < n3; k++) {
-            v3[k] += alpha * p3[k];
-            r3[k] -= alpha * q3[k];
-            z3[k] = inv[k] * r3[k];
-        }
-        const float rz_new = dot(r3, z3, n3);
+        const float rz_new = cg_update(v3, r3, z3, p3, q3, inv, alpha, n3);
         const float gamma = rz_new / rz;
         for (uint32_t k = 0; k < n3; k++) {
             p3[k] = z3[k] + gamma * p3[k];
