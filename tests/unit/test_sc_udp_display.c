@@ -1,6 +1,11 @@
 /* test_sc_udp_display.c: the display link sender through a real UDP socket on 127.0.0.1 into
  * the frame assembler: nothing lost when nothing is injected, exactly the injected lines lost
- * otherwise, and a full socket buffer drops and counts instead of blocking. */
+ * otherwise, and a full socket buffer drops and counts instead of blocking. Batching: packets
+ * arrive in call order (BEGIN, lines, END) for every batch size, frames larger than a batch and
+ * ending mid-batch, with the expected number of system calls; with a datagram socket pair whose
+ * reader never reads (a socket that really refuses with EAGAIN, which UDP on loopback never
+ * does: it drops at the receiver) the sender's counts are exactly what the reader got; a
+ * refused destination takes the link down and a receiver brings it up again. */
 #include "sc_test.h"
 
 #include <arpa/inet.h>
@@ -176,9 +181,325 @@ static void calls_out_of_order_are_refused_and_counted(void **state)
     close(rx);
 }
 
+/* Every datagram queued at fd, decoded, in order: type, frame, line index, and FRAME_END's
+ * counts. Returns how many (up to cap). */
+typedef struct rx_pkt {
+    uint8_t type;
+    uint32_t frame_no;
+    uint16_t line_index;
+    sc_dlink_end end;
+} rx_pkt;
+
+static uint32_t read_all(int fd, rx_pkt *out, uint32_t cap)
+{
+    uint8_t buf[2048];
+    uint32_t n = 0;
+    struct pollfd p = {fd, POLLIN, 0};
+    while (n < cap && poll(&p, 1, 10) > 0) {
+        ssize_t len = recv(fd, buf, sizeof buf, MSG_DONTWAIT);
+        if (len < 0) {
+            break;
+        }
+        sc_dlink_header h;
+        const uint8_t *pl = NULL;
+        assert_int_equal(sc_dlink_decode(buf, (size_t)len, &h, &pl), 0);
+        out[n].type = h.type;
+        out[n].frame_no = h.frame_no;
+        out[n].line_index = h.line_index;
+        memset(&out[n].end, 0, sizeof out[n].end);
+        if (h.type == SC_DLINK_FRAME_END) {
+            sc_dlink_parse_end(pl, &out[n].end);
+        }
+        n++;
+    }
+    return n;
+}
+
+static rx_pkt g_pkts[4096];
+
+static void packets_arrive_in_call_order_for_every_batch_size(void **state)
+{
+    (void)state;
+    static const uint32_t batches[] = {1u, 2u, 8u, 32u, 64u};
+    /* 100 lines: larger than most batches, the frame ends mid-batch; 31 lines: BEGIN and the
+     * lines fill a batch of 32 exactly, FRAME_END goes alone; 1 line. */
+    static const uint16_t frame_lines[] = {100u, 31u, 1u};
+    for (uint32_t bi = 0; bi < sizeof batches / sizeof batches[0]; bi++) {
+        uint16_t port;
+        int rx = open_rx(&port, 4 * 1024 * 1024);
+        sc_udp_display u;
+        sc_udp_display_def def = sc_udp_display_default_def();
+        def.port = port;
+        def.batch_packets = batches[bi];
+        assert_int_equal(sc_udp_display_open(&u, &def), 0);
+        sc_display_dev dev = sc_udp_display_dev(&u);
+        for (uint32_t fi = 0; fi < sizeof frame_lines / sizeof frame_lines[0]; fi++) {
+            const uint16_t n = frame_lines[fi];
+            const uint64_t calls0 = u.send_calls;
+            send_frame(&dev, 7u + fi, n, 64u);
+            /* BEGIN and the lines fill floor((n + 1) / b) batches; the last one takes the rest
+             * with FRAME_END */
+            assert_int_equal(u.send_calls - calls0, (n + 1u) / batches[bi] + 1u);
+            const uint32_t got = read_all(rx, g_pkts, 4096u);
+            assert_int_equal(got, n + 2u);
+            assert_int_equal(g_pkts[0].type, SC_DLINK_FRAME_BEGIN);
+            for (uint16_t l = 0; l < n; l++) {
+                assert_int_equal(g_pkts[1u + l].type, SC_DLINK_LINE);
+                assert_int_equal(g_pkts[1u + l].line_index, l);
+                assert_int_equal(g_pkts[1u + l].frame_no, 7u + fi);
+            }
+            assert_int_equal(g_pkts[n + 1u].type, SC_DLINK_FRAME_END);
+            assert_int_equal(g_pkts[n + 1u].end.lines_sent, n);
+            assert_int_equal(g_pkts[n + 1u].end.lines_dropped, 0u);
+        }
+        assert_int_equal(u.lines_sent, 132u);
+        assert_int_equal(u.lines_dropped, 0u);
+        assert_int_equal(u.send_errors, 0u);
+        assert_true(u.up);
+        sc_udp_display_close(&u);
+        close(rx);
+    }
+}
+
+static void lines_wait_in_the_batch_until_it_is_full_or_the_frame_ends(void **state)
+{
+    (void)state;
+    uint16_t port;
+    int rx = open_rx(&port, 4 * 1024 * 1024);
+    sc_udp_display u;
+    sc_udp_display_def def = sc_udp_display_default_def();
+    def.port = port;
+    def.batch_packets = 8u;
+    assert_int_equal(sc_udp_display_open(&u, &def), 0);
+    sc_display_dev dev = sc_udp_display_dev(&u);
+    const sc_display_frame_info info = {3u, 20u, 16u, 0u, 0u, 40.0f, 38.0f, 0.0f};
+    uint8_t s[16] = {0};
+    assert_int_equal(sc_display_frame_begin(&dev, &info), 0);
+    for (uint16_t l = 0; l < 6u; l++) {
+        assert_int_equal(sc_display_line(&dev, 3u, l, s, 16u), 0);
+    }
+    /* 7 packets queued: nothing has left, nothing is counted yet */
+    assert_int_equal(u.send_calls, 0u);
+    assert_int_equal(read_all(rx, g_pkts, 4096u), 0u);
+    assert_int_equal(u.lines_sent + u.lines_dropped, 0u);
+    assert_int_equal(sc_display_line(&dev, 3u, 6u, s, 16u), 0); /* the 8th fills the batch */
+    assert_int_equal(u.send_calls, 1u);
+    assert_int_equal(u.lines_sent, 7u);
+    assert_int_equal(read_all(rx, g_pkts, 4096u), 8u);
+    /* a frame left open: close counts its queued lines dropped, they never reach the socket */
+    assert_int_equal(sc_display_line(&dev, 3u, 7u, s, 16u), 0);
+    assert_int_equal(sc_display_line(&dev, 3u, 8u, s, 16u), 0);
+    sc_udp_display_close(&u);
+    assert_int_equal(u.lines_sent, 7u);
+    assert_int_equal(u.lines_dropped, 2u);
+    assert_int_equal(read_all(rx, g_pkts, 4096u), 0u);
+    close(rx);
+}
+
+/* The sender's socket replaced by one end of a datagram socket pair (a test reaching into the
+ * struct): with a tiny send buffer and nobody reading, it refuses with EAGAIN after a few
+ * packets, and what was taken is exactly what the reader finds afterwards. */
+static void full_socket_counts_exactly_what_the_reader_gets(void **state)
+{
+    (void)state;
+    static const uint32_t batches[] = {1u, 8u, 32u, 64u};
+    static const uint32_t drops[] = {0u, 100u};
+    for (uint32_t bi = 0; bi < sizeof batches / sizeof batches[0]; bi++) {
+        for (uint32_t di = 0; di < 2u; di++) {
+            uint16_t port;
+            int rx = open_rx(&port, 65536);
+            sc_udp_display u;
+            sc_udp_display_def def = sc_udp_display_default_def();
+            def.port = port;
+            def.batch_packets = batches[bi];
+            def.inject_drop_permille = drops[di];
+            assert_int_equal(sc_udp_display_open(&u, &def), 0);
+            int sv[2];
+            assert_int_equal(socketpair(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0, sv), 0);
+            int sndbuf = 4096;
+            assert_int_equal(setsockopt(sv[0], SOL_SOCKET, SO_SNDBUF, &sndbuf, sizeof sndbuf), 0);
+            assert_true(dup2(sv[0], u.fd) == u.fd);
+            close(sv[0]);
+            sc_display_dev dev = sc_udp_display_dev(&u);
+            send_frame(&dev, 40u, 100u, 256u);
+            send_frame(&dev, 41u, 100u, 256u);
+            /* every line ends sent or dropped, dropped ones are refused sends */
+            assert_int_equal(u.lines_sent + u.lines_dropped, 200u);
+            assert_true(u.lines_dropped > 100u);
+            assert_true(u.send_errors >= u.lines_dropped);
+            /* a full buffer refusing a packet at once leaves the link state as it was (the
+             * per-packet path); a batch taken only in part reads as down */
+            assert_int_equal(u.up, batches[bi] == 1u);
+            assert_true(u.last_errno == EAGAIN || u.last_errno == EWOULDBLOCK);
+            if (drops[di] == 0u) {
+                assert_int_equal(u.lines_injected, 0u);
+            } else {
+                assert_true(u.lines_injected > 0u);
+            }
+            /* the reader gets exactly the lines counted sent and not injected, in order */
+            const uint32_t got = read_all(sv[1], g_pkts, 4096u);
+            uint32_t lines = 0;
+            int prev = -1;
+            for (uint32_t i = 0; i < got; i++) {
+                if (g_pkts[i].type == SC_DLINK_LINE) {
+                    lines++;
+                    assert_int_equal(g_pkts[i].frame_no, 40u);
+                    assert_true((int)g_pkts[i].line_index > prev);
+                    prev = g_pkts[i].line_index;
+                }
+            }
+            assert_int_equal(lines, u.lines_sent - u.lines_injected);
+            assert_true(got >= 1u && g_pkts[0].type == SC_DLINK_FRAME_BEGIN);
+            assert_int_equal(u.packets_sent, got);
+            /* with the reader drained the link takes a whole (small: the buffer holds a few
+             * datagrams) frame and reads up again; its FRAME_END counts are exact */
+            const uint64_t sent0 = u.lines_sent, inj0 = u.lines_injected;
+            send_frame(&dev, 42u, 3u, 256u);
+            assert_true(u.up);
+            const uint32_t got2 = read_all(sv[1], g_pkts, 4096u);
+            const uint32_t inj = (uint32_t)(u.lines_injected - inj0);
+            assert_int_equal(got2, 3u - inj + 2u);
+            assert_int_equal(g_pkts[got2 - 1u].type, SC_DLINK_FRAME_END);
+            assert_int_equal(g_pkts[got2 - 1u].end.lines_sent, 3u);
+            assert_int_equal(g_pkts[got2 - 1u].end.lines_dropped, 0u);
+            assert_int_equal(u.lines_sent - sent0, 3u);
+            sc_udp_display_close(&u);
+            close(sv[1]);
+            close(rx);
+        }
+    }
+}
+
+/* A full buffer at frame_end: FRAME_END, last in the batch, is not taken; it is re-encoded
+ * with the exact counts and tried once more alone (here the buffer is still full, so that try
+ * fails too and is counted: at most two system calls). */
+static void frame_end_is_tried_once_more_alone_when_its_batch_did_not_all_go(void **state)
+{
+    (void)state;
+    uint16_t port;
+    int rx = open_rx(&port, 65536);
+    sc_udp_display u;
+    sc_udp_display_def def = sc_udp_display_default_def();
+    def.port = port;
+    def.batch_packets = 64u;
+    assert_int_equal(sc_udp_display_open(&u, &def), 0);
+    int sv[2];
+    assert_int_equal(socketpair(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0, sv), 0);
+    int sndbuf = 4096; /* a few datagrams until the reader reads */
+    assert_int_equal(setsockopt(sv[0], SOL_SOCKET, SO_SNDBUF, &sndbuf, sizeof sndbuf), 0);
+    assert_true(dup2(sv[0], u.fd) == u.fd);
+    close(sv[0]);
+    sc_display_dev dev = sc_udp_display_dev(&u);
+    const sc_display_frame_info info = {9u, 40u, 64u, 0u, 0u, 40.0f, 38.0f, 0.0f};
+    uint8_t s[64] = {0};
+    assert_int_equal(sc_display_frame_begin(&dev, &info), 0);
+    for (uint16_t l = 0; l < 40u; l++) {
+        assert_int_equal(sc_display_line(&dev, 9u, l, s, 64u), 0); /* all queued (batch 64) */
+    }
+    assert_int_equal(sc_display_frame_end(&dev, 9u), SC_ERR_IO); /* part of the batch taken */
+    assert_false(u.up);
+    assert_int_equal(u.send_calls, 2u);
+    const uint32_t got = read_all(sv[1], g_pkts, 4096u);
+    assert_true(got >= 2u && got < 40u);
+    assert_int_equal(g_pkts[0].type, SC_DLINK_FRAME_BEGIN);
+    for (uint32_t i = 1; i < got; i++) {
+        assert_int_equal(g_pkts[i].type, SC_DLINK_LINE);
+        assert_int_equal(g_pkts[i].line_index, i - 1u);
+    }
+    assert_int_equal(u.lines_sent, got - 1u);
+    assert_int_equal(u.lines_dropped, 40u - (got - 1u));
+    assert_int_equal(u.packets_sent, got);
+    assert_int_equal(u.send_errors, 42u - got + 1u); /* the batch's rest, FRAME_END again */
+    sc_udp_display_close(&u);
+    close(sv[1]);
+    close(rx);
+}
+
+/* No receiver: ICMP port unreachable refuses the sends (on loopback while a batch goes out, so
+ * sendmmsg takes only its start); the link reads down, every line is counted; once a receiver
+ * binds the port, a whole frame goes and the link reads up. */
+static void refused_destination_takes_the_link_down_until_a_receiver_appears(void **state)
+{
+    (void)state;
+    uint16_t port;
+    int rx = open_rx(&port, 4 * 1024 * 1024);
+    close(rx); /* the port is free now: nobody listens */
+    sc_udp_display u;
+    sc_udp_display_def def = sc_udp_display_default_def();
+    def.port = port;
+    def.batch_packets = 64u;
+    assert_int_equal(sc_udp_display_open(&u, &def), 0);
+    sc_display_dev dev = sc_udp_display_dev(&u);
+    /* one batch: BEGIN goes, its ICMP error refuses the next packet and sendmmsg stops there;
+     * the error is consumed, so FRAME_END sent again alone goes (to nobody) */
+    const sc_display_frame_info info = {0u, 40u, 64u, 0u, 0u, 40.0f, 38.0f, 0.0f};
+    uint8_t s[64] = {0};
+    assert_int_equal(sc_display_frame_begin(&dev, &info), 0);
+    for (uint16_t l = 0; l < 40u; l++) {
+        assert_int_equal(sc_display_line(&dev, 0u, l, s, 64u), 0);
+    }
+    assert_int_equal(sc_display_frame_end(&dev, 0u), SC_ERR_IO);
+    assert_false(u.up);
+    assert_int_equal(u.send_calls, 2u);
+    assert_int_equal(u.packets_sent, 2u);
+    assert_int_equal(u.lines_sent, 0u);
+    assert_int_equal(u.lines_dropped, 40u);
+    for (uint32_t f = 1; f < 3u; f++) {
+        send_frame(&dev, f, 100u, 64u);
+    }
+    assert_int_equal(u.lines_sent + u.lines_dropped, 240u);
+    assert_false(u.up);
+    sc_display_link_state st;
+    assert_int_equal(sc_display_get_link_state(&dev, &st), 0);
+    assert_false(st.up);
+    assert_int_equal(st.lines_sent + st.lines_dropped, 240u);
+
+    rx = socket(AF_INET, SOCK_DGRAM, 0);
+    struct sockaddr_in a;
+    memset(&a, 0, sizeof a);
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    a.sin_port = htons(port);
+    assert_int_equal(bind(rx, (struct sockaddr *)&a, sizeof a), 0);
+    /* a refusal may still be pending from the last frame: it costs at most the next batch */
+    send_frame(&dev, 3u, 100u, 64u);
+    (void)read_all(rx, g_pkts, 4096u);
+    const uint64_t dropped = u.lines_dropped;
+    send_frame(&dev, 4u, 100u, 64u);
+    assert_int_equal(u.lines_dropped, dropped);
+    assert_true(u.up);
+    const uint32_t got = read_all(rx, g_pkts, 4096u);
+    assert_int_equal(got, 102u);
+    assert_int_equal(g_pkts[0].type, SC_DLINK_FRAME_BEGIN);
+    assert_int_equal(g_pkts[101].type, SC_DLINK_FRAME_END);
+    assert_int_equal(g_pkts[101].end.lines_sent, 100u);
+    sc_udp_display_close(&u);
+    close(rx);
+}
+
+static void batch_above_the_limit_is_refused(void **state)
+{
+    (void)state;
+    sc_udp_display u;
+    sc_udp_display_def def = sc_udp_display_default_def();
+    assert_int_equal(def.batch_packets, SC_UDP_DISPLAY_DEFAULT_BATCH);
+    def.batch_packets = SC_UDP_DISPLAY_MAX_BATCH + 1u;
+    assert_int_equal(sc_udp_display_open(&u, &def), SC_ERR_RANGE);
+    def.batch_packets = 0u; /* the default */
+    assert_int_equal(sc_udp_display_open(&u, &def), 0);
+    assert_int_equal(u.batch, SC_UDP_DISPLAY_DEFAULT_BATCH);
+    sc_udp_display_close(&u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(packets_arrive_in_call_order_for_every_batch_size),
+        cmocka_unit_test(lines_wait_in_the_batch_until_it_is_full_or_the_frame_ends),
+        cmocka_unit_test(full_socket_counts_exactly_what_the_reader_gets),
+        cmocka_unit_test(frame_end_is_tried_once_more_alone_when_its_batch_did_not_all_go),
+        cmocka_unit_test(refused_destination_takes_the_link_down_until_a_receiver_appears),
+        cmocka_unit_test(batch_above_the_limit_is_refused),
         cmocka_unit_test(loopback_without_injection_loses_no_line),
         cmocka_unit_test(injected_losses_are_counted_exactly_by_the_receiver),
         cmocka_unit_test(full_socket_buffer_drops_and_counts_instead_of_blocking),
