@@ -13,7 +13,10 @@
 #include <string.h>
 #include <time.h>
 
+#include "sc_err.h"
+#include "sc_hs_cpu.h"
 #include "sc_labels.h"
+#include "sc_simd.h"
 #include "sc_stats.h"
 #include "sc_test_tissue_scene.h"
 #include "sc_tissue.h"
@@ -66,9 +69,12 @@ static int run(uint32_t nx, uint32_t ny, uint32_t nz, sc_tissue_method m, float 
     sc_stats st;
     sc_stats_reset(&st);
     uint64_t coll = 0;
-    const sc_collider_grid g = {g_t.mesh.nx, g_t.mesh.ny, g_t.mesh.nz,
-                                {g_t.mesh.origin_mm[0], g_t.mesh.origin_mm[1], g_t.mesh.origin_mm[2]},
-                                {g_t.mesh.cell_mm[0], g_t.mesh.cell_mm[1], g_t.mesh.cell_mm[2]}};
+    const sc_collider_grid g = {
+        g_t.mesh.nx,
+        g_t.mesh.ny,
+        g_t.mesh.nz,
+        {g_t.mesh.origin_mm[0], g_t.mesh.origin_mm[1], g_t.mesh.origin_mm[2]},
+        {g_t.mesh.cell_mm[0], g_t.mesh.cell_mm[1], g_t.mesh.cell_mm[2]}};
     static sc_contact_set cs;
     for (int f = 0; f < frames; f++) {
         const uint64_t t0 = now_ns();
@@ -94,11 +100,14 @@ static int run(uint32_t nx, uint32_t ny, uint32_t nz, sc_tissue_method m, float 
  * 32x16x16 after the press of run(): min over 5 batches of frames / 5 frames, springs only
  * and default. For instruction counts: valgrind --tool=callgrind
  * --toggle-collect=sc_msds_step bench-physics 10 msds (Ir / 10 = per frame, both runs). */
-static int msds_only(int frames)
+static int msds_only(int frames, int which)
 {
     const float ratios[2] = {0.0f, sc_msds_default_def().volume_stiffness_ratio};
     const int batch = frames >= 5 ? frames / 5 : 1;
     for (int r = 0; r < 2; r++) {
+        if (which >= 0 && which != r) {
+            continue;
+        }
         result a;
         if (run(32u, 16u, 16u, SC_TISSUE_MSDS, ratios[r], 1, &a) != 0) {
             return 1;
@@ -122,14 +131,21 @@ static int msds_only(int frames)
 int main(int argc, char **argv)
 {
     const int frames = argc > 1 ? atoi(argv[1]) : 200;
+    if (sc_hs_cpu_select_simd() != SC_OK) {
+        fprintf(stderr, "bench-physics: SONOCOMP_SIMD not available here, using %s\n",
+                sc_simd_name(sc_simd_selected()));
+    }
+    printf("kernels: %s\n", sc_simd_name(sc_simd_selected()));
     if (argc > 2 && strcmp(argv[2], "msds") == 0) {
-        return msds_only(frames);
+        const int which = argc > 3 ? (strcmp(argv[3], "springs") == 0 ? 0 : 1) : -1;
+        return msds_only(frames, which);
     }
     static const uint32_t sizes[4][3] = {{20, 10, 10}, {24, 12, 12}, {28, 14, 14}, {32, 16, 16}};
     static const double paper_msds[4] = {10, 17, 27, 40}, paper_fem[4] = {30, 60, 100, 150},
                         paper_coll[4] = {0.1, 0.2, 0.2, 0.3};
     printf("soft tissue, ms per frame (20 iterations, dt 0.01 s), one thread, %d frames, probe "
-           "3 mm in contact; paper Table I in brackets\n", frames);
+           "3 mm in contact; paper Table I in brackets\n",
+           frames);
     printf("%-10s %6s %7s | %-22s | %-22s | %-26s\n", "mesh", "nodes", "tets",
            "MSDS mean/p99 [paper]", "FEM mean/p99 [paper]", "collision ms (contacts) [paper]");
     for (int s = 0; s < 4; s++) {
@@ -143,10 +159,11 @@ int main(int argc, char **argv)
         }
         char name[32];
         snprintf(name, sizeof name, "%ux%ux%u", sizes[s][0], sizes[s][1], sizes[s][2]);
-        printf("%-10s %6u %7u | %6.2f / %6.2f [%4.0f] | %6.2f / %6.2f [%4.0f] | %6.3f (%4u, %4u MPR) "
-               "[%.1f]\n",
-               name, g_t.mesh.node_count, g_t.mesh.tet_count, a.mean_ms, a.p99_ms, paper_msds[s],
-               b.mean_ms, b.p99_ms, paper_fem[s], a.coll_ms, a.contacts, a.mpr, paper_coll[s]);
+        printf(
+            "%-10s %6u %7u | %6.2f / %6.2f [%4.0f] | %6.2f / %6.2f [%4.0f] | %6.3f (%4u, %4u MPR) "
+            "[%.1f]\n",
+            name, g_t.mesh.node_count, g_t.mesh.tet_count, a.mean_ms, a.p99_ms, paper_msds[s],
+            b.mean_ms, b.p99_ms, paper_fem[s], a.coll_ms, a.contacts, a.mpr, paper_coll[s]);
     }
     /* the MSDS's cost split at the largest size: Algorithm 1's springs alone (the paper's
      * MSDS, volume term off) against the default (springs + volume term) */
