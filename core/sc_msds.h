@@ -69,6 +69,8 @@
 
 #define SC_MSDS_FAMILIES   9u
 #define SC_MSDS_CELL_BLOCK 64u /* cells per block of the volume term (scratch 12 KB) */
+/* nodes per block of a substep's sweep (a multiple of SC_MSDS_CELL_BLOCK; sc_msds_kern.inc) */
+#define SC_MSDS_SWEEP_BLOCK 256u
 
 typedef struct sc_msds_def {
     float dt_s;                    /* explicit Euler step, > 0 (default SC_PHYS_DT_DEFAULT_S) */
