@@ -4,7 +4,11 @@
  * muscle, vein, artery) with the probe held 3 mm (10%) into the skin, so that contacts exist
  * every frame. Per mesh size and method: `frames` frames after a warm-up; wall time of
  * sc_tissue_step (solver + collision, skin off) and of the collision detection alone; one
- * thread. Then the MSDS at 32x16x16 with the volume term off and on (sc_msds.h).
+ * thread, the best kernel variant for this CPU (core/sc_simd.h). Then the MSDS at 32x16x16
+ * with the volume term off and on (sc_msds.h) for every kernel variant this CPU runs.
+ * Times are thread CPU time (CLOCK_THREAD_CPUTIME_ID), so that on a shared machine the time
+ * the thread spends descheduled is not counted (cache interference still is: compare p50
+ * and best with the mean).
  * Usage: bench-physics [frames]   (default 200)
  *        bench-physics frames msds   (the MSDS solver alone, see msds_only) */
 #include <stdio.h>
@@ -26,7 +30,7 @@ static sc_tissue g_t;
 static uint64_t now_ns(void)
 {
     struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
     return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
 }
 
@@ -36,7 +40,7 @@ static double ms(uint64_t ns)
 }
 
 typedef struct result {
-    double mean_ms, p99_ms, coll_ms;
+    double mean_ms, p50_ms, p99_ms, best_ms, coll_ms;
     uint32_t contacts, mpr;
 } result;
 
@@ -89,7 +93,9 @@ static int run(uint32_t nx, uint32_t ny, uint32_t nz, sc_tissue_method m, float 
         }
     }
     out->mean_ms = ms(sc_stats_mean_ns(&st));
+    out->p50_ms = ms(sc_stats_percentile_ns(&st, 500));
     out->p99_ms = ms(sc_stats_percentile_ns(&st, 990));
+    out->best_ms = ms(st.best_ns);
     out->coll_ms = ms(coll / (uint64_t)frames);
     out->contacts = cs.count;
     out->mpr = cs.mpr_calls;
@@ -165,18 +171,30 @@ int main(int argc, char **argv)
             name, g_t.mesh.node_count, g_t.mesh.tet_count, a.mean_ms, a.p99_ms, paper_msds[s],
             b.mean_ms, b.p99_ms, paper_fem[s], a.coll_ms, a.contacts, a.mpr, paper_coll[s]);
     }
-    /* the MSDS's cost split at the largest size: Algorithm 1's springs alone (the paper's
-     * MSDS, volume term off) against the default (springs + volume term) */
-    result a0, a1;
-    if (run(32u, 16u, 16u, SC_TISSUE_MSDS, 0.0f, frames, &a0) != 0 ||
-        run(32u, 16u, 16u, SC_TISSUE_MSDS, sc_msds_default_def().volume_stiffness_ratio, frames,
-            &a1) != 0) {
-        fprintf(stderr, "run failed\n");
-        return 1;
+    /* the MSDS at the largest size per kernel variant: Algorithm 1's springs alone (the
+     * paper's MSDS, volume term off) and the default (springs + volume term); a tissue frame
+     * as above (20 substeps with contact forces) */
+    printf("MSDS 32x16x16 tissue frame by kernel variant, ms (p50 is a histogram bin's upper "
+           "bound); target 2 ms\n");
+    printf("%-10s | %-27s | %-27s\n", "kernels", "springs only mean/p50/best",
+           "default (+volume) mean/p50/best");
+    const sc_simd chosen = sc_simd_selected();
+    for (int v = 0; v < (int)SC_SIMD_COUNT; v++) {
+        if (!sc_simd_built((sc_simd)v) || v > (int)sc_hs_cpu_best_simd()) {
+            continue;
+        }
+        (void)sc_simd_select((sc_simd)v);
+        result a0, a1;
+        if (run(32u, 16u, 16u, SC_TISSUE_MSDS, 0.0f, frames, &a0) != 0 ||
+            run(32u, 16u, 16u, SC_TISSUE_MSDS, sc_msds_default_def().volume_stiffness_ratio, frames,
+                &a1) != 0) {
+            fprintf(stderr, "run failed\n");
+            return 1;
+        }
+        printf("%-10s | %7.2f / %7.2f / %7.2f | %7.2f / %7.2f / %7.2f\n", sc_simd_name((sc_simd)v),
+               a0.mean_ms, a0.p50_ms, a0.best_ms, a1.mean_ms, a1.p50_ms, a1.best_ms);
     }
-    printf("MSDS 32x16x16 mean/p99 ms: springs only (volume term off) %.2f / %.2f, springs + "
-           "volume term (default) %.2f / %.2f; target 2 ms\n",
-           a0.mean_ms, a0.p99_ms, a1.mean_ms, a1.p99_ms);
+    (void)sc_simd_select(chosen);
     printf("sizeof(sc_tissue) = %zu bytes (sc_msds %zu, sc_fem %zu, sc_springs %zu)\n",
            sizeof(sc_tissue), sizeof(sc_msds), sizeof(sc_fem), sizeof(sc_springs));
     return 0;
