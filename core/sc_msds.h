@@ -76,7 +76,7 @@
 #include "sc_springs.h"
 
 #define SC_MSDS_FAMILIES   9u
-#define SC_MSDS_CELL_BLOCK 64u /* cells per block of the volume term (scratch 12 KB) */
+#define SC_MSDS_CELL_BLOCK 64u /* cells per block of the volume term (scratch 6 KB) */
 /* nodes per block of a substep's sweep (a multiple of SC_MSDS_CELL_BLOCK; sc_msds_kern.inc) */
 #define SC_MSDS_SWEEP_BLOCK 256u
 
@@ -120,8 +120,7 @@ typedef struct sc_msds {
     SC_ALIGN_HOT float cell_d0[5][SC_MAX_NODES];         /* rest 6V in the kernel's corner order */
     SC_ALIGN_HOT float cell_par[SC_MAX_NODES];           /* 1: odd cell (mirrored template), 0 */
     uint32_t cell_end;                                   /* origins 0..cell_end-1 are visited */
-    SC_ALIGN_HOT float cell_q[8][3][SC_MSDS_CELL_BLOCK]; /* scratch: mirrored corners */
-    SC_ALIGN_HOT float cell_g[8][3][SC_MSDS_CELL_BLOCK]; /* scratch: their forces */
+    SC_ALIGN_HOT float cell_g[8][3][SC_MSDS_CELL_BLOCK]; /* scratch: corner forces (mirrored) */
     float mass_scale; /* sigma (see above): 1.1 x spectral estimate / Gershgorin, <= 1 */
     uint32_t nx, nxy; /* grid shape and cell (rest geometry for the spectral estimate) */
     float cell_mm[3];

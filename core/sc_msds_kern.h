@@ -14,6 +14,17 @@
 /* velocities below this are set to 0 (see integrate in sc_msds_kern.inc) */
 #define SC_MSDS_V_FLUSH_MM_S 1e-12f
 
+/* Before a loop whose stores provably do not overlap its loads (distinct arrays) although the
+ * compiler cannot see it through many derived pointers: no run-time alias checks (GCC gives
+ * up vectorising beyond 10 of them). */
+#if defined(__clang__)
+#define SC_MSDS_IVDEP _Pragma("clang loop vectorize(assume_safety)")
+#elif defined(__GNUC__)
+#define SC_MSDS_IVDEP _Pragma("GCC ivdep")
+#else
+#define SC_MSDS_IVDEP
+#endif
+
 /* Portable variant (every target). */
 void sc_msds_substep_generic(sc_msds *s, sc_nodes *n);
 
