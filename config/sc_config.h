@@ -22,6 +22,12 @@
 #ifndef SC_SCHED_MAX_STAGES
 #define SC_SCHED_MAX_STAGES 8u
 #endif
+/* A burst of deadline misses is logged as its first miss, then at most one line per interval
+ * (the misses in between are counted in that line: the log must not flood under overload;
+ * the exact total is in the status). */
+#ifndef SC_ENGINE_MISS_LOG_INTERVAL_NS
+#define SC_ENGINE_MISS_LOG_INTERVAL_NS 1000000000u
+#endif
 /* Frames with deadline misses among the last SC_HEALTH_MISS_WINDOW frames that make the
  * engine DEGRADED. */
 #ifndef SC_HEALTH_MISS_WINDOW

@@ -451,9 +451,24 @@ void sc_engine_step(sc_engine *e, sc_frame_result *out)
     sc_frame_result r;
     sc_sched_run_frame(&e->sched, e, &r);
     e->frame_no++;
-    if (r.missed) {
+    /* deadline misses: the first of a burst is logged at once, then at most one line per
+     * interval (config/sc_config.h) so that an overload cannot flood the log; b counts the
+     * misses a line stands for (itself and the unlogged ones before it), and a burst that
+     * ends with unlogged misses gets a summary line once the interval is over */
+    const int log_due = e->miss_logged_ns == 0u ||
+                        r.end_ns - e->miss_logged_ns >= (uint64_t)SC_ENGINE_MISS_LOG_INTERVAL_NS;
+    if (r.missed && log_due) {
         sc_log(&e->hal->log, SC_LOG_WARN, "deadline_miss", SC_ERR_TIMEOUT,
-               (int64_t)(r.end_ns - r.release_ns), (int64_t)r.periods_skipped);
+               (int64_t)(r.end_ns - r.release_ns), (int64_t)e->misses_unlogged + 1);
+        e->miss_logged_ns = r.end_ns;
+        e->misses_unlogged = 0u;
+    } else if (r.missed) {
+        e->misses_unlogged++;
+    } else if (log_due && e->misses_unlogged > 0u) {
+        sc_log(&e->hal->log, SC_LOG_WARN, "deadline_miss_summary", SC_ERR_TIMEOUT, 0,
+               (int64_t)e->misses_unlogged);
+        e->miss_logged_ns = r.end_ns;
+        e->misses_unlogged = 0u;
     }
     sc_health_set(&e->health, SC_FAULT_DEADLINE,
                   sc_sched_recent_misses(&e->sched, SC_HEALTH_MISS_WINDOW) >=

@@ -116,6 +116,8 @@ typedef struct sc_engine {
     uint64_t phys_window_start_ns;
     uint64_t next_status_ns;
     uint32_t frame_no;
+    uint64_t miss_logged_ns;  /* end of the frame of the last miss line; 0: none yet */
+    uint32_t misses_unlogged; /* misses since then that got no line of their own */
     sc_bscan bscan;
     sc_tissue tissue; /* the large one last */
 } sc_engine;

@@ -45,11 +45,19 @@
  *
  * Layout (hot data, float32 SoA): the springs of the regular grid fall into 9 families by
  * grid direction (x, y, z and the six face diagonals); spring (n, n + off[d]) of family d is
- * stored at index n of family d's arrays (k = 0 where the grid has no such spring). A step
- * is then 9 straight, vectorisable passes with no gather/scatter by index. The volume term
+ * stored at index n of family d's arrays (k = 0 where the grid has no such spring), so the
+ * springs are straight, vectorisable loops with no gather/scatter by index. The volume term
  * runs per grid cell (origin node n): the 8 corners are loaded from straight rows, an odd
- * cell is mirrored in x by an exact 0/1 blend, so one branch-free body computes all five
- * tets, and the corner forces are added back by 8 straight passes per block of 64 cells.
+ * cell is mirrored in x by exact selects, so one branch-free body computes all five tets, and
+ * the corner forces are added back by 8 straight loops per block of 64 cells.
+ * A substep is one sweep over the nodes in blocks of SC_MSDS_SWEEP_BLOCK (256): the block's
+ * springs (as origins), its cells, then its integration; a node's last force comes from its
+ * own block and no block reads a node behind it, so this is exactly the explicit step, with
+ * the block's data in cache (one pass over memory per substep instead of about 20).
+ * The substep is one C source (sc_msds_kern.inc) built per instruction-set variant
+ * (sc_simd.h: generic, x86-64-v3, x86-64-v4), bit-identical; the platform picks the variant.
+ * Cost at 32x16x16, 20 substeps: about 1.7-1.9 ms per frame on x86-64-v4 (this machine),
+ * 4-5 ms generic (SSE2): bench-physics prints the table.
  * Memory (N = SC_MAX_NODES, T = SC_MAX_TETS): springs 72 B, masses/sums 24 B, scratch 24 B,
  * cells 44 B per node; per tet 24 B (k, V0, nodes: load time and energy only):
  * sizeof(sc_msds) about 2.2 MB at 8,192 nodes.
@@ -68,7 +76,9 @@
 #include "sc_springs.h"
 
 #define SC_MSDS_FAMILIES   9u
-#define SC_MSDS_CELL_BLOCK 64u /* cells per block of the volume term (scratch 12 KB) */
+#define SC_MSDS_CELL_BLOCK 64u /* cells per block of the volume term (scratch 6 KB) */
+/* nodes per block of a substep's sweep (a multiple of SC_MSDS_CELL_BLOCK; sc_msds_kern.inc) */
+#define SC_MSDS_SWEEP_BLOCK 256u
 
 typedef struct sc_msds_def {
     float dt_s;                    /* explicit Euler step, > 0 (default SC_PHYS_DT_DEFAULT_S) */
@@ -110,8 +120,7 @@ typedef struct sc_msds {
     SC_ALIGN_HOT float cell_d0[5][SC_MAX_NODES];         /* rest 6V in the kernel's corner order */
     SC_ALIGN_HOT float cell_par[SC_MAX_NODES];           /* 1: odd cell (mirrored template), 0 */
     uint32_t cell_end;                                   /* origins 0..cell_end-1 are visited */
-    SC_ALIGN_HOT float cell_q[8][3][SC_MSDS_CELL_BLOCK]; /* scratch: mirrored corners */
-    SC_ALIGN_HOT float cell_g[8][3][SC_MSDS_CELL_BLOCK]; /* scratch: their forces */
+    SC_ALIGN_HOT float cell_g[8][3][SC_MSDS_CELL_BLOCK]; /* scratch: corner forces (mirrored) */
     float mass_scale; /* sigma (see above): 1.1 x spectral estimate / Gershgorin, <= 1 */
     uint32_t nx, nxy; /* grid shape and cell (rest geometry for the spectral estimate) */
     float cell_mm[3];

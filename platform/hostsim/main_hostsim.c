@@ -24,6 +24,7 @@
 #include "sc_candump.h"
 #include "sc_engine.h"
 #include "sc_err.h"
+#include "sc_hs_cpu.h"
 #include "sc_hs_rig.h"
 #include "sc_labels.h"
 #include "sc_png_write.h"
@@ -351,6 +352,12 @@ static sc_hs_rig rig; /* about 20 MB: static, allocated once */
 static sc_emu emu;
 static sc_emu_row csv_rows[100000];
 
+/* sc_emu_send_fn over a CAN device (the simulated tracker node) */
+static int send_peer(void *ctx, const sc_can_frame *f)
+{
+    return sc_can_send((const sc_can_dev *)ctx, f);
+}
+
 int main(int argc, char **argv)
 {
     options o;
@@ -361,6 +368,14 @@ int main(int argc, char **argv)
     if (mkdir_p(o.out_dir) != 0) {
         fprintf(stderr, "sc-hostsim: cannot create %s: %s\n", o.out_dir, strerror(errno));
         return 1;
+    }
+
+    /* the kernel variant for this CPU (core/sc_simd.h; SONOCOMP_SIMD overrides): all variants
+     * give the same bits, so the outputs do not depend on it */
+    if (sc_hs_cpu_select_simd() != SC_OK) {
+        fprintf(stderr,
+                "sc-hostsim: SONOCOMP_SIMD=%s refused (not built or not on this CPU), using %s\n",
+                getenv("SONOCOMP_SIMD"), sc_simd_name(sc_simd_selected()));
     }
 
     /* engine on the host simulator, cases mapped from files */
@@ -496,9 +511,6 @@ int main(int argc, char **argv)
     const uint64_t period = rig.engine.sched.period_ns;
     const uint64_t t0 = rig.clock.now_ns;
     const uint32_t frames = (uint32_t)ceil(o.seconds * 1e9 / (double)period);
-    uint64_t emu_next_ns = 0;
-    sc_can_frame ef[SC_EMU_MAX_FRAMES];
-    int emu_more = !replay;
     for (uint32_t i = 0; i < frames; i++) {
         /* release time of the frame about to run */
         const uint64_t release = rig.engine.sched.started ? rig.engine.sched.next_release_ns
@@ -519,18 +531,8 @@ int main(int argc, char **argv)
                 have_pending = 0;
             }
         } else {
-            while (emu_more && t0 + emu_next_ns <= release) {
-                uint64_t t_ns;
-                int n = sc_emu_next(&emu, ef, SC_EMU_MAX_FRAMES, &t_ns);
-                if (n < 0) {
-                    emu_more = 0;
-                    break;
-                }
-                for (int k = 0; k < n; k++) {
-                    (void)sc_can_send(&rig.peer, &ef[k]);
-                }
-                emu_next_ns = t_ns + (uint64_t)(1e9 / emu.def.rate_hz);
-            }
+            /* every sample due before this frame, from the tracker node */
+            (void)sc_emu_feed(&emu, release - t0, send_peer, &rig.peer);
         }
         const double w0 = mono_s();
         sc_engine_step(&rig.engine, NULL);

@@ -24,6 +24,7 @@
 #include "sc_can_replay.h"
 #include "sc_engine.h"
 #include "sc_err.h"
+#include "sc_hs_cpu.h"
 #include "sc_kms_display.h"
 #include "sc_log_linux.h"
 #include "sc_png_sink.h"
@@ -496,9 +497,14 @@ int main(int argc, char **argv)
         cfg.status_line == SC_RTCFG_ON || (cfg.status_line == SC_RTCFG_AUTO && isatty(2));
     const int status_records = cfg.status_line != SC_RTCFG_OFF;
     sc_log_linux_set_status_mode(&g_log, terminal);
-    sc_log_linux_msg(&g_log, SC_LOG_INFO, "start", "version=%s config=%s rate_hz=%u",
+    /* the kernel variant for this CPU (core/sc_simd.h; SONOCOMP_SIMD overrides) */
+    if (sc_hs_cpu_select_simd() != SC_OK) {
+        sc_log_linux_msg(&g_log, SC_LOG_WARN, "simd", "SONOCOMP_SIMD=%s refused: not on this CPU",
+                         getenv("SONOCOMP_SIMD"));
+    }
+    sc_log_linux_msg(&g_log, SC_LOG_INFO, "start", "version=%s config=%s rate_hz=%u kernels=%s",
                      SONOCOMP_VERSION, a.config_path ? a.config_path : "(defaults)",
-                     (unsigned)cfg.frame_rate_hz);
+                     (unsigned)cfg.frame_rate_hz, sc_simd_name(sc_simd_selected()));
     if (sc_rt_install_signals() != 0) {
         sc_log_linux_msg(&g_log, SC_LOG_WARN, "signals", "reason=\"cannot install handlers\"");
     }

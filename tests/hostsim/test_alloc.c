@@ -60,7 +60,7 @@ void __wrap_free(void *p)
 static sc_hs_rig rig;
 static sc_test_case tc;
 static sc_emu emu;
-static uint64_t emu_next_ns, t0;
+static uint64_t t0;
 
 static void rig_up(sc_tissue_method m)
 {
@@ -78,27 +78,20 @@ static void rig_up(sc_tissue_method m)
     ed.depth_mm = 4.0f;
     ed.duration_s = 1000.0;
     assert_int_equal(sc_emu_init(&emu, &ed), SC_OK);
-    emu_next_ns = 0;
     t0 = rig.clock.now_ns;
+}
+
+static int send_peer(void *ctx, const sc_can_frame *f)
+{
+    return sc_can_send((const sc_can_dev *)ctx, f);
 }
 
 static void run_frames(uint32_t n)
 {
-    sc_can_frame f[SC_EMU_MAX_FRAMES];
     for (uint32_t i = 0; i < n; i++) {
-        const uint64_t release = rig.engine.sched.started ? rig.engine.sched.next_release_ns
-                                                          : rig.clock.now_ns;
-        while (t0 + emu_next_ns <= release) {
-            uint64_t t_ns;
-            int k = sc_emu_next(&emu, f, SC_EMU_MAX_FRAMES, &t_ns);
-            if (k < 0) {
-                break;
-            }
-            for (int j = 0; j < k; j++) {
-                (void)sc_can_send(&rig.peer, &f[j]);
-            }
-            emu_next_ns = t_ns + (uint64_t)(1e9 / emu.def.rate_hz);
-        }
+        const uint64_t release =
+            rig.engine.sched.started ? rig.engine.sched.next_release_ns : rig.clock.now_ns;
+        (void)sc_emu_feed(&emu, release - t0, send_peer, &rig.peer);
         sc_engine_step(&rig.engine, NULL);
     }
 }

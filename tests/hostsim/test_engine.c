@@ -441,6 +441,62 @@ static void a_bad_case_is_refused_and_the_running_case_stays(void **state)
     assert_int_equal(rig.display.frames_complete, 5);
 }
 
+static int overload = 0;
+
+static void slow_stage(void *user)
+{
+    (void)user;
+    /* 1.5 periods of work: every frame misses its deadline */
+    if (overload) {
+        sc_hs_clock_advance_ns(&rig.clock, rig.engine.sched.period_ns * 3u / 2u);
+    }
+}
+
+/* the sum of b over the ring's records of an event (the ring holds them all here) */
+static int64_t sum_b(const char *event)
+{
+    int64_t sum = 0;
+    const uint64_t kept = rig.log.total < SC_HS_LOG_RING ? rig.log.total : SC_HS_LOG_RING;
+    for (uint64_t i = 0; i < kept; i++) {
+        const sc_hs_log_record *r = &rig.log.ring[i];
+        if (r->event != NULL && strcmp(r->event, event) == 0) {
+            sum += r->b;
+        }
+    }
+    return sum;
+}
+
+/* Sustained overload: every frame misses, yet the log gets the first miss and then one line a
+ * second, whose counts add up to every miss; after the overload, a summary line takes the
+ * rest. */
+static void sustained_misses_are_logged_once_a_second_and_all_counted(void **state)
+{
+    (void)state;
+    rig_up("block", 6);
+    assert_int_equal(sc_engine_add_stage(&rig.engine, "slow", slow_stage), SC_OK);
+    overload = 1;
+    const uint64_t t_start = rig.clock.now_ns;
+    run(200, 0, -1.0); /* 200 frames of 1.5 periods: 5 s at 60 Hz */
+    const double seconds = (double)(rig.clock.now_ns - t_start) * 1e-9;
+    const uint64_t misses = rig.engine.sched.misses;
+    const uint32_t lines = sc_hs_log_count_event(&rig.log, "deadline_miss");
+    print_message("%.1f s of overload: %llu misses, %u deadline_miss lines, %u unlogged\n", seconds,
+                  (unsigned long long)misses, lines, rig.engine.misses_unlogged);
+    assert_true(misses >= 190u);
+    assert_true(rig.log.total < SC_HS_LOG_RING);
+    assert_true(lines >= 2u && (double)lines <= seconds + 1.0);
+    assert_int_equal(sum_b("deadline_miss") + (int64_t)rig.engine.misses_unlogged, (int64_t)misses);
+    /* the overload ends: once the interval is over, a summary line takes the unlogged rest */
+    overload = 0;
+    const uint32_t unlogged = rig.engine.misses_unlogged;
+    run(90, 0, -1.0);
+    assert_int_equal(rig.engine.sched.misses, misses);
+    assert_int_equal(rig.engine.misses_unlogged, 0);
+    assert_int_equal(sc_hs_log_count_event(&rig.log, "deadline_miss_summary"), unlogged > 0u);
+    assert_int_equal(sum_b("deadline_miss") + sum_b("deadline_miss_summary"), (int64_t)misses);
+    overload = 0;
+}
+
 static void send_cmd(const sc_cmd *c, uint8_t counter)
 {
     sc_can_frame f;
@@ -540,6 +596,7 @@ int main(void)
         cmocka_unit_test(a_bad_case_is_refused_and_the_running_case_stays),
         cmocka_unit_test(commands_over_can_select_case_and_method_and_bad_ones_are_refused),
         cmocka_unit_test(status_frames_report_state_and_compression_with_valid_e2e),
+        cmocka_unit_test(sustained_misses_are_logged_once_a_second_and_all_counted),
     };
     return cmocka_run_group_tests(tests, group_setup, group_teardown);
 }

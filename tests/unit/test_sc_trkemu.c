@@ -161,6 +161,49 @@ static void csv_rows_load_and_bad_rows_name_their_line(void **state)
     fclose(fp);
 }
 
+typedef struct sink {
+    uint32_t frames;
+    uint32_t ids[64];
+} sink;
+
+static int collect(void *ctx, const sc_can_frame *f)
+{
+    sink *k = ctx;
+    if (k->frames < 64u) {
+        k->ids[k->frames] = f->id;
+    }
+    k->frames++;
+    return 0;
+}
+
+/* sc_emu_feed hands over exactly the samples due up to the given time, in order, and says
+ * when the script is over. 100 Hz: samples at 0, 10, 20 ms ... */
+static void feed_sends_every_due_sample_once(void **state)
+{
+    (void)state;
+    sc_emu_def d = sc_emu_default_def();
+    d.duration_s = 0.05; /* samples at 0 .. 40 ms */
+    sc_emu e;
+    assert_int_equal(sc_emu_init(&e, &d), 0);
+    sink k = {0};
+    assert_int_equal(sc_emu_next_time_ns(&e), 0u);
+    assert_int_equal(sc_emu_feed(&e, 0u, collect, &k), 1); /* the sample at t = 0 */
+    const uint32_t per_sample = k.frames;
+    assert_true(per_sample >= 1u);
+    assert_int_equal(sc_emu_feed(&e, 9999999u, collect, &k), 0); /* nothing due */
+    assert_int_equal(sc_emu_next_time_ns(&e), 10000000u);
+    assert_int_equal(sc_emu_feed(&e, 30000000u, collect, &k), 3); /* 10, 20, 30 ms */
+    assert_int_equal(k.frames, 4u * per_sample);
+    assert_int_equal(e.samples_sent, 4u);
+    assert_int_equal(sc_emu_feed(&e, UINT64_MAX, collect, &k), 1); /* 40 ms, then the end */
+    assert_int_equal(sc_emu_feed(&e, UINT64_MAX, collect, &k), SC_ERR_NOT_FOUND);
+    assert_int_equal(k.frames, 5u * per_sample);
+    /* the frames came in sample order: the same id sequence each sample */
+    for (uint32_t i = per_sample; i < k.frames && i < 64u; i++) {
+        assert_int_equal(k.ids[i], k.ids[i % per_sample]);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -168,6 +211,7 @@ int main(void)
         cmocka_unit_test(press_goes_down_to_the_depth_and_back_with_a_contact_force),
         cmocka_unit_test(every_injected_fault_is_counted_by_the_tracker),
         cmocka_unit_test(csv_rows_load_and_bad_rows_name_their_line),
+        cmocka_unit_test(feed_sends_every_due_sample_once),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -4,7 +4,11 @@
  * muscle, vein, artery) with the probe held 3 mm (10%) into the skin, so that contacts exist
  * every frame. Per mesh size and method: `frames` frames after a warm-up; wall time of
  * sc_tissue_step (solver + collision, skin off) and of the collision detection alone; one
- * thread. Then the MSDS at 32x16x16 with the volume term off and on (sc_msds.h).
+ * thread, the best kernel variant for this CPU (core/sc_simd.h). Then the MSDS at 32x16x16
+ * with the volume term off and on (sc_msds.h) for every kernel variant this CPU runs.
+ * Times are thread CPU time (CLOCK_THREAD_CPUTIME_ID), so that on a shared machine the time
+ * the thread spends descheduled is not counted (cache interference still is: compare p50
+ * and best with the mean).
  * Usage: bench-physics [frames]   (default 200)
  *        bench-physics frames msds   (the MSDS solver alone, see msds_only) */
 #include <stdio.h>
@@ -13,7 +17,10 @@
 #include <string.h>
 #include <time.h>
 
+#include "sc_err.h"
+#include "sc_hs_cpu.h"
 #include "sc_labels.h"
+#include "sc_simd.h"
 #include "sc_stats.h"
 #include "sc_test_tissue_scene.h"
 #include "sc_tissue.h"
@@ -23,7 +30,7 @@ static sc_tissue g_t;
 static uint64_t now_ns(void)
 {
     struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
     return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
 }
 
@@ -33,7 +40,7 @@ static double ms(uint64_t ns)
 }
 
 typedef struct result {
-    double mean_ms, p99_ms, coll_ms;
+    double mean_ms, p50_ms, p99_ms, best_ms, coll_ms;
     uint32_t contacts, mpr;
 } result;
 
@@ -66,9 +73,12 @@ static int run(uint32_t nx, uint32_t ny, uint32_t nz, sc_tissue_method m, float 
     sc_stats st;
     sc_stats_reset(&st);
     uint64_t coll = 0;
-    const sc_collider_grid g = {g_t.mesh.nx, g_t.mesh.ny, g_t.mesh.nz,
-                                {g_t.mesh.origin_mm[0], g_t.mesh.origin_mm[1], g_t.mesh.origin_mm[2]},
-                                {g_t.mesh.cell_mm[0], g_t.mesh.cell_mm[1], g_t.mesh.cell_mm[2]}};
+    const sc_collider_grid g = {
+        g_t.mesh.nx,
+        g_t.mesh.ny,
+        g_t.mesh.nz,
+        {g_t.mesh.origin_mm[0], g_t.mesh.origin_mm[1], g_t.mesh.origin_mm[2]},
+        {g_t.mesh.cell_mm[0], g_t.mesh.cell_mm[1], g_t.mesh.cell_mm[2]}};
     static sc_contact_set cs;
     for (int f = 0; f < frames; f++) {
         const uint64_t t0 = now_ns();
@@ -83,7 +93,9 @@ static int run(uint32_t nx, uint32_t ny, uint32_t nz, sc_tissue_method m, float 
         }
     }
     out->mean_ms = ms(sc_stats_mean_ns(&st));
+    out->p50_ms = ms(sc_stats_percentile_ns(&st, 500));
     out->p99_ms = ms(sc_stats_percentile_ns(&st, 990));
+    out->best_ms = ms(st.best_ns);
     out->coll_ms = ms(coll / (uint64_t)frames);
     out->contacts = cs.count;
     out->mpr = cs.mpr_calls;
@@ -94,11 +106,14 @@ static int run(uint32_t nx, uint32_t ny, uint32_t nz, sc_tissue_method m, float 
  * 32x16x16 after the press of run(): min over 5 batches of frames / 5 frames, springs only
  * and default. For instruction counts: valgrind --tool=callgrind
  * --toggle-collect=sc_msds_step bench-physics 10 msds (Ir / 10 = per frame, both runs). */
-static int msds_only(int frames)
+static int msds_only(int frames, int which)
 {
     const float ratios[2] = {0.0f, sc_msds_default_def().volume_stiffness_ratio};
     const int batch = frames >= 5 ? frames / 5 : 1;
     for (int r = 0; r < 2; r++) {
+        if (which >= 0 && which != r) {
+            continue;
+        }
         result a;
         if (run(32u, 16u, 16u, SC_TISSUE_MSDS, ratios[r], 1, &a) != 0) {
             return 1;
@@ -122,14 +137,21 @@ static int msds_only(int frames)
 int main(int argc, char **argv)
 {
     const int frames = argc > 1 ? atoi(argv[1]) : 200;
+    if (sc_hs_cpu_select_simd() != SC_OK) {
+        fprintf(stderr, "bench-physics: SONOCOMP_SIMD not available here, using %s\n",
+                sc_simd_name(sc_simd_selected()));
+    }
+    printf("kernels: %s\n", sc_simd_name(sc_simd_selected()));
     if (argc > 2 && strcmp(argv[2], "msds") == 0) {
-        return msds_only(frames);
+        const int which = argc > 3 ? (strcmp(argv[3], "springs") == 0 ? 0 : 1) : -1;
+        return msds_only(frames, which);
     }
     static const uint32_t sizes[4][3] = {{20, 10, 10}, {24, 12, 12}, {28, 14, 14}, {32, 16, 16}};
     static const double paper_msds[4] = {10, 17, 27, 40}, paper_fem[4] = {30, 60, 100, 150},
                         paper_coll[4] = {0.1, 0.2, 0.2, 0.3};
     printf("soft tissue, ms per frame (20 iterations, dt 0.01 s), one thread, %d frames, probe "
-           "3 mm in contact; paper Table I in brackets\n", frames);
+           "3 mm in contact; paper Table I in brackets\n",
+           frames);
     printf("%-10s %6s %7s | %-22s | %-22s | %-26s\n", "mesh", "nodes", "tets",
            "MSDS mean/p99 [paper]", "FEM mean/p99 [paper]", "collision ms (contacts) [paper]");
     for (int s = 0; s < 4; s++) {
@@ -143,23 +165,36 @@ int main(int argc, char **argv)
         }
         char name[32];
         snprintf(name, sizeof name, "%ux%ux%u", sizes[s][0], sizes[s][1], sizes[s][2]);
-        printf("%-10s %6u %7u | %6.2f / %6.2f [%4.0f] | %6.2f / %6.2f [%4.0f] | %6.3f (%4u, %4u MPR) "
-               "[%.1f]\n",
-               name, g_t.mesh.node_count, g_t.mesh.tet_count, a.mean_ms, a.p99_ms, paper_msds[s],
-               b.mean_ms, b.p99_ms, paper_fem[s], a.coll_ms, a.contacts, a.mpr, paper_coll[s]);
+        printf(
+            "%-10s %6u %7u | %6.2f / %6.2f [%4.0f] | %6.2f / %6.2f [%4.0f] | %6.3f (%4u, %4u MPR) "
+            "[%.1f]\n",
+            name, g_t.mesh.node_count, g_t.mesh.tet_count, a.mean_ms, a.p99_ms, paper_msds[s],
+            b.mean_ms, b.p99_ms, paper_fem[s], a.coll_ms, a.contacts, a.mpr, paper_coll[s]);
     }
-    /* the MSDS's cost split at the largest size: Algorithm 1's springs alone (the paper's
-     * MSDS, volume term off) against the default (springs + volume term) */
-    result a0, a1;
-    if (run(32u, 16u, 16u, SC_TISSUE_MSDS, 0.0f, frames, &a0) != 0 ||
-        run(32u, 16u, 16u, SC_TISSUE_MSDS, sc_msds_default_def().volume_stiffness_ratio, frames,
-            &a1) != 0) {
-        fprintf(stderr, "run failed\n");
-        return 1;
+    /* the MSDS at the largest size per kernel variant: Algorithm 1's springs alone (the
+     * paper's MSDS, volume term off) and the default (springs + volume term); a tissue frame
+     * as above (20 substeps with contact forces) */
+    printf("MSDS 32x16x16 tissue frame by kernel variant, ms (p50 is a histogram bin's upper "
+           "bound); target 2 ms\n");
+    printf("%-10s | %-27s | %-27s\n", "kernels", "springs only mean/p50/best",
+           "default (+volume) mean/p50/best");
+    const sc_simd chosen = sc_simd_selected();
+    for (int v = 0; v < (int)SC_SIMD_COUNT; v++) {
+        if (!sc_simd_built((sc_simd)v) || v > (int)sc_hs_cpu_best_simd()) {
+            continue;
+        }
+        (void)sc_simd_select((sc_simd)v);
+        result a0, a1;
+        if (run(32u, 16u, 16u, SC_TISSUE_MSDS, 0.0f, frames, &a0) != 0 ||
+            run(32u, 16u, 16u, SC_TISSUE_MSDS, sc_msds_default_def().volume_stiffness_ratio, frames,
+                &a1) != 0) {
+            fprintf(stderr, "run failed\n");
+            return 1;
+        }
+        printf("%-10s | %7.2f / %7.2f / %7.2f | %7.2f / %7.2f / %7.2f\n", sc_simd_name((sc_simd)v),
+               a0.mean_ms, a0.p50_ms, a0.best_ms, a1.mean_ms, a1.p50_ms, a1.best_ms);
     }
-    printf("MSDS 32x16x16 mean/p99 ms: springs only (volume term off) %.2f / %.2f, springs + "
-           "volume term (default) %.2f / %.2f; target 2 ms\n",
-           a0.mean_ms, a0.p99_ms, a1.mean_ms, a1.p99_ms);
+    (void)sc_simd_select(chosen);
     printf("sizeof(sc_tissue) = %zu bytes (sc_msds %zu, sc_fem %zu, sc_springs %zu)\n",
            sizeof(sc_tissue), sizeof(sc_msds), sizeof(sc_fem), sizeof(sc_springs));
     return 0;

@@ -189,6 +189,29 @@ static int fault_due(const sc_emu *e, double t_s)
     return -1;
 }
 
+uint64_t sc_emu_next_time_ns(const sc_emu *e)
+{
+    return (uint64_t)llround((double)e->sample * 1e9 / e->def.rate_hz);
+}
+
+int sc_emu_feed(sc_emu *e, uint64_t until_ns, sc_emu_send_fn send, void *ctx)
+{
+    sc_can_frame f[SC_EMU_MAX_FRAMES];
+    int taken = 0;
+    while (sc_emu_next_time_ns(e) <= until_ns) {
+        uint64_t t_ns;
+        const int n = sc_emu_next(e, f, SC_EMU_MAX_FRAMES, &t_ns);
+        if (n < 0) {
+            return taken > 0 ? taken : n;
+        }
+        for (int k = 0; k < n; k++) {
+            (void)send(ctx, &f[k]);
+        }
+        taken++;
+    }
+    return taken;
+}
+
 int sc_emu_next(sc_emu *e, sc_can_frame *out, size_t cap, uint64_t *t_ns)
 {
     const double t_s = (double)e->sample / e->def.rate_hz;

@@ -110,6 +110,17 @@ sc_pose_msg sc_emu_pose_at(const sc_emu_def *def, double t_s);
  * sample time from the start. Returns the frame count, or SC_ERR_NOT_FOUND past the duration. */
 int sc_emu_next(sc_emu *e, sc_can_frame *out, size_t cap, uint64_t *t_ns);
 
+/* Time of the next sample from the start (ns). */
+uint64_t sc_emu_next_time_ns(const sc_emu *e);
+
+/* Hands every frame of every sample due at or before until_ns (time from the start) to
+ * send(ctx, frame), samples in order, all frames of a sample before the next. Returns the
+ * number of samples taken (a silent sample counts, with no frames), or SC_ERR_NOT_FOUND once
+ * the script is over and nothing was taken. send's result is not looked at: a sender that
+ * refuses a frame is a lost frame, which the receiver's counters show. */
+typedef int (*sc_emu_send_fn)(void *ctx, const sc_can_frame *frame);
+int sc_emu_feed(sc_emu *e, uint64_t until_ns, sc_emu_send_fn send, void *ctx);
+
 /* Loads csv rows (comma separated, '#' comments and a header line allowed, times strictly
  * increasing). 0, or SC_ERR_PARSE with *bad_line set, SC_ERR_NO_SPACE above cap. */
 int sc_emu_load_csv(FILE *fp, sc_emu_row *rows, size_t cap, size_t *n, size_t *bad_line);

@@ -1,0 +1,161 @@
+/* test_sc_simd.c: the instruction-set variants of the hot kernels (sc_simd.h) give the same
+ * bits, and the selection refuses what the build or the CPU does not have. */
+#define _POSIX_C_SOURCE 200809L /* setenv */
+#include "sc_test.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sc_err.h"
+#include "sc_hs_cpu.h"
+#include "sc_labels.h"
+#include "sc_material.h"
+#include "sc_mesh.h"
+#include "sc_msds.h"
+#include "sc_simd.h"
+#include "sc_springs.h"
+
+static sc_mesh g_mesh;
+static sc_nodes g_nodes;
+static sc_springs g_sp;
+static sc_msds g_msds;
+static sc_material_table g_mat;
+
+static uint64_t fnv_floats(uint64_t h, const float *p, uint32_t n)
+{
+    const unsigned char *b = (const unsigned char *)p;
+    for (size_t i = 0; i < (size_t)n * sizeof(float); i++) {
+        h = (h ^ b[i]) * 1099511628211ull;
+    }
+    return h;
+}
+
+/* A layered block pressed from above by a force that grows over the run, so that springs
+ * stretch and compress, tets change volume, and a few nodes move fast; then the state hash
+ * (positions and velocities, bit for bit). nx odd gives every loop a remainder. */
+static uint64_t run_scene(uint32_t nx, uint32_t ny, uint32_t nz, float volume_ratio)
+{
+    sc_mesh_def d = sc_mesh_default_def();
+    d.nx = nx;
+    d.ny = ny;
+    d.nz = nz;
+    assert_int_equal(sc_mesh_build(&g_mesh, &d), SC_OK);
+    sc_material_table_default(&g_mat);
+    assert_int_equal(sc_material_assign(&g_mesh, NULL, &g_mat, SC_LABEL_FAT), SC_OK);
+    static const uint8_t mix[] = {SC_LABEL_FAT, SC_LABEL_VEIN, SC_LABEL_MUSCLE, SC_LABEL_ARTERY,
+                                  SC_LABEL_THROMBUS};
+    for (uint32_t t = 0; t < g_mesh.tet_count; t++) {
+        g_mesh.tet_label[t] = mix[(t * 7u + t / 13u) % 5u];
+    }
+    assert_int_equal(sc_springs_from_tets(&g_sp, (const uint32_t(*)[4])g_mesh.tet, g_mesh.tet_label,
+                                          g_mesh.tet_count, &g_mat),
+                     SC_OK);
+    sc_msds_def def = sc_msds_default_def();
+    def.volume_stiffness_ratio = volume_ratio;
+    assert_int_equal(sc_msds_init(&g_msds, &g_mesh, &g_sp, &g_mat, &def), SC_OK);
+    sc_nodes_reset_to_rest(&g_nodes, &g_mesh);
+    /* k = 0 is the skin side (the bottom and the sides are fixed) */
+    for (uint32_t step = 0; step < 120u; step++) {
+        for (uint32_t i = 0; i < nx * ny; i++) {
+            const uint32_t ix = i % nx;
+            /* a press on the middle third of the top, sideways on one edge */
+            g_nodes.fz[i] = (ix > nx / 3u && ix < 2u * nx / 3u) ? 1e-3f * (float)step : 0.0f;
+            g_nodes.fx[i] = ix == 0u ? 2e-4f * (float)step : 0.0f;
+        }
+        sc_msds_substep(&g_msds, &g_nodes);
+    }
+    uint64_t h = 1469598103934665603ull;
+    h = fnv_floats(h, g_nodes.x, g_mesh.node_count);
+    h = fnv_floats(h, g_nodes.y, g_mesh.node_count);
+    h = fnv_floats(h, g_nodes.z, g_mesh.node_count);
+    h = fnv_floats(h, g_nodes.vx, g_mesh.node_count);
+    h = fnv_floats(h, g_nodes.vy, g_mesh.node_count);
+    h = fnv_floats(h, g_nodes.vz, g_mesh.node_count);
+    /* the scene must have moved, or equal hashes would prove nothing */
+    float dmax = 0.0f;
+    for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+        const float dz = fabsf(g_mesh.rest_z[i] - g_nodes.z[i]);
+        dmax = dz > dmax ? dz : dmax;
+    }
+    printf("# %ux%ux%u ratio %.0f: largest vertical displacement %.3f mm\n", nx, ny, nz,
+           (double)volume_ratio, (double)dmax);
+    assert_true(dmax > 0.2f);
+    return h;
+}
+
+/* Every variant this build has and this CPU runs gives the generic variant's bits, with and
+ * without the volume term, on an even and an odd grid. */
+static void variants_give_identical_bits(void **state)
+{
+    (void)state;
+    const sc_simd best = sc_hs_cpu_best_simd();
+    static const uint32_t shapes[2][3] = {{12u, 8u, 8u}, {11u, 7u, 6u}};
+    const float ratios[2] = {0.0f, sc_msds_default_def().volume_stiffness_ratio};
+    int compared = 0;
+    for (uint32_t sh = 0; sh < 2u; sh++) {
+        for (uint32_t r = 0; r < 2u; r++) {
+            assert_int_equal(sc_simd_select(SC_SIMD_GENERIC), SC_OK);
+            const uint64_t ref = run_scene(shapes[sh][0], shapes[sh][1], shapes[sh][2], ratios[r]);
+            for (int v = 1; v < (int)SC_SIMD_COUNT; v++) {
+                if (!sc_simd_built((sc_simd)v) || v > (int)best) {
+                    printf("# %s: not built or not on this CPU, skipped\n",
+                           sc_simd_name((sc_simd)v));
+                    continue;
+                }
+                assert_int_equal(sc_simd_select((sc_simd)v), SC_OK);
+                const uint64_t h =
+                    run_scene(shapes[sh][0], shapes[sh][1], shapes[sh][2], ratios[r]);
+                printf("# %ux%ux%u ratio %.0f: generic %016llx, %s %016llx\n", shapes[sh][0],
+                       shapes[sh][1], shapes[sh][2], (double)ratios[r], (unsigned long long)ref,
+                       sc_simd_name((sc_simd)v), (unsigned long long)h);
+                assert_true(h == ref);
+                compared++;
+            }
+        }
+    }
+    assert_int_equal(sc_simd_select(SC_SIMD_GENERIC), SC_OK);
+    printf("# %d comparisons (best variant here: %s)\n", compared, sc_simd_name(best));
+}
+
+static void selection_refuses_what_is_not_there(void **state)
+{
+    (void)state;
+    assert_int_equal(sc_simd_select(SC_SIMD_GENERIC), SC_OK);
+    assert_int_equal(sc_simd_selected(), SC_SIMD_GENERIC);
+    assert_int_equal(sc_simd_select(SC_SIMD_COUNT), SC_ERR_INVALID_ARG);
+    assert_int_equal(sc_simd_select((sc_simd)-1), SC_ERR_INVALID_ARG);
+    assert_int_equal(sc_simd_selected(), SC_SIMD_GENERIC);
+    assert_int_equal(sc_simd_built(SC_SIMD_GENERIC), 1);
+    assert_int_equal(sc_simd_built(SC_SIMD_COUNT), 0);
+    assert_string_equal(sc_simd_name(SC_SIMD_COUNT), "?");
+    for (int v = 0; v < (int)SC_SIMD_COUNT; v++) {
+        const int rc = sc_simd_select((sc_simd)v);
+        assert_int_equal(rc, sc_simd_built((sc_simd)v) ? SC_OK : SC_ERR_NOT_SUPPORTED);
+        assert_int_equal(sc_simd_selected(), rc == SC_OK ? (sc_simd)v : SC_SIMD_GENERIC);
+        assert_int_equal(sc_simd_select(SC_SIMD_GENERIC), SC_OK);
+    }
+    /* the host helper: the best is built, and an unknown override is refused (best kept) */
+    const sc_simd best = sc_hs_cpu_best_simd();
+    assert_int_equal(sc_simd_built(best), 1);
+    assert_int_equal(setenv("SONOCOMP_SIMD", "no-such-level", 1), 0);
+    assert_int_equal(sc_hs_cpu_select_simd(), SC_ERR_INVALID_ARG);
+    assert_int_equal(sc_simd_selected(), best);
+    assert_int_equal(setenv("SONOCOMP_SIMD", "generic", 1), 0);
+    assert_int_equal(sc_hs_cpu_select_simd(), SC_OK);
+    assert_int_equal(sc_simd_selected(), SC_SIMD_GENERIC);
+    assert_int_equal(unsetenv("SONOCOMP_SIMD"), 0);
+    assert_int_equal(sc_hs_cpu_select_simd(), SC_OK);
+    assert_int_equal(sc_simd_selected(), best);
+    assert_int_equal(sc_simd_select(SC_SIMD_GENERIC), SC_OK);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(variants_give_identical_bits),
+        cmocka_unit_test(selection_refuses_what_is_not_there),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
