@@ -58,10 +58,11 @@
  * (sc_simd.h: generic, x86-64-v3, x86-64-v4), bit-identical; the platform picks the variant.
  * Cost at 32x16x16, 20 substeps (bench-physics prints the table): 1.75-1.9 ms per frame on
  * x86-64-v4 (AMD Zen 5 here), 2.1-2.3 ms on x86-64-v3, 4.3-4.8 ms generic (SSE2); about 28M
- * instructions per frame on v3, 78M generic (callgrind). The springs are bound by their
- * sqrt and divide; six of the nine families are half empty (each face has one diagonal), and
- * packing them densely (selects of the ends) or moving them into the cell pass measured no
- * faster here.
+ * instructions per frame on v3, 78M generic (callgrind). Tried and measured no faster here:
+ * packing the six half-empty diagonal families densely (selects of the ends), moving them into
+ * the cell pass, a sqrt- and divide-free 1/|d| (Newton from a bit-pattern seed), fusing each
+ * family's far-end pass into the next, 512-bit or 256-bit vectors for x86-64-v4: the springs
+ * are bound by their loads and stores more than by their arithmetic.
  * Memory (N = SC_MAX_NODES, T = SC_MAX_TETS): springs 72 B, masses/sums 24 B, scratch 24 B,
  * cells 44 B per node; per tet 24 B (k, V0, nodes: load time and energy only):
  * sizeof(sc_msds) about 2.2 MB at 8,192 nodes.
