@@ -49,7 +49,7 @@
  * springs are straight, vectorisable loops with no gather/scatter by index. The volume term
  * runs per grid cell (origin node n): the 8 corners are loaded from straight rows, an odd
  * cell is mirrored in x by exact selects, so one branch-free body computes all five tets, and
- * the corner forces are added back by 8 straight loops per block of 64 cells.
+ * the corner forces are added back by 8 straight loops per block of SC_MSDS_CELL_BLOCK cells.
  * A substep is one sweep over the nodes in blocks of SC_MSDS_SWEEP_BLOCK (256): the block's
  * springs (as origins), its cells, then its integration; a node's last force comes from its
  * own block and no block reads a node behind it, so this is exactly the explicit step, with
@@ -80,10 +80,20 @@
 #include "sc_mesh.h"
 #include "sc_springs.h"
 
-#define SC_MSDS_FAMILIES   9u
-#define SC_MSDS_CELL_BLOCK 64u /* cells per block of the volume term (scratch 6 KB) */
+#define SC_MSDS_FAMILIES 9u
+/* cells per block of the cell pass: its force buffer is 96 B per cell (24 KB at 256; a
+ * block of 256 measured 8% faster than 64 on x86-64, the MCU build takes 64). The block sizes
+ * set the order in which a node's forces are summed, so they are part of what makes a state
+ * hash: builds with the same sizes agree bit for bit. */
+#ifndef SC_MSDS_CELL_BLOCK
+#define SC_MSDS_CELL_BLOCK 256u
+#endif
 /* nodes per block of a substep's sweep (a multiple of SC_MSDS_CELL_BLOCK; sc_msds_kern.inc) */
+#ifndef SC_MSDS_SWEEP_BLOCK
 #define SC_MSDS_SWEEP_BLOCK 256u
+#endif
+_Static_assert(SC_MSDS_SWEEP_BLOCK % SC_MSDS_CELL_BLOCK == 0u,
+               "a sweep block holds whole cell blocks");
 
 typedef struct sc_msds_def {
     float dt_s;                    /* explicit Euler step, > 0 (default SC_PHYS_DT_DEFAULT_S) */
