@@ -56,9 +56,10 @@
  * the block's data in cache (one pass over memory per substep instead of about 20).
  * The substep is one C source (sc_msds_kern.inc) built per instruction-set variant
  * (sc_simd.h: generic, x86-64-v3, x86-64-v4), bit-identical; the platform picks the variant.
- * Cost at 32x16x16, 20 substeps (bench-physics prints the table): 1.75-1.9 ms per frame on
- * x86-64-v4 (AMD Zen 5 here), 2.1-2.3 ms on x86-64-v3, 4.3-4.8 ms generic (SSE2); about 28M
- * instructions per frame on v3, 78M generic (callgrind). Tried and measured no faster here:
+ * Cost at 32x16x16, 20 substeps (bench-physics prints the table): on x86-64-v4 (AMD Zen 5
+ * here, a shared 2-core VM) best 1.56-1.69 ms, median 1.64-2.14 ms per frame over repeated
+ * runs; x86-64-v3 about 2.2 ms, generic (SSE2) 4.3-4.9 ms; 27.7M
+ * instructions per frame on v3, 76.7M generic (callgrind). Tried, measured no faster here:
  * packing the six half-empty diagonal families densely (selects of the ends), moving them into
  * the cell pass, a sqrt- and divide-free 1/|d| (Newton from a bit-pattern seed), fusing each
  * family's far-end pass into the next, 512-bit or 256-bit vectors for x86-64-v4: the springs
