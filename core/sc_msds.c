@@ -264,12 +264,10 @@ static void volume_gradients(const float *x, const float *y, const float *z, con
     }
 }
 
-/* the kernel's tets in the corner numbering of a cell (bit 0: +x, bit 1: +y, bit 2: +z),
- * even template; the mesh's tet q of an even cell has these nodes, of an odd cell the nodes
- * of corners c ^ 1 */
-static const uint8_t s_cell_tet[5][4] = {
-    {0u, 1u, 2u, 4u}, {3u, 2u, 1u, 7u}, {5u, 4u, 7u, 1u}, {6u, 7u, 4u, 2u}, {1u, 2u, 4u, 7u},
-};
+/* the kernel's tets (sc_msds_kern.h) as a table */
+#define SC_MSDS_TET_ROW(q, a, b, c, d) {a, b, c, d},
+static const uint8_t s_cell_tet[5][4] = {SC_MSDS_CELL_TETS(SC_MSDS_TET_ROW)};
+#undef SC_MSDS_TET_ROW
 
 static int same_node_set(const uint32_t a[4], const uint32_t b[4])
 {
@@ -289,7 +287,8 @@ static int same_node_set(const uint32_t a[4], const uint32_t b[4])
 static int init_cells(sc_msds *s, const sc_mesh *m)
 {
     const uint32_t nx = m->nx, ny = m->ny, nz = m->nz, nxy = nx * ny;
-    const uint32_t oc[8] = {0u, 1u, nx, nx + 1u, nxy, nxy + 1u, nxy + nx, nxy + nx + 1u};
+    uint32_t oc[8];
+    sc_msds_cell_offsets(nx, nxy, oc);
     for (uint32_t q = 0; q < 5u; q++) {
         for (uint32_t i = 0; i < SC_MAX_NODES; i++) {
             s->cell_k[q][i] = 0.0f;
