@@ -142,7 +142,7 @@ static void usage(FILE *f)
 {
     fprintf(f, "usage: bench-dlink [--frames N] [--rate HZ] [--lines N] [--samples N]\n"
                "                   [--batches LIST] [--drop-permille P] [--rx-tick-us US]\n"
-               "Defaults: 1000 frames, 120 Hz (0: back to back), 256 lines, 512 samples,\n"
+               "Defaults: 1000 frames, 120 Hz (0..1000; 0: back to back), 256 lines, 512 samples,\n"
                "batches 1,8,32,64 (1: one send() per packet, the per-line path), receiver\n"
                "asleep in poll() (0; US > 0: it wakes every US microseconds instead).\n");
 }
@@ -172,7 +172,7 @@ int main(int argc, char **argv)
                 sscanf(optarg, "%u%c", &frames, &extra) == 1 && frames > 0u && frames <= MAX_FRAMES;
             break;
         case 'r':
-            ok = sscanf(optarg, "%u%c", &rate, &extra) == 1;
+            ok = sscanf(optarg, "%u%c", &rate, &extra) == 1 && rate <= 1000u; /* 0: back to back */
             break;
         case 'l':
             ok = sscanf(optarg, "%u%c", &lines, &extra) == 1 && lines >= 1u &&
