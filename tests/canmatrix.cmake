@@ -23,7 +23,7 @@ endif()
 #    physical values the core decoded). Skipped (ctest SKIP) when canmatrix is not installed.
 add_executable(sc_canproto_dump ${CMAKE_CURRENT_SOURCE_DIR}/can/sc_canproto_dump.c)
 target_compile_options(sc_canproto_dump PRIVATE ${SC_WARN})
-target_link_libraries(sc_canproto_dump PRIVATE sc_core sc_hostsim)
+target_link_libraries(sc_canproto_dump PRIVATE sc_core sc_host_assert)
 # Debian's interpreter first: canmatrix is a Debian package, a pyenv python may not see it.
 find_program(SC_DEBIAN_PYTHON3 NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
 find_program(SC_DEBIAN_PYTHON3 NAMES python3)

@@ -1,7 +1,7 @@
 #!/bin/sh
 # dlink_loopback.sh VIEWER SENDER WORKDIR: the display link end to end over 127.0.0.1, with the
 # real programs: sc-dlink-send (platform/linux/sc_udp_display.c) -> UDP -> sc-viewer
-# (core/sc_dlink.c assembler). Checks:
+# (platform/dlink/sc_dlink.c assembler). Checks:
 #  1. nothing injected: every line of every frame arrives (lines_lost = 0, all frames complete);
 #  2. 2% loss injected at the sender: the viewer counts exactly the injected lines as lost;
 #  3. the viewer's recordings exist (PNG frames, an animated GIF with frames in it).

@@ -24,7 +24,7 @@
 #include "sc_candump.h"
 #include "sc_engine.h"
 #include "sc_err.h"
-#include "sc_hs_cpu.h"
+#include "sc_cpu.h"
 #include "sc_hs_rig.h"
 #include "sc_labels.h"
 #include "sc_png_write.h"
@@ -370,9 +370,9 @@ int main(int argc, char **argv)
         return 1;
     }
 
-    /* the kernel variant for this CPU (core/sc_simd.h; SONOCOMP_SIMD overrides): all variants
+    /* the kernel variant for this CPU (core/physics/sc_simd.h; SONOCOMP_SIMD overrides): all variants
      * give the same bits, so the outputs do not depend on it */
-    if (sc_hs_cpu_select_simd() != SC_OK) {
+    if (sc_cpu_select_simd() != SC_OK) {
         fprintf(stderr,
                 "sc-hostsim: SONOCOMP_SIMD=%s refused (not built or not on this CPU), using %s\n",
                 getenv("SONOCOMP_SIMD"), sc_simd_name(sc_simd_selected()));

@@ -24,7 +24,7 @@
 #include "sc_can_replay.h"
 #include "sc_engine.h"
 #include "sc_err.h"
-#include "sc_hs_cpu.h"
+#include "sc_cpu.h"
 #include "sc_kms_display.h"
 #include "sc_log_linux.h"
 #include "sc_png_sink.h"
@@ -497,8 +497,8 @@ int main(int argc, char **argv)
         cfg.status_line == SC_RTCFG_ON || (cfg.status_line == SC_RTCFG_AUTO && isatty(2));
     const int status_records = cfg.status_line != SC_RTCFG_OFF;
     sc_log_linux_set_status_mode(&g_log, terminal);
-    /* the kernel variant for this CPU (core/sc_simd.h; SONOCOMP_SIMD overrides) */
-    if (sc_hs_cpu_select_simd() != SC_OK) {
+    /* the kernel variant for this CPU (core/physics/sc_simd.h; SONOCOMP_SIMD overrides) */
+    if (sc_cpu_select_simd() != SC_OK) {
         sc_log_linux_msg(&g_log, SC_LOG_WARN, "simd", "SONOCOMP_SIMD=%s refused: not on this CPU",
                          getenv("SONOCOMP_SIMD"));
     }

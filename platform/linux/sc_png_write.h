@@ -4,7 +4,7 @@
  * The image data goes into zlib "stored" (uncompressed) deflate blocks, so no zlib or libpng
  * is linked: the engine binary also links statically for the HIL VM, where Debian's shared
  * libraries are not available. Files are therefore about the raw image size (a 512 x 512 grey
- * frame is 257 KiB). CRC-32 from core/sc_crc32.h, Adler-32 computed here. Any PNG reader
+ * frame is 257 KiB). CRC-32 from core/base/sc_crc32.h, Adler-32 computed here. Any PNG reader
  * (libpng, browsers, ImageMagick, Python) reads them.
  *
  * Allocation: none (streams through a stdio FILE). Reentrant.

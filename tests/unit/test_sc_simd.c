@@ -9,7 +9,7 @@
 #include <string.h>
 
 #include "sc_err.h"
-#include "sc_hs_cpu.h"
+#include "sc_cpu.h"
 #include "sc_labels.h"
 #include "sc_material.h"
 #include "sc_mesh.h"
@@ -90,7 +90,7 @@ static uint64_t run_scene(uint32_t nx, uint32_t ny, uint32_t nz, float volume_ra
 static void variants_give_identical_bits(void **state)
 {
     (void)state;
-    const sc_simd best = sc_hs_cpu_best_simd();
+    const sc_simd best = sc_cpu_best_simd();
     static const uint32_t shapes[2][3] = {{12u, 8u, 8u}, {11u, 7u, 6u}};
     const float ratios[2] = {0.0f, sc_msds_default_def().volume_stiffness_ratio};
     int compared = 0;
@@ -137,16 +137,16 @@ static void selection_refuses_what_is_not_there(void **state)
         assert_int_equal(sc_simd_select(SC_SIMD_GENERIC), SC_OK);
     }
     /* the host helper: the best is built, and an unknown override is refused (best kept) */
-    const sc_simd best = sc_hs_cpu_best_simd();
+    const sc_simd best = sc_cpu_best_simd();
     assert_int_equal(sc_simd_built(best), 1);
     assert_int_equal(setenv("SONOCOMP_SIMD", "no-such-level", 1), 0);
-    assert_int_equal(sc_hs_cpu_select_simd(), SC_ERR_INVALID_ARG);
+    assert_int_equal(sc_cpu_select_simd(), SC_ERR_INVALID_ARG);
     assert_int_equal(sc_simd_selected(), best);
     assert_int_equal(setenv("SONOCOMP_SIMD", "generic", 1), 0);
-    assert_int_equal(sc_hs_cpu_select_simd(), SC_OK);
+    assert_int_equal(sc_cpu_select_simd(), SC_OK);
     assert_int_equal(sc_simd_selected(), SC_SIMD_GENERIC);
     assert_int_equal(unsetenv("SONOCOMP_SIMD"), 0);
-    assert_int_equal(sc_hs_cpu_select_simd(), SC_OK);
+    assert_int_equal(sc_cpu_select_simd(), SC_OK);
     assert_int_equal(sc_simd_selected(), best);
     assert_int_equal(sc_simd_select(SC_SIMD_GENERIC), SC_OK);
 }

@@ -4,7 +4,7 @@
  * muscle, vein, artery) with the probe held 3 mm (10%) into the skin, so that contacts exist
  * every frame. Per mesh size and method: `frames` frames after a warm-up; wall time of
  * sc_tissue_step (solver + collision, skin off) and of the collision detection alone; one
- * thread, the best kernel variant for this CPU (core/sc_simd.h). Then the MSDS at 32x16x16
+ * thread, the best kernel variant for this CPU (core/physics/sc_simd.h). Then the MSDS at 32x16x16
  * with the volume term off and on (sc_msds.h) for every kernel variant this CPU runs.
  * Times are thread CPU time (CLOCK_THREAD_CPUTIME_ID), so that on a shared machine the time
  * the thread spends descheduled is not counted (cache interference still is: compare p50
@@ -18,7 +18,7 @@
 #include <time.h>
 
 #include "sc_err.h"
-#include "sc_hs_cpu.h"
+#include "sc_cpu.h"
 #include "sc_labels.h"
 #include "sc_simd.h"
 #include "sc_stats.h"
@@ -143,7 +143,7 @@ static int msds_only(int frames, int which)
 int main(int argc, char **argv)
 {
     const int frames = argc > 1 ? atoi(argv[1]) : 200;
-    if (sc_hs_cpu_select_simd() != SC_OK) {
+    if (sc_cpu_select_simd() != SC_OK) {
         fprintf(stderr, "bench-physics: SONOCOMP_SIMD not available here, using %s\n",
                 sc_simd_name(sc_simd_selected()));
     }
@@ -189,7 +189,7 @@ int main(int argc, char **argv)
            "tissue frame");
     const sc_simd chosen = sc_simd_selected();
     for (int v = 0; v < (int)SC_SIMD_COUNT; v++) {
-        if (!sc_simd_built((sc_simd)v) || v > (int)sc_hs_cpu_best_simd()) {
+        if (!sc_simd_built((sc_simd)v) || v > (int)sc_cpu_best_simd()) {
             continue;
         }
         (void)sc_simd_select((sc_simd)v);

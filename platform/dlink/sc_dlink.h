@@ -5,7 +5,7 @@
  * a FRAME_BEGIN packet, one LINE packet per scan line (any order, each at most once), and a
  * FRAME_END packet. Every packet starts with the same 28-byte little-endian header carrying
  * magic, version, type, flags, frame number, line index, line count, samples per line,
- * geometry id, payload length and a CRC-32 (core/sc_crc32.h) over header and payload. The wire
+ * geometry id, payload length and a CRC-32 (core/base/sc_crc32.h) over header and payload. The wire
  * format is specified byte by byte in docs/display-link.md; SC_DLINK_VERSION changes whenever
  * that format changes.
  *

@@ -1,12 +1,12 @@
-/* sc_hs_cpu.c: the host CPU's kernel variant; see sc_hs_cpu.h. */
-#include "sc_hs_cpu.h"
+/* sc_cpu.c: the host CPU's kernel variant; see sc_cpu.h. */
+#include "sc_cpu.h"
 
 #include <stdlib.h>
 #include <string.h>
 
 #include "sc_err.h"
 
-sc_simd sc_hs_cpu_best_simd(void)
+sc_simd sc_cpu_best_simd(void)
 {
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
     /* the level names test every feature of the level, and, for AVX and AVX-512, that the
@@ -21,9 +21,9 @@ sc_simd sc_hs_cpu_best_simd(void)
     return SC_SIMD_GENERIC;
 }
 
-int sc_hs_cpu_select_simd(void)
+int sc_cpu_select_simd(void)
 {
-    const sc_simd best = sc_hs_cpu_best_simd();
+    const sc_simd best = sc_cpu_best_simd();
     const char *want = getenv("SONOCOMP_SIMD");
     if (want == NULL || want[0] == '\0') {
         return sc_simd_select(best);

@@ -1,4 +1,4 @@
-/* sc_hs_assert.c: the host's SC_ASSERT hook: print the failed check and abort. */
+/* sc_assert_linux.c: the SC_ASSERT hook of every Linux host program (the appliance, the host simulator, the tools): print the failed check and abort. */
 #include <stdio.h>
 #include <stdlib.h>
 
