@@ -6,6 +6,17 @@
  * and counts, it never stalls the frame loop. Mandatory: frame_begin, line, frame_end.
  * Optional: link_state (NULL answers SC_ERR_NOT_SUPPORTED).
  * The sample buffer passed to line() is owned by the caller and valid only during the call.
+ *
+ * What the display needs with a frame travels with that frame: the geometry in frame_begin's
+ * info, and what the frame's own pass computes (the vessels' compression measure) in
+ * frame_end's record. Lines leave as soon as they are computed and the measure comes from the
+ * same pass, so the frame's closing record is the first place that holds it; every sink gets
+ * it in the same frame, none reads it from the engine afterwards.
+ *
+ * Return values of every op: SC_OK; SC_ERR_STATE (call out of order: line or frame_end without
+ * a frame_begin, frame numbers that do not match); SC_ERR_INVALID_ARG (NULL, line_index >=
+ * lines, count != samples); SC_ERR_IO / SC_ERR_WOULD_BLOCK (the link refused data: counted as
+ * dropped lines, the frame goes on); SC_ERR_NOT_SUPPORTED (optional op absent).
  */
 #ifndef SC_HAL_DISPLAY_H
 #define SC_HAL_DISPLAY_H
@@ -31,6 +42,13 @@ enum {
     SC_DISPLAY_FLAG_FROZEN = 1u << 1,  /* image frozen (fault or reset) */
 };
 
+/* The closing record of a frame: what the frame's pass computed. */
+typedef struct sc_display_end_info {
+    uint32_t frame_no;       /* as in frame_begin */
+    float vein_area_ratio;   /* image area of the vein now / at rest, this frame; < 0: none */
+    float artery_area_ratio; /* the same for the artery */
+} sc_display_end_info;
+
 typedef struct sc_display_link_state {
     uint8_t up;            /* link usable */
     uint32_t lines_sent;   /* since start */
@@ -41,7 +59,7 @@ typedef struct sc_display_ops {
     int (*frame_begin)(void *ctx, const sc_display_frame_info *info);
     int (*line)(void *ctx, uint32_t frame_no, uint16_t line_index, const uint8_t *samples,
                 uint16_t count);
-    int (*frame_end)(void *ctx, uint32_t frame_no);
+    int (*frame_end)(void *ctx, const sc_display_end_info *end);
     int (*link_state)(void *ctx, sc_display_link_state *state);
 } sc_display_ops;
 
@@ -62,10 +80,16 @@ static inline int sc_display_line(const sc_display_dev *dev, uint32_t frame_no,
     return dev->ops->line(dev->ctx, frame_no, line_index, samples, count);
 }
 
-static inline int sc_display_frame_end(const sc_display_dev *dev, uint32_t frame_no)
+static inline int sc_display_frame_end(const sc_display_dev *dev, const sc_display_end_info *end)
 {
-    return dev->ops->frame_end(dev->ctx, frame_no);
+    return dev->ops->frame_end(dev->ctx, end);
 }
+
+/* The closing record of a frame that carries no measure (test patterns, tools): a pointer to
+ * a compound literal of the enclosing block. */
+#define SC_DISPLAY_END_PLAIN(fno)                                                             \
+    (&(const sc_display_end_info){                                                               \
+        .frame_no = (fno), .vein_area_ratio = -1.0f, .artery_area_ratio = -1.0f})
 
 static inline int sc_display_get_link_state(const sc_display_dev *dev,
                                             sc_display_link_state *st)

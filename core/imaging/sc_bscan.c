@@ -1142,6 +1142,23 @@ static int emit_line(sc_bscan *b, const sc_display_dev *disp, uint32_t frame_no,
     return rc;
 }
 
+/* The frame's closing record carries this frame's compression measure (status areas). */
+static int close_frame(sc_bscan *b, const sc_display_dev *disp, uint32_t frame_no, int rc)
+{
+    sc_bscan_status *st = &b->status;
+    const sc_display_end_info end = {
+        .frame_no = frame_no,
+        .vein_area_ratio = st->areas_valid ? st->area_ratio[SC_LABEL_VEIN] : -1.0f,
+        .artery_area_ratio = st->areas_valid ? st->area_ratio[SC_LABEL_ARTERY] : -1.0f,
+    };
+    const int re = sc_display_frame_end(disp, &end);
+    if (re != SC_OK) {
+        st->display_errors++;
+        return rc != SC_OK ? rc : re;
+    }
+    return rc;
+}
+
 int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, const sc_volume *volume,
                    const sc_xform *probe_to_volume, int contact, const sc_display_dev *display,
                    uint32_t frame_no)
@@ -1192,12 +1209,7 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
             st->area_rest_mm2[i] = 0.0f;
             st->area_ratio[i] = -1.0f;
         }
-        const int re = sc_display_frame_end(display, frame_no);
-        if (re != SC_OK) {
-            st->display_errors++;
-            rc = rc != SC_OK ? rc : re;
-        }
-        return rc;
+        return close_frame(b, display, frame_no, rc);
     }
 
     frame_ctx c;
@@ -1301,12 +1313,6 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
         sample_line(b, &vc, volume, &c, &acc);
         rc = emit_line(b, display, frame_no, l, rc);
     }
-    const int re = sc_display_frame_end(display, frame_no);
-    if (re != SC_OK) {
-        st->display_errors++;
-        rc = rc != SC_OK ? rc : re;
-    }
-
     /* areas: sum over pixels of the pixel area, from counts (exact integers) */
     const float a0 = b->geom.sample_area_mm2[0];
     const float a1 = n > 1u ? b->geom.sample_area_mm2[1] - a0 : 0.0f; /* per sample index */
@@ -1320,5 +1326,5 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
             st->area_rest_mm2[i] > 0.0f ? st->area_now_mm2[i] / st->area_rest_mm2[i] : -1.0f;
         st->image_area_mm2 += st->area_now_mm2[i];
     }
-    return rc;
+    return close_frame(b, display, frame_no, rc);
 }

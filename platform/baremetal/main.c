@@ -68,10 +68,10 @@ static int m7_line(void *ctx, uint32_t frame_no, uint16_t line, const uint8_t *s
     return SC_OK;
 }
 
-static int m7_end(void *ctx, uint32_t frame_no)
+static int m7_end(void *ctx, const sc_display_end_info *end)
 {
     (void)ctx;
-    (void)frame_no;
+    (void)end;
     return SC_OK;
 }
 

@@ -66,6 +66,11 @@ static float f32_from_bits(uint32_t u)
     return f;
 }
 
+static int compression_ok(uint16_t pm)
+{
+    return pm <= SC_DLINK_COMPRESSION_MAX || pm == SC_DLINK_COMPRESSION_UNKNOWN;
+}
+
 static int frame_fields_ok(const sc_dlink_frame *f)
 {
     return f->line_count >= 1u && f->line_count <= SC_MAX_SCAN_LINES && f->samples >= 1u &&
@@ -112,8 +117,7 @@ int sc_dlink_encode_begin(uint8_t *buf, size_t cap, const sc_dlink_frame *f,
     if (cap < SC_DLINK_HEADER_SIZE + SC_DLINK_BEGIN_PAYLOAD) {
         return SC_ERR_NO_SPACE;
     }
-    if (!frame_fields_ok(f) || (b->compression_pm > SC_DLINK_COMPRESSION_MAX &&
-                                b->compression_pm != SC_DLINK_COMPRESSION_UNKNOWN)) {
+    if (!frame_fields_ok(f)) {
         return SC_ERR_DLINK_FIELD;
     }
     if (!isfinite(b->depth_mm) || !isfinite(b->width_mm) || !isfinite(b->radius_mm)) {
@@ -127,8 +131,7 @@ int sc_dlink_encode_begin(uint8_t *buf, size_t cap, const sc_dlink_frame *f,
     put32(p + 0, f32_bits(b->depth_mm));
     put32(p + 4, f32_bits(b->width_mm));
     put32(p + 8, f32_bits(b->radius_mm));
-    put16(p + 12, b->compression_pm);
-    put16(p + 14, 0u);
+    put32(p + 12, 0u);
     return finish(buf, (uint16_t)SC_DLINK_BEGIN_PAYLOAD);
 }
 
@@ -157,14 +160,16 @@ int sc_dlink_encode_end(uint8_t *buf, size_t cap, const sc_dlink_frame *f, const
     if (cap < SC_DLINK_HEADER_SIZE + SC_DLINK_END_PAYLOAD) {
         return SC_ERR_NO_SPACE;
     }
-    if (!frame_fields_ok(f) || (uint32_t)e->lines_sent + e->lines_dropped > f->line_count) {
+    if (!frame_fields_ok(f) || (uint32_t)e->lines_sent + e->lines_dropped > f->line_count ||
+        !compression_ok(e->compression_pm) || !compression_ok(e->artery_compression_pm)) {
         return SC_ERR_DLINK_FIELD;
     }
     write_header(buf, f, SC_DLINK_FRAME_END, 0u, (uint16_t)SC_DLINK_END_PAYLOAD);
     uint8_t *p = buf + SC_DLINK_HEADER_SIZE;
     put16(p + 0, e->lines_sent);
     put16(p + 2, e->lines_dropped);
-    put32(p + 4, 0u);
+    put16(p + 4, e->compression_pm);
+    put16(p + 6, e->artery_compression_pm);
     return finish(buf, (uint16_t)SC_DLINK_END_PAYLOAD);
 }
 
@@ -232,14 +237,13 @@ int sc_dlink_decode(const uint8_t *pkt, size_t len, sc_dlink_header *h, const ui
         float depth = f32_from_bits(get32(pl + 0));
         float width = f32_from_bits(get32(pl + 4));
         float radius = f32_from_bits(get32(pl + 8));
-        uint16_t comp = get16(pl + 12);
         if (!isfinite(depth) || !isfinite(width) || !isfinite(radius) || radius < 0.0f ||
-            get16(pl + 14) != 0u ||
-            (comp > SC_DLINK_COMPRESSION_MAX && comp != SC_DLINK_COMPRESSION_UNKNOWN)) {
+            get32(pl + 12) != 0u) {
             return SC_ERR_DLINK_FIELD;
         }
     } else if (d.type == SC_DLINK_FRAME_END) {
-        if ((uint32_t)get16(pl + 0) + get16(pl + 2) > d.line_count || get32(pl + 4) != 0u) {
+        if ((uint32_t)get16(pl + 0) + get16(pl + 2) > d.line_count ||
+            !compression_ok(get16(pl + 4)) || !compression_ok(get16(pl + 6))) {
             return SC_ERR_DLINK_FIELD;
         }
     }
@@ -253,13 +257,23 @@ void sc_dlink_parse_begin(const uint8_t *payload, sc_dlink_begin *b)
     b->depth_mm = f32_from_bits(get32(payload + 0));
     b->width_mm = f32_from_bits(get32(payload + 4));
     b->radius_mm = f32_from_bits(get32(payload + 8));
-    b->compression_pm = get16(payload + 12);
 }
 
 void sc_dlink_parse_end(const uint8_t *payload, sc_dlink_end *e)
 {
     e->lines_sent = get16(payload + 0);
     e->lines_dropped = get16(payload + 2);
+    e->compression_pm = get16(payload + 4);
+    e->artery_compression_pm = get16(payload + 6);
+}
+
+uint16_t sc_dlink_compression_pm(float area_ratio)
+{
+    if (!(area_ratio >= 0.0f) || !isfinite(area_ratio)) {
+        return SC_DLINK_COMPRESSION_UNKNOWN;
+    }
+    const float c = 1000.0f * (1.0f - fminf(1.0f, area_ratio));
+    return (uint16_t)(c + 0.5f);
 }
 
 /* ---- assembler ------------------------------------------------------------------------- */
@@ -274,7 +288,8 @@ static int32_t frame_diff(uint32_t a, uint32_t b)
 void sc_dlink_asm_init(sc_dlink_asm *a)
 {
     memset(a, 0, sizeof *a);
-    a->begin.compression_pm = SC_DLINK_COMPRESSION_UNKNOWN;
+    a->end.compression_pm = SC_DLINK_COMPRESSION_UNKNOWN;
+    a->end.artery_compression_pm = SC_DLINK_COMPRESSION_UNKNOWN;
 }
 
 static void count_reject(sc_dlink_rx_stats *s, int rc)
@@ -330,6 +345,8 @@ static void close_frame(sc_dlink_asm *a, uint8_t end_seen)
     }
     a->done.frame = a->frame;
     a->done.begin = a->begin;
+    a->done.end = end_seen ? a->end : (sc_dlink_end){0u, 0u, SC_DLINK_COMPRESSION_UNKNOWN,
+                                                     SC_DLINK_COMPRESSION_UNKNOWN};
     a->done.lines_received = a->received;
     a->done.lines_lost = lost;
     a->done.begin_seen = a->begin_seen;
@@ -423,6 +440,7 @@ int sc_dlink_asm_push(sc_dlink_asm *a, const uint8_t *pkt, size_t len)
         sc_dlink_end e;
         sc_dlink_parse_end(pl, &e);
         a->stats.lines_sender_dropped += e.lines_dropped;
+        a->end = e;
         a->frame.flags = h.flags;
         close_frame(a, 1u);
         closed = 1;

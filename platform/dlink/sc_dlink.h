@@ -29,10 +29,10 @@
 #include "sc_config.h"
 
 #define SC_DLINK_MAGIC         0x4C444353u /* bytes 'S' 'C' 'D' 'L' on the wire (little-endian) */
-#define SC_DLINK_VERSION       1u
+#define SC_DLINK_VERSION       2u /* 2: the compression measure moved to FRAME_END */
 #define SC_DLINK_HEADER_SIZE   28u
-#define SC_DLINK_BEGIN_PAYLOAD 16u /* depth, width, radius f32; compression u16; rsvd u16 */
-#define SC_DLINK_END_PAYLOAD   8u  /* lines_sent u16, lines_dropped u16, reserved u32 */
+#define SC_DLINK_BEGIN_PAYLOAD 16u /* depth, width, radius f32; reserved u32 */
+#define SC_DLINK_END_PAYLOAD   8u  /* lines_sent, lines_dropped, vein and artery compression u16 */
 /* Largest packet: a line of SC_MAX_SCAN_SAMPLES samples (540 bytes with the default limits,
  * below the 1472-byte UDP payload of a 1500-byte Ethernet MTU, so no IP fragmentation). */
 #define SC_DLINK_MAX_PACKET (SC_DLINK_HEADER_SIZE + SC_MAX_SCAN_SAMPLES)
@@ -67,14 +67,22 @@ typedef struct sc_dlink_begin {
     float depth_mm;          /* imaging depth */
     float width_mm;          /* linear: aperture width; curvilinear: sector angle in degrees */
     float radius_mm;         /* curvilinear: probe face radius (apex behind the face); linear 0 */
-    uint16_t compression_pm; /* vessel compression measure, permille; or ..._UNKNOWN */
 } sc_dlink_begin;
 
-/* FRAME_END payload: what the sender did with this frame's lines. */
+/* FRAME_END payload: what the sender did with this frame's lines, and what the frame's own
+ * pass computed (the measure is known only once the last line is computed, so it closes the
+ * frame it belongs to). */
 typedef struct sc_dlink_end {
-    uint16_t lines_sent;    /* handed to the network */
-    uint16_t lines_dropped; /* dropped by the sender (socket full, over its time budget) */
+    uint16_t lines_sent;     /* handed to the network */
+    uint16_t lines_dropped;  /* dropped by the sender (socket full, over its time budget) */
+    uint16_t compression_pm; /* vein compression, 1000 (1 - area now / at rest), permille; or
+                              * ..._UNKNOWN */
+    uint16_t artery_compression_pm; /* the same for the artery */
 } sc_dlink_end;
+
+/* The compression measure in permille of an area ratio (now / at rest; < 0 or not finite:
+ * unknown): 1000 (1 - ratio), clamped to 0..1000. O(1). */
+uint16_t sc_dlink_compression_pm(float area_ratio);
 
 /* Frame parameters shared by the packets of one frame. */
 typedef struct sc_dlink_frame {
@@ -89,7 +97,7 @@ typedef struct sc_dlink_frame {
  * Encoders write one packet into buf (capacity cap) and return its length (> 0), or
  * SC_ERR_NO_SPACE when cap is too small, SC_ERR_DLINK_FIELD when a field is outside the wire
  * limits (line_count or samples 0 or above the SC_MAX_SCAN_* limits, line_index >= line_count,
- * geometry_id > 1, count != samples, compression above 1000 and not unknown, lines_sent +
+ * geometry_id > 1, count != samples, a compression above 1000 and not unknown, lines_sent +
  * lines_dropped above line_count, radius negative), SC_ERR_NOT_FINITE for a non-finite depth,
  * width or radius,
  * SC_ERR_INVALID_ARG for NULL pointers. O(header + payload), never allocates. */
@@ -138,6 +146,7 @@ typedef struct sc_dlink_rx_stats {
 typedef struct sc_dlink_done {
     sc_dlink_frame frame;
     sc_dlink_begin begin; /* from FRAME_BEGIN, or the previous frame's if it was lost */
+    sc_dlink_end end;     /* from FRAME_END; measures ..._UNKNOWN when it never came */
     uint16_t lines_received;
     uint16_t lines_lost;
     uint8_t begin_seen;
@@ -154,6 +163,7 @@ typedef struct sc_dlink_asm {
     uint8_t begin_seen;
     sc_dlink_frame frame;    /* open frame */
     sc_dlink_begin begin;    /* open frame's (or last known) begin payload */
+    sc_dlink_end end;        /* the FRAME_END payload that closes the open frame */
     uint16_t received;       /* lines of the open frame */
     uint32_t last_closed_no; /* frame number of the last closed frame */
     sc_dlink_done done;      /* last closed frame */

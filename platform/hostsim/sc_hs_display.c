@@ -53,14 +53,15 @@ static int hs_line(void *ctx, uint32_t frame_no, uint16_t line_index, const uint
     return SC_OK;
 }
 
-static int hs_end(void *ctx, uint32_t frame_no)
+static int hs_end(void *ctx, const sc_display_end_info *end)
 {
     sc_hs_display *d = ctx;
-    if (!d->in_frame || frame_no != d->info.frame_no) {
+    if (!end || !d->in_frame || end->frame_no != d->info.frame_no) {
         d->protocol_errors++;
         return SC_ERR_STATE;
     }
     d->in_frame = 0;
+    d->end = *end;
     if (d->lines_seen != d->info.lines) {
         d->frames_incomplete++;
         return SC_OK;
@@ -68,6 +69,7 @@ static int hs_end(void *ctx, uint32_t frame_no)
     const size_t n = (size_t)d->info.lines * d->info.samples;
     memcpy(d->last, d->image, n);
     d->last_info = d->info;
+    d->last_end = *end;
     if (d->hash_count < SC_HS_DISPLAY_HISTORY) {
         d->hashes[d->hash_count++] = sc_hs_hash64(d->image, n, 0);
     }

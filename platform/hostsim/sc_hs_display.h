@@ -3,7 +3,8 @@
  *
  * An sc_display_dev that assembles each frame from its lines into a fixed buffer, checks the
  * protocol (begin/line/end order, line indices in range, each line once, frame numbers) and
- * counts every violation; keeps the last complete frame and a hash (FNV-1a 64) of every frame
+ * counts every violation; keeps the last complete frame with its closing record (the frame's
+ * compression measure) and a hash (FNV-1a 64) of every frame
  * in a bounded history, so tests and the replay compare frames bit for bit. Storage is fixed at
  * compile time; nothing allocates.
  */
@@ -27,6 +28,8 @@ typedef struct sc_hs_display {
     uint8_t image[SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES]; /* line-major: [line][sample] */
     uint8_t last[SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES];  /* last complete frame */
     sc_display_frame_info last_info;
+    sc_display_end_info last_end;   /* closing record of the last complete frame */
+    sc_display_end_info end;        /* closing record of the last frame_end call */
     uint64_t frames_complete;
     uint64_t frames_incomplete;  /* ended with missing lines */
     uint64_t lines;

@@ -81,10 +81,10 @@ static int null_line(void *ctx, uint32_t f, uint16_t l, const uint8_t *s, uint16
     return 0;
 }
 
-static int null_end(void *ctx, uint32_t f)
+static int null_end(void *ctx, const sc_display_end_info *end)
 {
     (void)ctx;
-    (void)f;
+    (void)end;
     return 0;
 }
 
@@ -709,14 +709,6 @@ int main(int argc, char **argv)
                 break;
             }
             sc_engine_step(e, &fr);
-            if (udp_open) {
-                sc_engine_status st;
-                sc_engine_get_status(e, &st);
-                const float r = st.vein_area_ratio;
-                sc_udp_display_set_compression(
-                    &udp, r >= 0.0f ? (uint16_t)(1000.0f * fminf(1.0f, fmaxf(0.0f, 1.0f - r)))
-                                    : SC_DLINK_COMPRESSION_UNKNOWN);
-            }
             const uint64_t now = sc_rt_now_ns();
             if (now >= next_status) {
                 fps = (double)(e->sched.frames - frames_at_status) * 1e9 / (double)(now - t_status);

@@ -384,10 +384,10 @@ static int kms_line(void *ctx, uint32_t frame_no, uint16_t line_index, const uin
     return SC_OK;
 }
 
-static int kms_end(void *ctx, uint32_t frame_no)
+static int kms_end(void *ctx, const sc_display_end_info *end)
 {
     sc_kms_display *d = ctx;
-    if (!d->in_frame || frame_no != d->info.frame_no) {
+    if (!end || !d->in_frame || end->frame_no != d->info.frame_no) {
         d->stats.line_errors++;
         return SC_ERR_STATE;
     }

@@ -111,10 +111,10 @@ static int png_line(void *ctx, uint32_t frame_no, uint16_t line_index, const uin
     return 0;
 }
 
-static int png_frame_end(void *ctx, uint32_t frame_no)
+static int png_frame_end(void *ctx, const sc_display_end_info *end)
 {
     sc_png_sink *s = ctx;
-    if (!s->in_frame || frame_no != s->info.frame_no) {
+    if (!end || !s->in_frame || end->frame_no != s->info.frame_no) {
         count_protocol_error(s);
         return SC_ERR_STATE;
     }
@@ -131,7 +131,7 @@ static int png_frame_end(void *ctx, uint32_t frame_no)
     }
     int rc = 0;
     const int wanted =
-        (s->every_n <= 1u || frame_no % s->every_n == 0u) &&
+        (s->every_n <= 1u || end->frame_no % s->every_n == 0u) &&
         (s->max_frames == 0u || s->st.frames_written + (uint64_t)s->pending < s->max_frames);
     if (wanted) {
         if (s->pending) {

@@ -25,7 +25,6 @@ int sc_udp_display_open(sc_udp_display *u, const sc_udp_display_def *def)
 {
     memset(u, 0, sizeof *u);
     u->fd = -1;
-    u->compression_pm = SC_DLINK_COMPRESSION_UNKNOWN;
     if (!def || !def->host || def->port == 0u) {
         return SC_ERR_INVALID_ARG;
     }
@@ -179,7 +178,7 @@ static int udp_frame_begin(void *ctx, const sc_display_frame_info *info)
     u->frame_sent = 0;
     u->frame_dropped = 0;
     const sc_dlink_begin b = {info->depth_mm, info->width_mm,
-                              info->geometry_id == 1u ? info->radius_mm : 0.0f, u->compression_pm};
+                              info->geometry_id == 1u ? info->radius_mm : 0.0f};
     int len = sc_dlink_encode_begin(u->q_pkt[u->queued], SC_DLINK_MAX_PACKET, &u->frame, &b);
     if (len < 0) {
         u->protocol_errors++;
@@ -226,17 +225,20 @@ static int udp_line(void *ctx, uint32_t frame_no, uint16_t line_index, const uin
     return queue(u, SC_DLINK_LINE, len);
 }
 
-static int udp_frame_end(void *ctx, uint32_t frame_no)
+static int udp_frame_end(void *ctx, const sc_display_end_info *end)
 {
     sc_udp_display *u = ctx;
-    if (!u->in_frame || frame_no != u->frame.frame_no) {
+    if (!end || !u->in_frame || end->frame_no != u->frame.frame_no) {
         u->protocol_errors++;
         return SC_ERR_STATE;
     }
     u->in_frame = 0;
     /* The counts as they will be if the batch goes whole. There is room: between calls the
      * batch holds at most batch - 1 packets. */
-    const sc_dlink_end e = {(uint16_t)(u->frame_sent + u->q_lines), u->frame_dropped};
+    const uint16_t vein_pm = sc_dlink_compression_pm(end->vein_area_ratio);
+    const uint16_t artery_pm = sc_dlink_compression_pm(end->artery_area_ratio);
+    const sc_dlink_end e = {(uint16_t)(u->frame_sent + u->q_lines), u->frame_dropped, vein_pm,
+                            artery_pm};
     int len = sc_dlink_encode_end(u->q_pkt[u->queued], SC_DLINK_MAX_PACKET, &u->frame, &e);
     if (len < 0) {
         u->protocol_errors++;
@@ -251,7 +253,7 @@ static int udp_frame_end(void *ctx, uint32_t frame_no)
     /* FRAME_END, last in the batch, was not taken: the receiver wants the frame's drop count
      * most when there were drops, so send it once more alone, with the exact counts. That
      * send only counts: the batch already set the link state. */
-    const sc_dlink_end ex = {u->frame_sent, u->frame_dropped};
+    const sc_dlink_end ex = {u->frame_sent, u->frame_dropped, vein_pm, artery_pm};
     len = sc_dlink_encode_end(u->q_pkt[0], SC_DLINK_MAX_PACKET, &u->frame, &ex);
     if (len < 0) {
         u->protocol_errors++;
@@ -283,11 +285,6 @@ sc_display_dev sc_udp_display_dev(sc_udp_display *u)
 {
     sc_display_dev d = {&k_udp_ops, u};
     return d;
-}
-
-void sc_udp_display_set_compression(sc_udp_display *u, uint16_t compression_pm)
-{
-    u->compression_pm = compression_pm;
 }
 
 void sc_udp_display_close(sc_udp_display *u)

@@ -84,7 +84,6 @@ typedef struct sc_udp_display {
     sc_dlink_frame frame;
     uint16_t frame_sent;
     uint16_t frame_dropped;
-    uint16_t compression_pm; /* carried in FRAME_BEGIN */
     uint32_t inject_drop_permille;
     uint32_t rng;
     uint32_t batch;   /* packets per system call */
@@ -110,9 +109,6 @@ sc_udp_display_def sc_udp_display_default_def(void);
  * SC_ERR_RANGE (drop permille above 1000, batch above SC_UDP_DISPLAY_MAX_BATCH). */
 int sc_udp_display_open(sc_udp_display *u, const sc_udp_display_def *def);
 sc_display_dev sc_udp_display_dev(sc_udp_display *u);
-/* The vessels' compression measure (permille, or SC_DLINK_COMPRESSION_UNKNOWN) for the next
- * FRAME_BEGINs: hal frame info does not carry it. */
-void sc_udp_display_set_compression(sc_udp_display *u, uint16_t compression_pm);
 /* Close the socket. Lines still in the batch (a frame left open) are counted dropped, not sent. */
 void sc_udp_display_close(sc_udp_display *u);
 

@@ -43,8 +43,9 @@ size_t sc_fuzz_seed(uint32_t i, uint8_t *buf, size_t cap)
     }
     sc_dlink_frame f = {.frame_no = 7u + i, .flags = 0, .line_count = 4, .samples = 16,
                         .geometry_id = (uint16_t)(i & 1u)};
-    sc_dlink_begin b = {.depth_mm = 60.0f, .width_mm = 38.0f, .compression_pm = 500};
-    sc_dlink_end e = {.lines_sent = 4, .lines_dropped = 0};
+    sc_dlink_begin b = {.depth_mm = 60.0f, .width_mm = 38.0f};
+    sc_dlink_end e = {.lines_sent = 4, .lines_dropped = 0, .compression_pm = 500,
+                      .artery_compression_pm = SC_DLINK_COMPRESSION_UNKNOWN};
     uint8_t pkt[1024], line[16];
     size_t n = 0;
     for (int p = -1; p <= 4; p++) {

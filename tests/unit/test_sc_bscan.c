@@ -413,6 +413,7 @@ typedef struct rec_display {
     uint32_t next_line;
     int order_ok;
     sc_display_frame_info info;
+    sc_display_end_info end;
 } rec_display;
 
 static int rec_begin(void *ctx, const sc_display_frame_info *info)
@@ -436,11 +437,12 @@ static int rec_line(void *ctx, uint32_t frame_no, uint16_t line, const uint8_t *
     return (int)line == r->fail_line ? SC_ERR_IO : SC_OK;
 }
 
-static int rec_end(void *ctx, uint32_t frame_no)
+static int rec_end(void *ctx, const sc_display_end_info *end)
 {
     rec_display *r = ctx;
     r->ends++;
-    r->frame_no = frame_no;
+    r->frame_no = end->frame_no;
+    r->end = *end;
     return SC_OK;
 }
 
@@ -468,6 +470,18 @@ static void lines_stream_in_order_between_begin_and_end_with_frame_number(void *
     assert_int_equal(rec.info.geometry_id, SC_SCAN_GEOM_LINEAR);
     assert_true(fabsf(rec.info.depth_mm - 60.0f) < 1e-6f &&
                 fabsf(rec.info.width_mm - 38.0f) < 1e-6f);
+    /* the frame's own compression measure closes it: the same numbers as its status */
+    assert_int_equal(rec.end.frame_no, 4242u);
+    assert_int_equal(g_b.status.areas_valid, 1);
+    assert_memory_equal(&rec.end.vein_area_ratio, &g_b.status.area_ratio[SC_LABEL_VEIN],
+                        sizeof(float));
+    assert_memory_equal(&rec.end.artery_area_ratio, &g_b.status.area_ratio[SC_LABEL_ARTERY],
+                        sizeof(float));
+    assert_true(rec.end.vein_area_ratio > 0.9f);
+    /* without contact there is no measure */
+    assert_int_equal(sc_bscan_frame(&g_b, &g_mesh, &g_nodes, &g_vol.v, &probe, 0, &dev, 4243u),
+                     SC_OK);
+    assert_true(rec.end.vein_area_ratio < 0.0f && rec.end.artery_area_ratio < 0.0f);
     /* a failing display line is counted and reported, the frame still completes */
     rec = (rec_display){.order_ok = 1, .fail_line = 17};
     assert_int_equal(sc_bscan_frame(&g_b, &g_mesh, &g_nodes, &g_vol.v, &probe, 1, &dev, 5u),

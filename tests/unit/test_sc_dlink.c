@@ -40,7 +40,7 @@ static void round_trip_preserves_every_field_of_all_three_packet_types(void **st
     const uint8_t *pl;
 
     const sc_dlink_begin b = {
-        .depth_mm = 47.5f, .width_mm = 60.25f, .radius_mm = 40.0f, .compression_pm = 734u};
+        .depth_mm = 47.5f, .width_mm = 60.25f, .radius_mm = 40.0f};
     int n = sc_dlink_encode_begin(buf, sizeof buf, &k_frame, &b);
     assert_int_equal(n, SC_DLINK_HEADER_SIZE + SC_DLINK_BEGIN_PAYLOAD);
     assert_int_equal(sc_dlink_decode(buf, (size_t)n, &h, &pl), 0);
@@ -56,7 +56,6 @@ static void round_trip_preserves_every_field_of_all_three_packet_types(void **st
     assert_memory_equal(&b2.depth_mm, &b.depth_mm, sizeof(float)); /* bit-exact */
     assert_memory_equal(&b2.width_mm, &b.width_mm, sizeof(float));
     assert_memory_equal(&b2.radius_mm, &b.radius_mm, sizeof(float));
-    assert_int_equal(b2.compression_pm, 734u);
 
     n = sc_dlink_encode_line(buf, sizeof buf, &k_frame, 127u, samples, 200u);
     assert_int_equal(n, SC_DLINK_HEADER_SIZE + 200);
@@ -66,7 +65,8 @@ static void round_trip_preserves_every_field_of_all_three_packet_types(void **st
     assert_int_equal(h.payload_len, 200u);
     assert_memory_equal(pl, samples, 200u);
 
-    const sc_dlink_end e = {.lines_sent = 120u, .lines_dropped = 8u};
+    const sc_dlink_end e = {.lines_sent = 120u, .lines_dropped = 8u, .compression_pm = 734u,
+                            .artery_compression_pm = SC_DLINK_COMPRESSION_UNKNOWN};
     n = sc_dlink_encode_end(buf, sizeof buf, &k_frame, &e);
     assert_int_equal(n, SC_DLINK_HEADER_SIZE + SC_DLINK_END_PAYLOAD);
     assert_int_equal(sc_dlink_decode(buf, (size_t)n, &h, &pl), 0);
@@ -75,6 +75,19 @@ static void round_trip_preserves_every_field_of_all_three_packet_types(void **st
     sc_dlink_parse_end(pl, &e2);
     assert_int_equal(e2.lines_sent, 120u);
     assert_int_equal(e2.lines_dropped, 8u);
+    assert_int_equal(e2.compression_pm, 734u);
+    assert_int_equal(e2.artery_compression_pm, SC_DLINK_COMPRESSION_UNKNOWN);
+}
+
+static void compression_measure_is_permille_of_the_area_lost(void **state)
+{
+    (void)state;
+    assert_int_equal(sc_dlink_compression_pm(1.0f), 0u);
+    assert_int_equal(sc_dlink_compression_pm(0.25f), 750u);
+    assert_int_equal(sc_dlink_compression_pm(0.0f), 1000u);
+    assert_int_equal(sc_dlink_compression_pm(1.4f), 0u); /* a vessel pushed into view */
+    assert_int_equal(sc_dlink_compression_pm(-1.0f), SC_DLINK_COMPRESSION_UNKNOWN);
+    assert_int_equal(sc_dlink_compression_pm(NAN), SC_DLINK_COMPRESSION_UNKNOWN);
 }
 
 static void wire_bytes_match_the_documented_layout(void **state)
@@ -89,7 +102,7 @@ static void wire_bytes_match_the_documented_layout(void **state)
                               .geometry_id = 0u};
     int n = sc_dlink_encode_line(buf, sizeof buf, &f, 5u, s, 4u);
     assert_int_equal(n, 32);
-    const uint8_t expect[24] = {'S', 'C', 'D', 'L', 1, 2, 0x01, 0x02, 0xD4, 0xC3, 0xB2, 0xA1,
+    const uint8_t expect[24] = {'S', 'C', 'D', 'L', 2, 2, 0x01, 0x02, 0xD4, 0xC3, 0xB2, 0xA1,
                                 5,   0,   9,   0,   4, 0, 0,    0,    4,    0,    0,    0};
     assert_memory_equal(buf, expect, 24u);
     assert_memory_equal(buf + 28, s, 4u);
@@ -209,7 +222,7 @@ static void begin_and_end_payload_fields_are_range_checked(void **state)
     sc_dlink_header h;
     const uint8_t *pl;
     const sc_dlink_begin b = {
-        .depth_mm = 40.0f, .width_mm = 38.0f, .radius_mm = 0.0f, .compression_pm = 0u};
+        .depth_mm = 40.0f, .width_mm = 38.0f, .radius_mm = 0.0f};
     int n = sc_dlink_encode_begin(pkt, sizeof pkt, &k_frame, &b);
     size_t len = (size_t)n;
     /* depth = NaN (0x7FC00000) */
@@ -266,20 +279,21 @@ static void encoders_refuse_out_of_range_fields_and_small_buffers(void **state)
     assert_int_equal(sc_dlink_encode_line(buf, sizeof buf, &f, 0u, s, 200u), SC_ERR_DLINK_FIELD);
     f = k_frame;
     f.line_count = (uint16_t)(SC_MAX_SCAN_LINES + 1u);
-    const sc_dlink_begin ok_b = {40.0f, 38.0f, 0.0f, SC_DLINK_COMPRESSION_UNKNOWN};
+    const sc_dlink_begin ok_b = {40.0f, 38.0f, 0.0f};
     assert_int_equal(sc_dlink_encode_begin(buf, sizeof buf, &f, &ok_b), SC_ERR_DLINK_FIELD);
     f = k_frame;
-    sc_dlink_begin bad_b = {INFINITY, 38.0f, 0.0f, 0u};
+    sc_dlink_begin bad_b = {INFINITY, 38.0f, 0.0f};
     assert_int_equal(sc_dlink_encode_begin(buf, sizeof buf, &f, &bad_b), SC_ERR_NOT_FINITE);
     bad_b.depth_mm = 40.0f;
-    bad_b.compression_pm = 1001u;
-    assert_int_equal(sc_dlink_encode_begin(buf, sizeof buf, &f, &bad_b), SC_ERR_DLINK_FIELD);
-    bad_b.compression_pm = 0u;
     bad_b.radius_mm = -1.0f;
     assert_int_equal(sc_dlink_encode_begin(buf, sizeof buf, &f, &bad_b), SC_ERR_DLINK_FIELD);
     assert_int_equal(sc_dlink_encode_begin(buf, 43u, &f, &ok_b), SC_ERR_NO_SPACE);
-    const sc_dlink_end bad_e = {100u, 29u};
+    const sc_dlink_end bad_e = {100u, 29u, 0u, 0u};
     assert_int_equal(sc_dlink_encode_end(buf, sizeof buf, &f, &bad_e), SC_ERR_DLINK_FIELD);
+    const sc_dlink_end bad_c = {100u, 0u, 1001u, 0u};
+    assert_int_equal(sc_dlink_encode_end(buf, sizeof buf, &f, &bad_c), SC_ERR_DLINK_FIELD);
+    const sc_dlink_end bad_a = {100u, 0u, 0u, 1001u};
+    assert_int_equal(sc_dlink_encode_end(buf, sizeof buf, &f, &bad_a), SC_ERR_DLINK_FIELD);
 }
 
 /* ---- assembler -------------------------------------------------------------------------- */
@@ -293,7 +307,7 @@ typedef struct sender {
 
 static int push_begin(sender *s)
 {
-    const sc_dlink_begin b = {40.0f, 38.0f, 0.0f, 500u};
+    const sc_dlink_begin b = {40.0f, 38.0f, 0.0f};
     int n = sc_dlink_encode_begin(s->buf, sizeof s->buf, &s->f, &b);
     assert_true(n > 0);
     return sc_dlink_asm_push(&g_asm, s->buf, (size_t)n);
@@ -310,7 +324,7 @@ static int push_line(sender *s, uint16_t i)
 
 static int push_end(sender *s, uint16_t sent)
 {
-    const sc_dlink_end e = {sent, 0u};
+    const sc_dlink_end e = {sent, 0u, 500u, 0u};
     int n = sc_dlink_encode_end(s->buf, sizeof s->buf, &s->f, &e);
     assert_true(n > 0);
     return sc_dlink_asm_push(&g_asm, s->buf, (size_t)n);
@@ -344,7 +358,8 @@ static void complete_frames_assemble_without_loss(void **state)
         assert_int_equal(d->lines_received, 64u);
         assert_int_equal(d->lines_lost, 0u);
         assert_true(d->begin_seen && d->end_seen);
-        assert_int_equal(d->begin.compression_pm, 500u);
+        assert_int_equal(d->end.compression_pm, 500u);
+        assert_int_equal(d->end.artery_compression_pm, 0u);
         for (uint16_t i = 0; i < 64u; i++) {
             assert_true(row_is(d->image, i, 100u, fr * 1000u + i));
         }
@@ -492,6 +507,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(round_trip_preserves_every_field_of_all_three_packet_types),
         cmocka_unit_test(wire_bytes_match_the_documented_layout),
+        cmocka_unit_test(compression_measure_is_permille_of_the_area_lost),
         cmocka_unit_test(every_single_bit_flip_is_rejected_with_its_named_error),
         cmocka_unit_test(truncated_and_extended_datagrams_are_length_errors),
         cmocka_unit_test(valid_crc_with_bad_type_or_fields_is_still_rejected),

@@ -24,7 +24,7 @@ static void send_frame(sc_display_dev *d, uint32_t no, uint16_t lines, int skip_
         memset(s, (int)(l * 3u), sizeof s);
         assert_int_equal(sc_display_line(d, no, l, s, 64u), 0);
     }
-    (void)sc_display_frame_end(d, no);
+    (void)sc_display_frame_end(d, SC_DISPLAY_END_PLAIN(no));
 }
 
 static uint64_t wait_written(sc_png_sink *s, uint64_t n)
@@ -121,7 +121,7 @@ static void protocol_violations_are_refused(void **state)
     assert_int_equal(sc_display_frame_begin(&d, &ok), 0);
     assert_int_equal(sc_display_line(&d, 1u, 4u, smp, 8u), SC_ERR_STATE);
     assert_int_equal(sc_display_line(&d, 1u, 0u, smp, 7u), SC_ERR_STATE);
-    assert_int_equal(sc_display_frame_end(&d, 2u), SC_ERR_STATE);
+    assert_int_equal(sc_display_frame_end(&d, SC_DISPLAY_END_PLAIN(2u)), SC_ERR_STATE);
     sc_png_sink_stats st;
     sc_png_sink_get_stats(s, &st);
     assert_int_equal(st.protocol_errors, 5u);

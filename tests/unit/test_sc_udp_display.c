@@ -67,7 +67,7 @@ static void send_frame(sc_display_dev *dev, uint32_t frame_no, uint16_t lines, u
         memset(s, (int)((frame_no + l) & 0xFFu), samples);
         (void)sc_display_line(dev, frame_no, l, s, samples);
     }
-    (void)sc_display_frame_end(dev, frame_no);
+    (void)sc_display_frame_end(dev, SC_DISPLAY_END_PLAIN(frame_no));
 }
 
 static void loopback_without_injection_loses_no_line(void **state)
@@ -167,7 +167,7 @@ static void calls_out_of_order_are_refused_and_counted(void **state)
     sc_display_dev dev = sc_udp_display_dev(&u);
     uint8_t s[16] = {0};
     assert_int_equal(sc_display_line(&dev, 1u, 0u, s, 16u), SC_ERR_STATE);
-    assert_int_equal(sc_display_frame_end(&dev, 1u), SC_ERR_STATE);
+    assert_int_equal(sc_display_frame_end(&dev, SC_DISPLAY_END_PLAIN(1u)), SC_ERR_STATE);
     const sc_display_frame_info info = {1u, 4u, 16u, 0u, 0u, 40.0f, 38.0f, 0.0f};
     assert_int_equal(sc_display_frame_begin(&dev, &info), 0);
     assert_int_equal(sc_display_line(&dev, 1u, 4u, s, 16u), SC_ERR_DLINK_FIELD);
@@ -396,7 +396,7 @@ static void frame_end_is_tried_once_more_alone_when_its_batch_did_not_all_go(voi
     for (uint16_t l = 0; l < 40u; l++) {
         assert_int_equal(sc_display_line(&dev, 9u, l, s, 64u), 0); /* all queued (batch 64) */
     }
-    assert_int_equal(sc_display_frame_end(&dev, 9u), SC_ERR_IO); /* part of the batch taken */
+    assert_int_equal(sc_display_frame_end(&dev, SC_DISPLAY_END_PLAIN(9u)), SC_ERR_IO); /* part of the batch taken */
     assert_false(u.up);
     assert_int_equal(u.send_calls, 2u);
     const uint32_t got = read_all(sv[1], g_pkts, 4096u);
@@ -438,7 +438,7 @@ static void refused_destination_takes_the_link_down_until_a_receiver_appears(voi
     for (uint16_t l = 0; l < 40u; l++) {
         assert_int_equal(sc_display_line(&dev, 0u, l, s, 64u), 0);
     }
-    assert_int_equal(sc_display_frame_end(&dev, 0u), SC_ERR_IO);
+    assert_int_equal(sc_display_frame_end(&dev, SC_DISPLAY_END_PLAIN(0u)), SC_ERR_IO);
     assert_false(u.up);
     assert_int_equal(u.send_calls, 2u);
     assert_int_equal(u.packets_sent, 2u);

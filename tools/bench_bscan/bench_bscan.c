@@ -46,10 +46,10 @@ static int kd_line(void *ctx, uint32_t frame_no, uint16_t line, const uint8_t *s
     return SC_OK;
 }
 
-static int kd_end(void *ctx, uint32_t frame_no)
+static int kd_end(void *ctx, const sc_display_end_info *end)
 {
     (void)ctx;
-    (void)frame_no;
+    (void)end;
     return SC_OK;
 }
 

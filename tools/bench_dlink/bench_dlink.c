@@ -285,7 +285,7 @@ int main(int argc, char **argv)
             for (unsigned l = 0; l < lines; l++) {
                 (void)sc_display_line(&dev, f, (uint16_t)l, line_buf[l], (uint16_t)samples);
             }
-            (void)sc_display_frame_end(&dev, f);
+            (void)sc_display_frame_end(&dev, SC_DISPLAY_END_PLAIN(f));
             const uint64_t w1 = now_ns(CLOCK_MONOTONIC), c1 = now_ns(CLOCK_THREAD_CPUTIME_ID);
             if (f >= warmup) {
                 g_cpu[f - warmup] = c1 - c0;

@@ -157,7 +157,6 @@ int main(int argc, char **argv)
         /* compression: 0 .. 1 .. 0 over 2 s */
         const double t = (double)f / rate;
         const float comp = (float)(0.5 - 0.5 * cos(t * M_PI));
-        sc_udp_display_set_compression(&u, (uint16_t)(comp * 1000.0f + 0.5f));
         const sc_display_frame_info info = {(uint32_t)f,
                                             (uint16_t)lines,
                                             (uint16_t)samples,
@@ -177,7 +176,9 @@ int main(int argc, char **argv)
                 worst_line_ns = dt;
             }
         }
-        sc_display_frame_end(&dev, (uint32_t)f);
+        /* the frame's measure closes it, as the engine's does */
+        const sc_display_end_info end = {(uint32_t)f, 1.0f - comp, 1.0f};
+        sc_display_frame_end(&dev, &end);
         release += period;
         if (sc_clock_now_ns(&clk) > release) {
             late_frames++;

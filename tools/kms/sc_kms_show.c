@@ -124,7 +124,7 @@ static int show(const char *path, int use_fbdev, int hold_s)
         rc = sc_display_line(&dev, 1, l, f.data + (size_t)l * f.info.samples, f.info.samples);
     }
     if (rc == SC_OK) {
-        rc = sc_display_frame_end(&dev, 1);
+        rc = sc_display_frame_end(&dev, SC_DISPLAY_END_PLAIN(1));
     }
     if (rc == SC_OK) {
         rc = sc_kms_wait_flip(d, 2000);

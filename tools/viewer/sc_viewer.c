@@ -241,9 +241,9 @@ static void render_frame(vw_render *r, const sc_dlink_done *d, double fps, uint6
     const int contact = (d->frame.flags & 1u) != 0;
     x = vw_text(r->index, r->w, r->h, 4, 2 + lh, sc, contact ? VW_COL_OK : VW_COL_BAD,
                 contact ? "CONTACT" : "NO CONTACT");
-    if (d->begin.compression_pm <= 1000u) {
+    if (d->end.compression_pm <= 1000u) {
         snprintf(t, sizeof t, "  VEIN COMPRESSION %u%%",
-                 (unsigned)(d->begin.compression_pm + 5u) / 10u);
+                 (unsigned)(d->end.compression_pm + 5u) / 10u);
     } else {
         snprintf(t, sizeof t, "  VEIN COMPRESSION --");
     }
