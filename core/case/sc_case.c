@@ -338,9 +338,11 @@ static int tag_index(uint32_t tag)
     }
 }
 
-/* Walk the sections: framing, CRCs, padding, presence. */
+/* Walk the sections: framing, CRCs, padding, presence. With chk == NULL every payload CRC is
+ * checked here; otherwise only the headers are, and every section's payload and expected CRC
+ * is recorded in chk for sc_case_check_step(). */
 static int load_sections(const uint8_t *bytes, size_t size, section_ref sec[SC_CASE_SECTION_COUNT],
-                         uint32_t *case_id)
+                         uint32_t *case_id, sc_case_check *chk)
 {
     if (size < SC_CASE_MAGIC_LEN) {
         return SC_ERR_CASE_TRUNCATED;
@@ -372,8 +374,11 @@ static int load_sections(const uint8_t *bytes, size_t size, section_ref sec[SC_C
         return SC_ERR_CASE_SIZE; /* trailing bytes after the last section, or odd size */
     }
     const uint32_t count = rd_u32(bytes + HDR_SECTION_COUNT);
-    if (count < SC_CASE_SECTION_COUNT || count > 64u) {
+    if (count < SC_CASE_SECTION_COUNT || count > SC_CASE_MAX_SECTIONS) {
         return SC_ERR_CASE_SECTION;
+    }
+    if (chk != NULL) {
+        chk->sec_count = count;
     }
     for (unsigned s = 0; s < SC_CASE_SECTION_COUNT; s++) {
         sec[s].p = NULL;
@@ -401,7 +406,11 @@ static int load_sections(const uint8_t *bytes, size_t size, section_ref sec[SC_C
             return SC_ERR_CASE_TRUNCATED;
         }
         const uint8_t *p = h + SC_CASE_SECTION_HEADER_SIZE;
-        if (rd_u32(h + SEC_CRC) != sc_crc32(p, (size_t)psize)) {
+        if (chk != NULL) {
+            chk->sec_off[i] = off + SC_CASE_SECTION_HEADER_SIZE;
+            chk->sec_size[i] = psize;
+            chk->sec_crc[i] = rd_u32(h + SEC_CRC);
+        } else if (rd_u32(h + SEC_CRC) != sc_crc32(p, (size_t)psize)) {
             return SC_ERR_CASE_CRC;
         }
         /* padding up to the next 64-byte boundary: present and zero */
@@ -441,17 +450,22 @@ static int material_ok(const sc_case_material *m)
            m->poisson < 0.5f && isfinite(m->density_kg_m3) && m->density_kg_m3 > 0.0f;
 }
 
-int sc_case_load(const uint8_t *bytes, size_t size, sc_case *out)
+static uint8_t label_max(const uint8_t *lab, uint64_t n)
 {
-    if (bytes == NULL || out == NULL) {
-        return SC_ERR_INVALID_ARG;
+    /* one pass, max reduction (branch-free inner loop) */
+    uint8_t maxl = 0;
+    for (uint64_t i = 0; i < n; i++) {
+        maxl = lab[i] > maxl ? lab[i] : maxl;
     }
-    section_ref sec[SC_CASE_SECTION_COUNT];
-    uint32_t case_id = 0;
-    int rc = load_sections(bytes, size, sec, &case_id);
-    if (rc != SC_OK) {
-        return rc;
-    }
+    return maxl;
+}
+
+/* The semantic checks over framed sections whose payload CRCs are verified. max_label < 0:
+ * the label pass runs here (O(voxels)); else it was done by the caller. */
+static int parse_case(const section_ref sec[SC_CASE_SECTION_COUNT], uint32_t case_id,
+                      int max_label, sc_case *out)
+{
+    int rc;
     sc_case c;
     memset(&c, 0, sizeof c);
 
@@ -535,14 +549,11 @@ int sc_case_load(const uint8_t *bytes, size_t size, sc_case *out)
             return SC_ERR_CASE_MATERIAL;
         }
     }
-    /* every label inside the table: one pass, max reduction (branch-free inner loop) */
+    /* every label inside the table */
     {
-        uint8_t maxl = 0;
-        const uint8_t *lab = c.volume.labels;
-        for (uint64_t i = 0; i < c.voxel_count; i++) {
-            maxl = lab[i] > maxl ? lab[i] : maxl;
-        }
-        if ((uint32_t)maxl >= c.material_count) {
+        const uint32_t maxl = max_label >= 0 ? (uint32_t)max_label
+                                             : label_max(c.volume.labels, c.voxel_count);
+        if (maxl >= c.material_count) {
             return SC_ERR_CASE_LABEL;
         }
     }
@@ -597,6 +608,107 @@ int sc_case_load(const uint8_t *bytes, size_t size, sc_case *out)
     c.case_id = case_id;
     *out = c;
     return SC_OK;
+}
+
+int sc_case_load(const uint8_t *bytes, size_t size, sc_case *out)
+{
+    if (bytes == NULL || out == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    section_ref sec[SC_CASE_SECTION_COUNT];
+    uint32_t case_id = 0;
+    const int rc = load_sections(bytes, size, sec, &case_id, NULL);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    return parse_case(sec, case_id, -1, out);
+}
+
+/* ---- the same validation in slices ------------------------------------------------------- */
+
+int sc_case_check_begin(sc_case_check *k, const uint8_t *bytes, size_t size)
+{
+    if (k == NULL || bytes == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    memset(k, 0, sizeof *k);
+    k->bytes = bytes;
+    k->size = size;
+    section_ref sec[SC_CASE_SECTION_COUNT];
+    const int rc = load_sections(bytes, size, sec, &k->case_id, k);
+    if (rc != SC_OK) {
+        k->state = rc;
+        return rc;
+    }
+    for (unsigned s = 0; s < SC_CASE_SECTION_COUNT; s++) {
+        k->known_p[s] = sec[s].p;
+        k->known_size[s] = sec[s].size;
+    }
+    k->labels = sec[3].p;
+    k->label_count = sec[3].size;
+    k->crc = SC_CRC32_INIT;
+    return SC_OK;
+}
+
+int sc_case_check_step(sc_case_check *k, size_t budget_bytes)
+{
+    if (k == NULL || k->bytes == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    if (k->state != 0) {
+        return k->state; /* finished (1) or failed (< 0): sticky */
+    }
+    size_t left = budget_bytes > 0u ? budget_bytes : 1u;
+    /* payload CRCs, section by section */
+    while (k->sec_index < k->sec_count && left > 0u) {
+        const uint64_t n_sec = k->sec_size[k->sec_index];
+        const uint64_t todo = n_sec - k->sec_done;
+        const size_t n = todo < (uint64_t)left ? (size_t)todo : left;
+        k->crc = sc_crc32_update(k->crc, k->bytes + k->sec_off[k->sec_index] + k->sec_done, n);
+        k->sec_done += n;
+        left -= n;
+        if (k->sec_done == n_sec) {
+            if (sc_crc32_final(k->crc) != k->sec_crc[k->sec_index]) {
+                k->state = SC_ERR_CASE_CRC;
+                return k->state;
+            }
+            k->sec_index++;
+            k->sec_done = 0u;
+            k->crc = SC_CRC32_INIT;
+        }
+    }
+    /* then the label pass */
+    while (k->sec_index == k->sec_count && k->label_done < k->label_count && left > 0u) {
+        const uint64_t todo = k->label_count - k->label_done;
+        const size_t n = todo < (uint64_t)left ? (size_t)todo : left;
+        const uint8_t m = label_max(k->labels + k->label_done, n);
+        k->label_max = m > k->label_max ? m : k->label_max;
+        k->label_done += n;
+        left -= n;
+    }
+    if (k->sec_index == k->sec_count && k->label_done == k->label_count) {
+        k->state = 1;
+    }
+    return k->state;
+}
+
+int sc_case_check_finish(const sc_case_check *k, sc_case *out)
+{
+    if (k == NULL || out == NULL || k->bytes == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    if (k->state < 0) {
+        return k->state;
+    }
+    if (k->state != 1) {
+        return SC_ERR_STATE;
+    }
+    section_ref sec[SC_CASE_SECTION_COUNT];
+    for (unsigned s = 0; s < SC_CASE_SECTION_COUNT; s++) {
+        sec[s].p = k->known_p[s];
+        sec[s].size = k->known_size[s];
+    }
+    return parse_case(sec, k->case_id, (int)k->label_max, out);
 }
 
 void sc_case_label_histogram(const sc_case *c, uint64_t counts[SC_MAX_LABELS])

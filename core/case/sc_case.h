@@ -141,6 +141,49 @@ int sc_case_write(const sc_case_def *def, uint8_t *buf, size_t cap, size_t *out_
  * SC_ERR_CASE_MESH_NODES, SC_ERR_CASE_MESH_BOX. */
 int sc_case_load(const uint8_t *bytes, size_t size, sc_case *out);
 
+/* ---- the same validation in bounded slices (a case switch while another case runs) --------
+ * sc_case_check_begin() checks the framing (file header, every section header and its CRC,
+ * sizes, padding, presence; O(sections), the payloads are not read); each
+ * sc_case_check_step() then CRCs at most budget_bytes of payload (in file order) and, after the
+ * last CRC, runs the label pass over at most the rest of the budget; sc_case_check_finish()
+ * runs the remaining semantic checks (O(materials), no pass over the volume) and fills *out.
+ * The three together accept exactly the files sc_case_load() accepts and fill the same view
+ * (tests/unit/test_sc_case.c); the error of a file with several faults may differ (framing
+ * faults are found before payload CRC faults). Never allocates; the check holds pointers into
+ * bytes, which must stay mapped until finish. */
+#ifndef SC_CASE_MAX_SECTIONS
+#define SC_CASE_MAX_SECTIONS 64u /* sections a file may declare (7 known + unknown ones) */
+#endif
+
+typedef struct sc_case_check {
+    const uint8_t *bytes;
+    size_t size;
+    int state;            /* 0 running, 1 every byte checked, < 0 the sc_err that refused it */
+    uint32_t case_id;
+    uint32_t sec_count;   /* sections declared */
+    uint32_t sec_index;   /* section whose payload CRC is running */
+    uint64_t sec_done;    /* bytes of it CRC'd */
+    uint32_t crc;         /* running CRC of that payload */
+    uint64_t sec_off[SC_CASE_MAX_SECTIONS]; /* payload offset, size and stored CRC, file order */
+    uint64_t sec_size[SC_CASE_MAX_SECTIONS];
+    uint32_t sec_crc[SC_CASE_MAX_SECTIONS];
+    const uint8_t *known_p[SC_CASE_SECTION_COUNT]; /* the known sections, by tag index */
+    uint64_t known_size[SC_CASE_SECTION_COUNT];
+    const uint8_t *labels; /* LABL payload and the label pass's progress */
+    uint64_t label_count;
+    uint64_t label_done;
+    uint8_t label_max;
+} sc_case_check;
+
+/* O(sections). Errors: SC_ERR_INVALID_ARG and the framing errors of sc_case_load. */
+int sc_case_check_begin(sc_case_check *k, const uint8_t *bytes, size_t size);
+/* O(budget_bytes) (a budget of 0 counts as 1). Returns 0 (more to do), 1 (every byte
+ * checked), or the sticky error (SC_ERR_CASE_CRC, SC_ERR_INVALID_ARG, a begin error). */
+int sc_case_check_step(sc_case_check *k, size_t budget_bytes);
+/* O(materials). Fills *out only when valid. Errors: SC_ERR_STATE (steps not finished), the
+ * sticky error, and every semantic error of sc_case_load. */
+int sc_case_check_finish(const sc_case_check *k, sc_case *out);
+
 /* The running case and the storage mapping that backs it. Zero-initialise (or
  * sc_case_slot_init) before first use. */
 typedef struct sc_case_slot {

@@ -323,6 +323,67 @@ static void labels_outside_the_material_table_are_refused(void **state)
     assert_int_equal(sc_case_load(g_buf, n, &c), SC_ERR_CASE_LABEL);
 }
 
+/* The sliced validation, run to the end with a budget per step; the steps it took in *steps. */
+static int check_sliced(const uint8_t *b, size_t n, size_t budget, sc_case *out, uint32_t *steps)
+{
+    sc_case_check k;
+    int rc = sc_case_check_begin(&k, b, n);
+    *steps = 0;
+    while (rc == 0) {
+        rc = sc_case_check_step(&k, budget);
+        (*steps)++;
+    }
+    if (rc < 0) {
+        assert_int_equal(sc_case_check_step(&k, budget), rc); /* sticky */
+        return rc;
+    }
+    return sc_case_check_finish(&k, out);
+}
+
+static void sliced_check_accepts_exactly_what_load_accepts_and_fills_the_same_view(void **state)
+{
+    (void)state;
+    sc_case_def d = make_def();
+    const size_t n = write_def(&d, g_buf);
+    sc_case whole, sliced;
+    assert_int_equal(sc_case_load(g_buf, n, &whole), SC_OK);
+    const size_t budgets[] = {1u, 7u, 4096u, 1u << 30};
+    for (size_t i = 0; i < sizeof budgets / sizeof budgets[0]; i++) {
+        uint32_t steps = 0;
+        memset(&sliced, 0xA5, sizeof sliced);
+        assert_int_equal(check_sliced(g_buf, n, budgets[i], &sliced, &steps), SC_OK);
+        assert_memory_equal(&sliced, &whole, sizeof whole);
+        /* each step did at most its budget: the payload bytes (and the labels) need this many */
+        if (budgets[i] == 7u) {
+            assert_true(steps >= (3u * NVOX) / 7u); /* voxels, labels, then the label pass */
+        }
+    }
+    /* finish before the last step is a state error */
+    sc_case_check k;
+    assert_int_equal(sc_case_check_begin(&k, g_buf, n), SC_OK);
+    assert_int_equal(sc_case_check_finish(&k, &sliced), SC_ERR_STATE);
+    /* a flipped bit anywhere (every 13th byte) and every truncation: both refuse */
+    for (size_t pos = 0; pos < n; pos += 13u) {
+        memcpy(g_bad, g_buf, n);
+        g_bad[pos] ^= (uint8_t)(1u << (pos % 8u));
+        uint32_t steps = 0;
+        const int a = sc_case_load(g_bad, n, &whole);
+        const int b = check_sliced(g_bad, n, 1000u, &sliced, &steps);
+        if (a == SC_OK || b == SC_OK) {
+            fail_msg("byte %zu: load %s, sliced %s", pos, sc_err_name(a), sc_err_name(b));
+        }
+    }
+    for (size_t len = 0; len < n; len += 61u) {
+        uint32_t steps = 0;
+        assert_true(check_sliced(g_buf, len, 1000u, &sliced, &steps) < 0);
+    }
+    /* a label outside the table, in the last voxel: found by the sliced label pass */
+    g_lab[NVOX - 1u] = (uint8_t)SC_LABEL_COUNT;
+    const size_t n2 = write_def(&d, g_buf);
+    uint32_t steps = 0;
+    assert_int_equal(check_sliced(g_buf, n2, 333u, &sliced, &steps), SC_ERR_CASE_LABEL);
+}
+
 static void invalid_materials_are_refused(void **state)
 {
     (void)state;
@@ -609,6 +670,7 @@ int main(void)
         cmocka_unit_test(dimensions_above_limits_or_overflowing_are_refused),
         cmocka_unit_test(non_finite_or_non_positive_spacing_is_refused),
         cmocka_unit_test(labels_outside_the_material_table_are_refused),
+        cmocka_unit_test(sliced_check_accepts_exactly_what_load_accepts_and_fills_the_same_view),
         cmocka_unit_test(invalid_materials_are_refused),
         cmocka_unit_test(mesh_box_outside_the_volume_is_refused),
         cmocka_unit_test(mesh_node_counts_outside_limits_are_refused),
