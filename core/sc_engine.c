@@ -1,4 +1,5 @@
-/* sc_engine.c: the engine object and its frame stages, see sc_engine.h. */
+/* sc_engine.c: the engine object, its frame and the control step between frames; see
+ * sc_engine.h. */
 #include "sc_engine.h"
 
 #include <string.h>
@@ -12,8 +13,9 @@
 /* Skin patch margin around the mesh box's top face. */
 #define SC_ENGINE_SKIN_MARGIN_MM 10.0f
 
-/* Case id reported for a case loaded by a name that is not in the catalogue. */
-#define SC_ENGINE_CASE_UNLISTED 254u
+static const char *const k_stage_names[SC_ENGINE_STAGE_COUNT] = {
+    "rx", "physics", "imaging", "status", "control", "platform",
+};
 
 sc_engine_def sc_engine_default_def(void)
 {
@@ -25,6 +27,9 @@ sc_engine_def sc_engine_default_def(void)
     d.tracker_fault_hold_ms = 1000u;
     d.phys_fault_hold_ms = 1000u;
     d.phys_resets_fatal = 5u;
+    d.case_check_slice_bytes = 1u << 20;
+    d.control_slice_estimate_ns = 2000000u;
+    d.control_wait_frames = 30u;
     d.tracker = sc_tracker_default_def();
     d.tissue = sc_tissue_default_def();
     d.bscan = sc_bscan_default_def();
@@ -37,74 +42,12 @@ static uint64_t now_ns(const sc_engine *e)
     return sc_clock_now_ns(&e->hal->clock);
 }
 
-/* ---- commands ------------------------------------------------------------------------------ */
-
-static int apply_imaging(sc_engine *e, const sc_imaging_cmd *c)
+static sc_tissue *running_tissue(sc_engine *e)
 {
-    sc_bscan_def d = e->bscan.def;
-    const sc_xform calib = d.scan.image_to_probe;
-    if (c->geometry == SC_SCAN_CURVILINEAR && d.scan.kind != SC_SCAN_CURVILINEAR) {
-        d.scan = sc_scan_curvilinear_default_def();
-    } else if (c->geometry == SC_SCAN_LINEAR && d.scan.kind != SC_SCAN_LINEAR) {
-        d.scan = sc_scan_default_def();
-    }
-    d.scan.image_to_probe = calib;
-    d.scan.depth_mm = c->depth_mm;
-    d.gain_db = c->gain_db;
-    d.dynamic_range_db = c->dyn_range_db;
-    /* TGC as a slope: each band gets the slope times its centre depth */
-    for (uint32_t b = 0; b < SC_BSCAN_TGC_BANDS; b++) {
-        const float centre_cm = 0.1f * c->depth_mm * ((float)b + 0.5f) / (float)SC_BSCAN_TGC_BANDS;
-        d.tgc_db[b] = c->tgc_db_per_cm * centre_cm;
-    }
-    return sc_bscan_set_def(&e->bscan, &d);
+    return &e->tissue[e->active];
 }
 
-static void apply_command(sc_engine *e, const sc_cmd *c)
-{
-    int rc = SC_OK;
-    switch (c->kind) {
-    case SC_CMD_SELECT_CASE:
-        if (c->case_id >= e->def.case_count || !e->def.case_names[c->case_id]) {
-            rc = SC_ERR_NOT_FOUND;
-        } else {
-            rc = sc_engine_load_case(e, e->def.case_names[c->case_id]);
-        }
-        break;
-    case SC_CMD_SET_METHOD:
-        e->def.tissue.method = c->method == SC_METHOD_FEM ? SC_TISSUE_FEM : SC_TISSUE_MSDS;
-        if (e->case_loaded) {
-            rc = sc_tissue_set_method(&e->tissue, e->def.tissue.method);
-        }
-        break;
-    case SC_CMD_SET_IMAGING:
-        rc = apply_imaging(e, &c->imaging);
-        break;
-    case SC_CMD_RESET:
-        if (c->reset_target & SC_RESET_TISSUE) {
-            if (e->case_loaded) {
-                sc_tissue_reset(&e->tissue);
-            }
-        }
-        if (c->reset_target & SC_RESET_FAULTS) {
-            sc_health_clear(&e->health, SC_FAULT_PHYS_REPEATED);
-            sc_health_clear(&e->health, SC_FAULT_CONFIG);
-            e->phys_resets_window = 0;
-        }
-        break;
-    }
-    if (rc == SC_OK) {
-        e->counters.commands_applied++;
-        sc_health_clear(&e->health, SC_FAULT_CONFIG);
-        sc_log(&e->hal->log, SC_LOG_INFO, "command_applied", SC_OK, (int64_t)c->kind, 0);
-    } else {
-        e->counters.commands_refused++;
-        sc_health_raise(&e->health, SC_FAULT_CONFIG);
-        sc_log(&e->hal->log, SC_LOG_WARN, "command_refused", rc, (int64_t)c->kind, 0);
-    }
-}
-
-/* ---- stage: CAN receive, commands, pose --------------------------------------------------- */
+/* ==== stage rx: CAN -> the probe in the volume frame ===================================== */
 
 static void take_bus_errors(sc_engine *e)
 {
@@ -129,7 +72,7 @@ static void take_bus_errors(sc_engine *e)
     }
 }
 
-static void update_tracker_faults(sc_engine *e, uint64_t now)
+static void update_tracker_faults(sc_engine *e, uint64_t now, uint8_t tracked)
 {
     const sc_trk_counters *n = sc_tracker_counters(&e->tracker);
     const uint32_t rejects = sc_tracker_rejected_e2e(&e->tracker) +
@@ -143,13 +86,11 @@ static void update_tracker_faults(sc_engine *e, uint64_t now)
     const int recent = rejects != 0u && now - e->last_tracker_reject_ns <
                                             (uint64_t)e->def.tracker_fault_hold_ms * NS_PER_MS;
     sc_health_set(&e->health, SC_FAULT_TRACKER_DATA, recent);
-    sc_health_set(&e->health, SC_FAULT_TRACKER_TIMEOUT, !e->probe_tracked);
+    sc_health_set(&e->health, SC_FAULT_TRACKER_TIMEOUT, !tracked);
 }
 
-static void stage_rx(void *user)
+static void stage_rx(sc_engine *e, uint64_t now, sc_probe_in *out)
 {
-    sc_engine *e = user;
-    const uint64_t now = now_ns(e);
     sc_can_frame f;
     uint32_t n = 0;
     for (; n < SC_CAN_RX_BURST_MAX; n++) {
@@ -164,39 +105,36 @@ static void stage_rx(void *user)
     }
     take_bus_errors(e);
 
-    sc_cmd cmd;
-    while (sc_tracker_take_command(&e->tracker, &cmd) == SC_OK) {
-        apply_command(e, &cmd);
-    }
-
+    /* the last pose is kept while lifted (status, getters); the transform is recomputed */
+    out->tracked = 0;
     sc_pose pose;
     int tracked = 0;
-    e->probe_tracked = 0;
     if (sc_tracker_poll(&e->tracker, now, &pose, &tracked) == SC_OK && tracked) {
-        e->probe_tracked = 1;
-        e->probe_tracker = pose;
-        if (e->case_loaded) {
-            const sc_xform t = sc_xform_from_pose(&pose);
-            e->probe_to_volume = sc_xform_compose(&e->slot.c.tracker_to_volume, &t);
-            e->probe_volume = sc_pose_from_xform(&e->probe_to_volume);
-        }
+        out->tracked = 1;
+        out->pose_tracker = pose;
     }
-    update_tracker_faults(e, now);
+    if (e->case_loaded) {
+        const sc_xform t = sc_xform_from_pose(&out->pose_tracker);
+        out->to_volume = sc_xform_compose(&e->slot.c.tracker_to_volume, &t);
+        out->pose_volume = sc_pose_from_xform(&out->to_volume);
+    }
+    update_tracker_faults(e, now, out->tracked);
 }
 
-/* ---- stage: physics ------------------------------------------------------------------------ */
+/* ==== stage physics: the probe -> the deformed mesh ====================================== */
 
-static void stage_physics(void *user)
+static void stage_physics(sc_engine *e, uint64_t now, const sc_probe_in *in, sc_tissue_out *out)
 {
-    sc_engine *e = user;
+    *out = (sc_tissue_out){0};
     if (!e->case_loaded) {
         return;
     }
-    const uint64_t now = now_ns(e);
+    sc_tissue *t = running_tissue(e);
     const int frozen = sc_health_is_active(&e->health, SC_FAULT_PHYS_REPEATED);
-    const sc_pose *probe = (e->probe_tracked && !frozen) ? &e->probe_volume : NULL;
-    const int rc = sc_tissue_step(&e->tissue, probe);
+    const sc_pose *probe = (in->tracked && !frozen) ? &in->pose_volume : NULL;
+    const int rc = sc_tissue_step(t, probe);
     if (rc == SC_ERR_PHYS_UNSTABLE) {
+        out->reset = 1;
         e->counters.phys_resets++;
         e->last_phys_reset_ns = now;
         const uint64_t window = 10u * (uint64_t)e->def.phys_fault_hold_ms * NS_PER_MS;
@@ -215,22 +153,34 @@ static void stage_physics(void *user)
                          now - e->last_phys_reset_ns <
                              (uint64_t)e->def.phys_fault_hold_ms * NS_PER_MS;
     sc_health_set(&e->health, SC_FAULT_PHYS_UNSTABLE, unstable);
-    e->probe_contact = (uint8_t)(probe != NULL && e->tissue.stats.contacts > 0u);
+    out->contact = (uint8_t)(probe != NULL && t->stats.contacts > 0u);
+    out->mesh = &t->mesh;
+    out->nodes = &t->nodes;
 }
 
-/* ---- stage: imaging ------------------------------------------------------------------------ */
+/* ==== stage imaging: the deformed mesh -> scan lines and the compression measure ========= */
 
-static void stage_imaging(void *user)
+static void stage_imaging(sc_engine *e, const sc_probe_in *probe, const sc_tissue_out *in,
+                          sc_image_out *out)
 {
-    sc_engine *e = user;
-    if (!e->case_loaded) {
-        return;
-    }
-    const int rc = sc_bscan_frame(&e->bscan, &e->tissue.mesh, &e->tissue.nodes, &e->slot.c.volume,
-                                  &e->probe_to_volume, e->probe_contact, &e->hal->display,
-                                  e->frame_no);
-    if (rc != SC_OK) {
-        e->counters.imaging_errors++;
+    *out = (sc_image_out){.rc = SC_OK,
+                          .vein_area_ratio = SC_AREA_RATIO_NOT_AVAILABLE,
+                          .artery_area_ratio = SC_AREA_RATIO_NOT_AVAILABLE};
+    if (in->mesh != NULL) {
+        out->rc = sc_bscan_frame(&e->bscan, in->mesh, in->nodes, &e->slot.c.volume,
+                                 &probe->to_volume, in->contact, &e->hal->display, e->frame_no);
+        if (out->rc != SC_OK) {
+            e->counters.imaging_errors++;
+        }
+        const sc_bscan_status *b = sc_bscan_status_get(&e->bscan);
+        if (b->areas_valid) {
+            if (b->area_ratio[SC_LABEL_VEIN] >= 0.0f) {
+                out->vein_area_ratio = b->area_ratio[SC_LABEL_VEIN];
+            }
+            if (b->area_ratio[SC_LABEL_ARTERY] >= 0.0f) {
+                out->artery_area_ratio = b->area_ratio[SC_LABEL_ARTERY];
+            }
+        }
     }
     sc_display_link_state ls;
     if (sc_display_get_link_state(&e->hal->display, &ls) == SC_OK) {
@@ -238,21 +188,11 @@ static void stage_imaging(void *user)
     }
 }
 
-/* ---- stage: status ------------------------------------------------------------------------- */
+/* ==== stage status: what the frame did -> CAN ============================================ */
 
-static float area_ratio(const sc_engine *e, uint32_t label)
+static void stage_status(sc_engine *e, uint64_t now, const sc_probe_in *probe,
+                         const sc_tissue_out *tissue, const sc_image_out *in)
 {
-    const sc_bscan_status *b = sc_bscan_status_get(&e->bscan);
-    if (!e->case_loaded || !b->areas_valid || b->area_ratio[label] < 0.0f) {
-        return SC_AREA_RATIO_NOT_AVAILABLE;
-    }
-    return b->area_ratio[label];
-}
-
-static void stage_status(void *user)
-{
-    sc_engine *e = user;
-    const uint64_t now = now_ns(e);
     if (now < e->next_status_ns) {
         return;
     }
@@ -263,15 +203,15 @@ static void stage_status(void *user)
     sc_status_msg s = {
         .state = (uint8_t)e->health.state,
         .method = e->def.tissue.method == SC_TISSUE_FEM ? SC_METHOD_FEM : SC_METHOD_MSDS,
-        .probe_contact = e->probe_contact,
-        .probe_lifted = (uint8_t)!e->probe_tracked,
+        .probe_contact = tissue->contact,
+        .probe_lifted = (uint8_t)!probe->tracked,
         .fault_bits = (uint16_t)e->health.active,
         .deadline_misses = (uint32_t)(e->sched.misses > UINT32_MAX ? UINT32_MAX
                                                                    : e->sched.misses),
         .case_id = e->case_loaded ? e->case_id : (uint8_t)SC_STATUS_CASE_NONE,
         .worst_frame_us = (uint32_t)(worst_us > UINT32_MAX ? UINT32_MAX : worst_us),
-        .vein_area_ratio = area_ratio(e, SC_LABEL_VEIN),
-        .artery_area_ratio = area_ratio(e, SC_LABEL_ARTERY),
+        .vein_area_ratio = in->vein_area_ratio,
+        .artery_area_ratio = in->artery_area_ratio,
     };
     sc_can_frame out[SC_STATUS_FRAMES];
     if (sc_tracker_encode_status(&e->tracker, &s, out) != SC_OK) {
@@ -285,19 +225,101 @@ static void stage_status(void *user)
     }
 }
 
-/* ---- init, case load, frame ---------------------------------------------------------------- */
+/* ==== control step: commands and case switches, between frames ========================== */
 
-static int set_filters(sc_engine *e)
+static int apply_imaging(sc_engine *e, const sc_imaging_cmd *c)
 {
-    /* the protocol's receive ids: commands 0x080..0x083, classic pose 0x100..0x103 (0x103 is
-     * unused and rejected by the tracker), FD pose 0x110 */
-    const sc_can_filter f[] = {
-        {.id = SC_CANID_CMD_CASE, .mask = 0x7FCu, .flags = 0},
-        {.id = SC_CANID_POSE_POS, .mask = 0x7FCu, .flags = 0},
-        {.id = SC_CANID_POSE_FD, .mask = 0x7FFu, .flags = 0},
-    };
-    const int rc = sc_can_set_filters(&e->hal->can, f, SC_COUNT_OF(f));
-    return rc == SC_ERR_NOT_SUPPORTED ? SC_OK : rc;
+    sc_bscan_def d = e->bscan.def;
+    const sc_xform calib = d.scan.image_to_probe;
+    if (c->geometry == SC_SCAN_CURVILINEAR && d.scan.kind != SC_SCAN_CURVILINEAR) {
+        d.scan = sc_scan_curvilinear_default_def();
+    } else if (c->geometry == SC_SCAN_LINEAR && d.scan.kind != SC_SCAN_LINEAR) {
+        d.scan = sc_scan_default_def();
+    }
+    d.scan.image_to_probe = calib;
+    d.scan.depth_mm = c->depth_mm;
+    d.gain_db = c->gain_db;
+    d.dynamic_range_db = c->dyn_range_db;
+    /* TGC as a slope: each band gets the slope times its centre depth */
+    for (uint32_t b = 0; b < SC_BSCAN_TGC_BANDS; b++) {
+        const float centre_cm = 0.1f * c->depth_mm * ((float)b + 0.5f) / (float)SC_BSCAN_TGC_BANDS;
+        d.tgc_db[b] = c->tgc_db_per_cm * centre_cm;
+    }
+    return sc_bscan_set_def(&e->bscan, &d);
+}
+
+static void count_refusal(sc_engine *e, const char *event, int rc, int64_t a)
+{
+    e->counters.commands_refused++;
+    sc_health_raise(&e->health, SC_FAULT_CONFIG);
+    sc_log(&e->hal->log, SC_LOG_WARN, event, rc, a, 0);
+}
+
+static uint8_t catalogue_id(const sc_engine *e, const char *name)
+{
+    for (uint32_t i = 0; i < e->def.case_count; i++) {
+        if (strcmp(e->def.case_names[i], name) == 0) {
+            return (uint8_t)i;
+        }
+    }
+    return (uint8_t)SC_ENGINE_CASE_UNLISTED;
+}
+
+/* Start a switch (no I/O yet: the control step's slices do the work). */
+static int request_switch(sc_engine *e, const char *name)
+{
+    if (!name) {
+        return SC_ERR_INVALID_ARG;
+    }
+    const size_t len = strlen(name);
+    if (len == 0u || len >= SC_ENGINE_CASE_NAME_MAX) {
+        return len == 0u ? SC_ERR_INVALID_ARG : SC_ERR_RANGE;
+    }
+    if (e->sw.phase != SC_SWITCH_IDLE) {
+        return SC_ERR_STATE;
+    }
+    memcpy(e->sw.name, name, len + 1u);
+    e->sw.case_id = catalogue_id(e, name);
+    e->sw.waited = 0;
+    e->sw.phase = SC_SWITCH_OPEN;
+    return SC_OK;
+}
+
+static void apply_command(sc_engine *e, const sc_cmd *c)
+{
+    int rc = SC_OK;
+    switch (c->kind) {
+    case SC_CMD_SELECT_CASE:
+        rc = c->case_id < e->def.case_count ? request_switch(e, e->def.case_names[c->case_id])
+                                            : SC_ERR_NOT_FOUND;
+        break;
+    case SC_CMD_SET_METHOD:
+        e->def.tissue.method = c->method == SC_METHOD_FEM ? SC_TISSUE_FEM : SC_TISSUE_MSDS;
+        if (e->case_loaded) { /* a tissue built later takes it from def.tissue */
+            rc = sc_tissue_set_method(running_tissue(e), e->def.tissue.method);
+        }
+        break;
+    case SC_CMD_SET_IMAGING:
+        rc = apply_imaging(e, &c->imaging);
+        break;
+    case SC_CMD_RESET:
+        if ((c->reset_target & SC_RESET_TISSUE) && e->case_loaded) {
+            sc_tissue_reset(running_tissue(e));
+        }
+        if (c->reset_target & SC_RESET_FAULTS) {
+            sc_health_clear(&e->health, SC_FAULT_PHYS_REPEATED);
+            sc_health_clear(&e->health, SC_FAULT_CONFIG);
+            e->phys_resets_window = 0;
+        }
+        break;
+    }
+    if (rc == SC_OK) {
+        e->counters.commands_applied++;
+        sc_health_clear(&e->health, SC_FAULT_CONFIG);
+        sc_log(&e->hal->log, SC_LOG_INFO, "command_applied", SC_OK, (int64_t)c->kind, 0);
+    } else {
+        count_refusal(e, "command_refused", rc, (int64_t)c->kind);
+    }
 }
 
 /* No case runs: the status says none, the probe transform is valid (the imaging stage streams
@@ -306,95 +328,35 @@ static void set_no_case(sc_engine *e)
 {
     e->case_loaded = 0;
     e->case_id = (uint8_t)SC_STATUS_CASE_NONE;
-    e->probe_to_volume = sc_xform_identity();
-    e->probe_volume = sc_pose_identity();
-    e->probe_tracker = sc_pose_identity();
+    e->probe.to_volume = sc_xform_identity();
+    e->probe.pose_volume = sc_pose_identity();
+    e->probe.pose_tracker = sc_pose_identity();
     sc_health_raise(&e->health, SC_FAULT_NO_CASE);
 }
 
-int sc_engine_init(sc_engine *e, const sc_engine_def *def, const sc_hal *hal)
+/* The switch was refused: the running case stays (its mapping and tissue were not touched,
+ * except by a one-slot build, after which no case runs). */
+static void switch_refused(sc_engine *e, int rc)
 {
-    if (!e || !def || !hal || !hal->clock.ops || !hal->can.ops || !hal->can.ops->send ||
-        !hal->can.ops->recv || !hal->display.ops || !hal->storage.ops ||
-        def->case_count > SC_ENGINE_MAX_CASES) {
-        return SC_ERR_INVALID_ARG;
+    if (e->sw.data != NULL) {
+        sc_storage_close(&e->hal->storage, e->sw.data, e->sw.size);
     }
-    if (def->status_period_ms < 10u || def->status_period_ms > 10000u ||
-        def->tracker_fault_hold_ms > 60000u || def->phys_fault_hold_ms > 60000u ||
-        def->phys_resets_fatal == 0u) {
-        return SC_ERR_RANGE;
-    }
-    memset(e, 0, offsetof(sc_engine, bscan)); /* the big members are set up by their inits */
-    e->hal = hal;
-    e->def = *def;
-    sc_health_init(&e->health);
-    int rc = sc_sched_init(&e->sched, &def->sched, &hal->clock);
-    if (rc == SC_OK) {
-        rc = sc_tracker_init(&e->tracker, &def->tracker);
-    }
-    if (rc == SC_OK) {
-        rc = sc_bscan_init(&e->bscan, &def->bscan);
-    }
-    if (rc == SC_OK) {
-        rc = sc_sched_add_stage(&e->sched, "rx", stage_rx);
-    }
-    if (rc == SC_OK) {
-        rc = sc_sched_add_stage(&e->sched, "physics", stage_physics);
-    }
-    if (rc == SC_OK) {
-        rc = sc_sched_add_stage(&e->sched, "imaging", stage_imaging);
-    }
-    if (rc == SC_OK) {
-        rc = sc_sched_add_stage(&e->sched, "status", stage_status);
-    }
-    if (rc == SC_OK) {
-        rc = set_filters(e);
-    }
-    if (rc != SC_OK) {
-        return rc;
-    }
-    if (def->watchdog_timeout_ms) {
-        const int wrc = sc_watchdog_start(&hal->watchdog, def->watchdog_timeout_ms);
-        if (wrc != SC_OK) {
-            sc_health_raise(&e->health, SC_FAULT_WATCHDOG);
-            sc_log(&hal->log, SC_LOG_WARN, "watchdog_unavailable", wrc, 0, 0);
-        }
-    }
-    sc_case_slot_init(&e->slot);
-    set_no_case(e);
-    sc_health_set_ready(&e->health, 1);
-    return SC_OK;
+    e->sw.data = NULL;
+    e->sw.phase = SC_SWITCH_IDLE;
+    e->counters.case_load_failures++;
+    e->counters.last_case_error = rc;
+    e->slot.refused++;
+    e->slot.last_error = rc;
+    sc_health_raise(&e->health, SC_FAULT_CONFIG);
+    sc_log(&e->hal->log, SC_LOG_ERROR, "case_refused", rc, (int64_t)e->sw.case_id, 0);
 }
 
-static uint8_t catalogue_id(const sc_engine *e, const char *name)
+/* Build the next case's tissue into `slot` (the standby slot, or the running one with a single
+ * slot). Limits were checked by the loader, so this fails only on a capacity the loader cannot
+ * see. */
+static int build_tissue(sc_engine *e, uint32_t slot)
 {
-    for (uint32_t i = 0; i < e->def.case_count; i++) {
-        if (e->def.case_names[i] && strcmp(e->def.case_names[i], name) == 0) {
-            return (uint8_t)i;
-        }
-    }
-    return (uint8_t)SC_ENGINE_CASE_UNLISTED;
-}
-
-
-int sc_engine_load_case(sc_engine *e, const char *name)
-{
-    if (!e || !name) {
-        return SC_ERR_INVALID_ARG;
-    }
-    /* open, validate, and only then replace the running case's mapping (sc_case_slot) */
-    int rc = sc_case_slot_switch(&e->slot, &e->hal->storage, name);
-    if (rc != SC_OK) {
-        /* refused before anything of the running case was touched */
-        e->counters.case_load_failures++;
-        e->counters.last_case_error = rc;
-        sc_log(&e->hal->log, SC_LOG_ERROR, "case_refused", rc, 0, 0);
-        return rc;
-    }
-    const sc_case *c = &e->slot.c;
-
-    /* The case is valid: rebuild the tissue and attach imaging. Limits were checked by the
-     * loader, so this fails only on a capacity the loader cannot see (then no case runs). */
+    const sc_case *c = &e->sw.c;
     sc_material_table mat;
     memset(&mat, 0, sizeof(mat));
     mat.count = c->material_count;
@@ -412,67 +374,339 @@ int sc_engine_load_case(sc_engine *e, const char *name)
         td.skin.size_mm[a] = c->mesh.size_mm[a] + 2.0f * SC_ENGINE_SKIN_MARGIN_MM;
     }
     td.skin.z_mm = c->mesh.origin_mm[2];
-    rc = sc_tissue_init(&e->tissue, &td, &c->volume, &mat, (uint8_t)SC_LABEL_FAT);
+    return sc_tissue_init(&e->tissue[slot], &td, &c->volume, &mat, (uint8_t)SC_LABEL_FAT);
+}
+
+/* Between two frames: the new case becomes the running one. */
+static int swap_case(sc_engine *e, uint32_t slot)
+{
+    sc_bscan_def bd = e->bscan.def;
+    bd.scan.image_to_probe = e->sw.c.image_to_probe;
+    int rc = sc_bscan_set_def(&e->bscan, &bd);
     if (rc == SC_OK) {
-        sc_bscan_def bd = e->bscan.def;
-        bd.scan.image_to_probe = c->image_to_probe;
-        rc = sc_bscan_set_def(&e->bscan, &bd);
-    }
-    if (rc == SC_OK) {
-        rc = sc_bscan_attach_mesh(&e->bscan, &e->tissue.mesh);
+        rc = sc_bscan_attach_mesh(&e->bscan, &e->tissue[slot].mesh);
     }
     if (rc != SC_OK) {
-        /* the previous tissue is gone: no case runs */
-        sc_case_slot_close(&e->slot);
-        set_no_case(e);
-        e->counters.case_load_failures++;
-        e->counters.last_case_error = rc;
-        sc_log(&e->hal->log, SC_LOG_ERROR, "case_rebuild_failed", rc, 0, 0);
+        /* imaging cannot show the new mesh: keep the running case if it is intact */
+        if (e->case_loaded && slot != e->active) {
+            (void)sc_bscan_attach_mesh(&e->bscan, &running_tissue(e)->mesh);
+        } else {
+            sc_case_slot_close(&e->slot);
+            set_no_case(e);
+        }
         return rc;
     }
+    sc_case_slot_close(&e->slot);
+    e->slot.dev = &e->hal->storage;
+    e->slot.data = e->sw.data;
+    e->slot.size = e->sw.size;
+    e->slot.c = e->sw.c;
+    e->slot.loaded = 1;
+    e->slot.last_error = SC_OK;
+    e->sw.data = NULL;
+    e->active = (uint8_t)slot;
     e->case_loaded = 1;
-    e->case_id = catalogue_id(e, name);
-    e->probe_contact = 0;
+    e->case_id = e->sw.case_id;
     e->counters.case_loads++;
     sc_health_clear(&e->health, SC_FAULT_NO_CASE);
-    sc_log(&e->hal->log, SC_LOG_INFO, "case_loaded", SC_OK, (int64_t)c->case_id,
-           (int64_t)e->tissue.mesh.tet_count);
+    sc_log(&e->hal->log, SC_LOG_INFO, "case_loaded", SC_OK, (int64_t)e->sw.c.case_id,
+           (int64_t)e->tissue[slot].mesh.tet_count);
     return SC_OK;
 }
 
-int sc_engine_add_stage(sc_engine *e, const char *name, sc_stage_fn fn)
+/* One slice of the switch: the work of its current phase. */
+static void switch_slice(sc_engine *e)
 {
-    return sc_sched_add_stage(&e->sched, name, fn);
+    sc_case_switch *sw = &e->sw;
+    const uint32_t standby = SC_ENGINE_TISSUE_SLOTS > 1u ? 1u - e->active : 0u;
+    int rc = SC_OK;
+    switch (sw->phase) {
+    case SC_SWITCH_OPEN:
+        rc = sc_storage_open(&e->hal->storage, sw->name, &sw->data, &sw->size);
+        if (rc != SC_OK) {
+            sw->data = NULL;
+        } else {
+            rc = sc_case_check_begin(&sw->check, sw->data, sw->size);
+        }
+        if (rc == SC_OK) {
+            sw->phase = SC_SWITCH_VALIDATE;
+        }
+        break;
+    case SC_SWITCH_VALIDATE: {
+        rc = sc_case_check_step(&sw->check, e->def.case_check_slice_bytes);
+        if (rc == 1) {
+            rc = sc_case_check_finish(&sw->check, &sw->c);
+            if (rc == SC_OK) {
+                sw->phase = SC_SWITCH_BUILD;
+            }
+        }
+        rc = rc > 0 ? SC_OK : rc;
+        break;
+    }
+    case SC_SWITCH_BUILD:
+        if (SC_ENGINE_TISSUE_SLOTS == 1u) {
+            /* in place: the running case ends here */
+            e->case_loaded = 0;
+        }
+        rc = build_tissue(e, standby);
+        if (rc == SC_OK) {
+            sw->phase = SC_SWITCH_SWAP;
+            if (SC_ENGINE_TISSUE_SLOTS > 1u) {
+                break; /* swapped in a slice of its own */
+            }
+            rc = swap_case(e, standby);
+            sw->phase = SC_SWITCH_IDLE;
+        } else if (SC_ENGINE_TISSUE_SLOTS == 1u) {
+            sc_case_slot_close(&e->slot);
+            set_no_case(e);
+        }
+        break;
+    case SC_SWITCH_SWAP:
+        rc = swap_case(e, standby);
+        sw->phase = SC_SWITCH_IDLE;
+        break;
+    case SC_SWITCH_IDLE:
+        break;
+    }
+    if (rc != SC_OK) {
+        switch_refused(e, rc);
+    }
+}
+
+static sc_engine_slice slice_kind(sc_switch_phase p)
+{
+    switch (p) {
+    case SC_SWITCH_OPEN:
+        return SC_ENGINE_SLICE_OPEN;
+    case SC_SWITCH_VALIDATE:
+        return SC_ENGINE_SLICE_VALIDATE;
+    case SC_SWITCH_BUILD:
+        return SC_ENGINE_SLICE_BUILD;
+    case SC_SWITCH_SWAP:
+    case SC_SWITCH_IDLE:
+        break;
+    }
+    return SC_ENGINE_SLICE_SWAP;
+}
+
+/* Run one slice now; its cost is recorded. */
+static void run_slice(sc_engine *e)
+{
+    const sc_engine_slice kind = slice_kind(e->sw.phase);
+    const uint64_t bytes_before = e->sw.check.bytes_done;
+    const uint64_t t0 = now_ns(e);
+    switch_slice(e);
+    const uint64_t dt = now_ns(e) - t0;
+    e->counters.control_slices[kind]++;
+    if (dt > e->counters.control_worst_ns[kind]) {
+        e->counters.control_worst_ns[kind] = dt;
+    }
+    const uint64_t bytes = e->sw.check.bytes_done - bytes_before; /* <= the slice budget */
+    if (kind == SC_ENGINE_SLICE_VALIDATE && bytes > e->counters.case_check_bytes_worst) {
+        e->counters.case_check_bytes_worst = bytes;
+    }
+    e->sw.waited = 0;
+}
+
+static void control_step(sc_engine *e)
+{
+    sc_cmd cmd;
+    while (sc_tracker_take_command(&e->tracker, &cmd) == SC_OK) {
+        apply_command(e, &cmd);
+    }
+    if (e->sw.phase == SC_SWITCH_IDLE) {
+        return;
+    }
+    const sc_engine_slice kind = slice_kind(e->sw.phase);
+    const uint64_t need = e->counters.control_slices[kind] > 0u
+                              ? e->counters.control_worst_ns[kind]
+                              : (uint64_t)e->def.control_slice_estimate_ns;
+    if (sc_sched_slack_ns(&e->sched) > need) {
+        run_slice(e);
+    } else if (++e->sw.waited > e->def.control_wait_frames) {
+        e->counters.control_forced++;
+        run_slice(e);
+    } else {
+        e->counters.control_deferred++;
+    }
+}
+
+/* ==== init, case selection, frame ========================================================= */
+
+static int set_filters(sc_engine *e)
+{
+    /* the protocol's receive ids: commands 0x080..0x083, classic pose 0x100..0x103 (0x103 is
+     * unused and rejected by the tracker), FD pose 0x110 */
+    const sc_can_filter f[] = {
+        {.id = SC_CANID_CMD_CASE, .mask = 0x7FCu, .flags = 0},
+        {.id = SC_CANID_POSE_POS, .mask = 0x7FCu, .flags = 0},
+        {.id = SC_CANID_POSE_FD, .mask = 0x7FFu, .flags = 0},
+    };
+    const int rc = sc_can_set_filters(&e->hal->can, f, SC_COUNT_OF(f));
+    return rc == SC_ERR_NOT_SUPPORTED ? SC_OK : rc;
+}
+
+static int def_valid(const sc_engine_def *def)
+{
+    if (def->case_count > SC_ENGINE_MAX_CASES) {
+        return SC_ERR_INVALID_ARG;
+    }
+    for (uint32_t i = 0; i < def->case_count; i++) {
+        if (!def->case_names[i] || def->case_names[i][0] == '\0' ||
+            strlen(def->case_names[i]) >= SC_ENGINE_CASE_NAME_MAX) {
+            return SC_ERR_INVALID_ARG;
+        }
+    }
+    if (def->status_period_ms < 10u || def->status_period_ms > 10000u ||
+        def->tracker_fault_hold_ms > 60000u || def->phys_fault_hold_ms > 60000u ||
+        def->phys_resets_fatal == 0u || def->case_check_slice_bytes < 4096u ||
+        def->control_wait_frames == 0u) {
+        return SC_ERR_RANGE;
+    }
+    return SC_OK;
+}
+
+int sc_engine_init(sc_engine *e, const sc_engine_def *def, const sc_hal *hal)
+{
+    if (!e || !def || !hal || !hal->clock.ops || !hal->can.ops || !hal->can.ops->send ||
+        !hal->can.ops->recv || !hal->display.ops || !hal->storage.ops) {
+        return SC_ERR_INVALID_ARG;
+    }
+    int rc = def_valid(def);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    memset(e, 0, offsetof(sc_engine, bscan)); /* the big members are set up by their inits */
+    e->hal = hal;
+    e->def = *def;
+    sc_health_init(&e->health);
+    rc = sc_sched_init(&e->sched, &def->sched, &hal->clock);
+    for (uint32_t s = 0; s < SC_ENGINE_STAGE_COUNT && rc == SC_OK; s++) {
+        const int idx = sc_sched_add_stage(&e->sched, k_stage_names[s]);
+        rc = idx == (int)s ? SC_OK : (idx < 0 ? idx : SC_ERR_STATE);
+    }
+    if (rc == SC_OK) {
+        rc = sc_tracker_init(&e->tracker, &def->tracker);
+    }
+    if (rc == SC_OK) {
+        rc = sc_bscan_init(&e->bscan, &def->bscan);
+    }
+    if (rc == SC_OK) {
+        rc = set_filters(e);
+    }
+    if (rc != SC_OK) {
+        return rc;
+    }
+    if (def->watchdog_timeout_ms) {
+        const int wrc = sc_watchdog_start(&hal->watchdog, def->watchdog_timeout_ms);
+        if (wrc != SC_OK) {
+            sc_health_raise(&e->health, SC_FAULT_WATCHDOG);
+            sc_log(&hal->log, SC_LOG_WARN, "watchdog_unavailable", wrc, 0, 0);
+        }
+    }
+    sc_case_slot_init(&e->slot);
+    set_no_case(e);
+    e->tissue_out = (sc_tissue_out){0};
+    e->image = (sc_image_out){.rc = SC_OK,
+                              .vein_area_ratio = SC_AREA_RATIO_NOT_AVAILABLE,
+                              .artery_area_ratio = SC_AREA_RATIO_NOT_AVAILABLE};
+    sc_health_set_ready(&e->health, 1);
+    return SC_OK;
+}
+
+int sc_engine_select_case(sc_engine *e, const char *name)
+{
+    if (!e) {
+        return SC_ERR_INVALID_ARG;
+    }
+    const int rc = request_switch(e, name);
+    if (rc != SC_OK) {
+        count_refusal(e, "case_select_refused", rc, 0);
+    }
+    return rc;
+}
+
+int sc_engine_load_case(sc_engine *e, const char *name)
+{
+    if (!e) {
+        return SC_ERR_INVALID_ARG;
+    }
+    int rc = request_switch(e, name);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    const uint64_t failures = e->counters.case_load_failures;
+    while (e->sw.phase != SC_SWITCH_IDLE) {
+        run_slice(e);
+    }
+    return e->counters.case_load_failures != failures ? e->counters.last_case_error : SC_OK;
+}
+
+int sc_engine_set_hook(sc_engine *e, sc_engine_hook_fn fn, void *user)
+{
+    if (!e) {
+        return SC_ERR_INVALID_ARG;
+    }
+    e->hook = fn;
+    e->hook_user = user;
+    return SC_OK;
+}
+
+/* Deadline misses: the first of a burst is logged at once, then at most one line per interval
+ * (config/sc_config.h) so that an overload cannot flood the log; b counts the misses a line
+ * stands for (itself and the unlogged ones before it), and a burst that ends with unlogged
+ * misses gets a summary line once the interval is over. */
+static void log_misses(sc_engine *e, const sc_frame_result *r)
+{
+    const int log_due = e->miss_logged_ns == 0u ||
+                        r->end_ns - e->miss_logged_ns >= (uint64_t)SC_ENGINE_MISS_LOG_INTERVAL_NS;
+    if (r->missed && log_due) {
+        sc_log(&e->hal->log, SC_LOG_WARN, "deadline_miss", SC_ERR_TIMEOUT,
+               (int64_t)(r->end_ns - r->release_ns), (int64_t)e->misses_unlogged + 1);
+        e->miss_logged_ns = r->end_ns;
+        e->misses_unlogged = 0u;
+    } else if (r->missed) {
+        e->misses_unlogged++;
+    } else if (log_due && e->misses_unlogged > 0u) {
+        sc_log(&e->hal->log, SC_LOG_WARN, "deadline_miss_summary", SC_ERR_TIMEOUT, 0,
+               (int64_t)e->misses_unlogged);
+        e->miss_logged_ns = r->end_ns;
+        e->misses_unlogged = 0u;
+    }
 }
 
 void sc_engine_step(sc_engine *e, sc_frame_result *out)
 {
     SC_ASSERT(e && e->hal);
-    sc_frame_result r;
-    sc_sched_run_frame(&e->sched, e, &r);
-    e->frame_no++;
-    /* deadline misses: the first of a burst is logged at once, then at most one line per
-     * interval (config/sc_config.h) so that an overload cannot flood the log; b counts the
-     * misses a line stands for (itself and the unlogged ones before it), and a burst that
-     * ends with unlogged misses gets a summary line once the interval is over */
-    const int log_due = e->miss_logged_ns == 0u ||
-                        r.end_ns - e->miss_logged_ns >= (uint64_t)SC_ENGINE_MISS_LOG_INTERVAL_NS;
-    if (r.missed && log_due) {
-        sc_log(&e->hal->log, SC_LOG_WARN, "deadline_miss", SC_ERR_TIMEOUT,
-               (int64_t)(r.end_ns - r.release_ns), (int64_t)e->misses_unlogged + 1);
-        e->miss_logged_ns = r.end_ns;
-        e->misses_unlogged = 0u;
-    } else if (r.missed) {
-        e->misses_unlogged++;
-    } else if (log_due && e->misses_unlogged > 0u) {
-        sc_log(&e->hal->log, SC_LOG_WARN, "deadline_miss_summary", SC_ERR_TIMEOUT, 0,
-               (int64_t)e->misses_unlogged);
-        e->miss_logged_ns = r.end_ns;
-        e->misses_unlogged = 0u;
+    sc_sched *s = &e->sched;
+    sc_sched_begin_frame(s);
+
+    stage_rx(e, now_ns(e), &e->probe);
+    sc_sched_stage_done(s, SC_ENGINE_STAGE_RX);
+
+    stage_physics(e, now_ns(e), &e->probe, &e->tissue_out);
+    sc_sched_stage_done(s, SC_ENGINE_STAGE_PHYSICS);
+
+    stage_imaging(e, &e->probe, &e->tissue_out, &e->image);
+    sc_sched_stage_done(s, SC_ENGINE_STAGE_IMAGING);
+
+    stage_status(e, now_ns(e), &e->probe, &e->tissue_out, &e->image);
+    sc_sched_stage_done(s, SC_ENGINE_STAGE_STATUS);
+
+    control_step(e);
+    sc_sched_stage_done(s, SC_ENGINE_STAGE_CONTROL);
+
+    if (e->hook) {
+        e->hook(e->hook_user);
+        sc_sched_stage_done(s, SC_ENGINE_STAGE_PLATFORM);
     }
+
+    sc_frame_result r;
+    sc_sched_end_frame(s, &r);
+    e->frame_no++;
+    log_misses(e, &r);
     sc_health_set(&e->health, SC_FAULT_DEADLINE,
-                  sc_sched_recent_misses(&e->sched, SC_HEALTH_MISS_WINDOW) >=
-                      SC_HEALTH_MISS_DEGRADED);
+                  sc_sched_recent_misses(s, SC_HEALTH_MISS_WINDOW) >= SC_HEALTH_MISS_DEGRADED);
     if (!sc_health_is_active(&e->health, SC_FAULT_WATCHDOG) &&
         sc_watchdog_kick(&e->hal->watchdog) == SC_OK) {
         e->counters.watchdog_kicks++;
@@ -481,6 +715,8 @@ void sc_engine_step(sc_engine *e, sc_frame_result *out)
         *out = r;
     }
 }
+
+/* ==== read-only views ====================================================================== */
 
 void sc_engine_get_status(const sc_engine *e, sc_engine_status *out)
 {
@@ -493,15 +729,57 @@ void sc_engine_get_status(const sc_engine *e, sc_engine_status *out)
         .p99_frame_ns = sc_stats_percentile_ns(&e->sched.frame_stats, 990u),
         .case_loaded = e->case_loaded,
         .case_id = e->case_id,
+        .switching = (uint8_t)(e->sw.phase != SC_SWITCH_IDLE),
         .method = e->def.tissue.method,
-        .probe_tracked = e->probe_tracked,
-        .probe_contact = e->probe_contact,
-        .vein_area_ratio = area_ratio(e, SC_LABEL_VEIN),
-        .artery_area_ratio = area_ratio(e, SC_LABEL_ARTERY),
+        .probe_tracked = e->probe.tracked,
+        .probe_contact = e->tissue_out.contact,
+        .vein_area_ratio = e->case_loaded ? e->image.vein_area_ratio : SC_AREA_RATIO_NOT_AVAILABLE,
+        .artery_area_ratio =
+            e->case_loaded ? e->image.artery_area_ratio : SC_AREA_RATIO_NOT_AVAILABLE,
     };
 }
 
 uint64_t sc_engine_state_hash(const sc_engine *e)
 {
-    return e->case_loaded ? sc_tissue_state_hash(&e->tissue) : 0u;
+    return e->case_loaded ? sc_tissue_state_hash(&e->tissue[e->active]) : 0u;
+}
+
+const sc_engine_counters *sc_engine_get_counters(const sc_engine *e)
+{
+    return &e->counters;
+}
+
+const sc_sched *sc_engine_get_sched(const sc_engine *e)
+{
+    return &e->sched;
+}
+
+const sc_case *sc_engine_get_case(const sc_engine *e)
+{
+    return e->case_loaded ? &e->slot.c : NULL;
+}
+
+const sc_tissue *sc_engine_get_tissue(const sc_engine *e)
+{
+    return e->case_loaded ? &e->tissue[e->active] : NULL;
+}
+
+const sc_tracker *sc_engine_get_tracker(const sc_engine *e)
+{
+    return &e->tracker;
+}
+
+const sc_bscan_status *sc_engine_get_bscan_status(const sc_engine *e)
+{
+    return sc_bscan_status_get(&e->bscan);
+}
+
+uint64_t sc_engine_next_release_ns(const sc_engine *e)
+{
+    return e->sched.started ? e->sched.next_release_ns : now_ns(e);
+}
+
+const sc_probe_in *sc_engine_get_probe(const sc_engine *e)
+{
+    return &e->probe;
 }

@@ -1,29 +1,58 @@
 /*
- * sc_engine.h: the engine object: every piece of engine state in one caller-placed struct.
+ * sc_engine.h: the engine: every piece of engine state in one caller-placed object, and the
+ * frame that runs it. The platform's whole view of the core.
  *
+ * ---- Integration ------------------------------------------------------------------------
  * The platform places one sc_engine where it wants (static storage on an MCU, locked memory on
- * Linux), fills an sc_hal with its devices, and calls:
- *   sc_engine_init()       once: validates the definition, sets up the scheduler stages;
- *   sc_engine_load_case()  at start-up and on a "select case" command: the case is validated
- *                          completely (sc_case_load) before anything of the running case is
- *                          touched; a bad case is refused, counted, and the running case stays;
- *   sc_engine_step()       once per frame: sleeps until the frame's release time through the
- *                          HAL clock, then runs the fixed stage list, detects deadline misses,
- *                          feeds the watchdog.
+ * Linux; sizeof(sc_engine) is fixed by config/sc_config.h), fills an sc_hal with its devices
+ * (hal/sc_hal.h: CAN, display, clock, storage, log, watchdog), and calls:
+ *   sc_engine_init()         once: validates the definition, resets every subsystem;
+ *   sc_engine_load_case()    at start-up: the whole case switch below in one call;
+ *   sc_engine_step()         once per frame, forever;
+ *   sc_engine_select_case()  any time: asks for a case switch by name (the CAN command
+ *                            CmdSelectCase asks by catalogue index); it runs between frames;
+ * and reads the engine through the const getters at the end of this file (status, counters,
+ * timing, the running case, the tissue, the tracker). A platform never writes engine fields.
  *
- * The frame (paper Fig. 1 recast as firmware stages, each timed by the scheduler):
- *   rx       drain at most SC_CAN_RX_BURST_MAX CAN frames into the tracker (E2E, pose
- *            assembly, plausibility, commands), apply queued commands, take the newest valid
- *            pose and carry it tracker -> volume frame with the case's registration;
- *   physics  one tissue step (MSDS or FEM, collider, skin, stability guard);
- *   imaging  B-scan synthesis through the deformed mesh, each line streamed to the display
- *            as soon as it is computed; the vessels' compression measure;
- *   status   every status_period_ms: the status frames (state, faults, misses, worst frame
- *            time, compression measure, tracker counters) on CAN.
+ * ---- The frame (sc_engine_step) ------------------------------------------------------------
+ * One call per stage, in this order, each a function with a small typed input and output; the
+ * scheduler (sc_sched.h) times each and counts a frame that ends after its deadline as a miss
+ * (counted and reported, never queued). Worst-case work per stage, bounded by config/ limits:
+ *   rx       CAN -> sc_probe_in (the probe's pose in the volume frame, or lifted).
+ *            At most SC_CAN_RX_BURST_MAX frames drained into the tracker (E2E, 3-frame pose
+ *            assembly, plausibility; commands are queued, not applied), the newest valid pose
+ *            carried tracker -> volume frame with the case's registration. O(burst).
+ *   physics  sc_probe_in -> sc_tissue_out (contact, node state of the tet mesh).
+ *            One tissue step (sc_tissue.h): MSDS O(iterations x nodes) or FEM O(iterations x
+ *            nonzeros), collider O(contact candidates), skin, stability guard O(nodes).
+ *   imaging  sc_tissue_out -> sc_image_out (scan lines to the display, the compression
+ *            measure). O(lines x samples) plus the tets each line crosses (sc_bscan.h); every
+ *            line leaves through the display HAL as soon as it is computed, the frame's
+ *            compression measure closes the display frame (hal/sc_hal_display.h).
+ *   status   sc_image_out -> CAN status frames every status_period_ms (3 frames). O(1).
+ *   control  between this frame and the next, in the frame's slack: the queued commands
+ *            (O(SC_CAN_CMD_QUEUE_MAX)), then at most one slice of a pending case switch:
+ *              open      the storage mapping, the file's framing (O(sections));
+ *              validate  at most case_check_slice_bytes of CRC / label pass (sc_case.h);
+ *              build     the next case's tissue in the standby slot (sc_tissue_init:
+ *                        O(tets + nodes) plus the FEM assembly) while the running case runs;
+ *              swap      imaging attached to the new mesh (O(tets)), calibration taken, the
+ *                        slots exchanged: the next frame runs the new case.
+ *            A slice runs only when the slack left is at least the longest that kind of slice
+ *            has taken so far (measured on the HAL clock; def.control_slice_estimate_ns until
+ *            then), so a switch never makes a frame miss; a slice that has waited
+ *            control_wait_frames frames runs anyway (counted in control_forced). With one
+ *            tissue slot (SC_ENGINE_TISSUE_SLOTS 1, the MCU) build and swap are one slice that
+ *            replaces the running tissue.
  *
- * Thread rules: one thread drives an engine. Memory: never allocates; no OS calls; all I/O goes
- * through the HAL. Deterministic: the same case and input sequence (frames and their time
- * stamps on the HAL clock) give bit-identical output.
+ * ---- Rules ----------------------------------------------------------------------------------
+ * Threads: one thread drives an engine; the getters may be called between steps.
+ * Memory: never allocates; everything lives in the sc_engine (the case voxels stay in storage
+ * and are read through the HAL's mapping). No OS calls; all I/O goes through the HAL.
+ * Deterministic: the same case and input sequence (frames and their time stamps on the HAL
+ * clock) give bit-identical output (sc_engine_state_hash, tests/hostsim/test_engine.c).
+ * Errors: functions that can fail return 0 or a negative sc_err (sc_err.h); bad input from the
+ * outside (CAN, case files, commands) is refused, counted and logged, never asserted.
  */
 #ifndef SC_ENGINE_H
 #define SC_ENGINE_H
@@ -43,6 +72,42 @@
 #ifndef SC_ENGINE_MAX_CASES
 #define SC_ENGINE_MAX_CASES 16u
 #endif
+#ifndef SC_ENGINE_CASE_NAME_MAX
+#define SC_ENGINE_CASE_NAME_MAX 256u /* bytes of a requested case name, with the NUL */
+#endif
+/* Tissue slots: 2 lets the next case be built while the running one runs (double the tissue
+ * memory); 1 (the MCU) builds in place, in one slice, replacing the running case. */
+#ifndef SC_ENGINE_TISSUE_SLOTS
+#define SC_ENGINE_TISSUE_SLOTS 2u
+#endif
+_Static_assert(SC_ENGINE_TISSUE_SLOTS == 1u || SC_ENGINE_TISSUE_SLOTS == 2u,
+               "one or two tissue slots");
+_Static_assert(SC_ENGINE_MAX_CASES <= 254u, "case ids are 8-bit; 254 and 255 are reserved");
+
+/* The frame's stages, in order (timing slots of the scheduler). */
+typedef enum sc_engine_stage {
+    SC_ENGINE_STAGE_RX = 0,
+    SC_ENGINE_STAGE_PHYSICS,
+    SC_ENGINE_STAGE_IMAGING,
+    SC_ENGINE_STAGE_STATUS,
+    SC_ENGINE_STAGE_CONTROL,
+    SC_ENGINE_STAGE_PLATFORM, /* the optional platform hook */
+    SC_ENGINE_STAGE_COUNT
+} sc_engine_stage;
+_Static_assert(SC_ENGINE_STAGE_COUNT <= SC_SCHED_MAX_STAGES, "scheduler timing slots");
+
+/* Kinds of control slices (their worst times are tracked separately). */
+typedef enum sc_engine_slice {
+    SC_ENGINE_SLICE_OPEN = 0,
+    SC_ENGINE_SLICE_VALIDATE,
+    SC_ENGINE_SLICE_BUILD,
+    SC_ENGINE_SLICE_SWAP,
+    SC_ENGINE_SLICE_COUNT
+} sc_engine_slice;
+
+/* A platform's own work at the end of every frame (tests model load with it), timed as the
+ * stage "platform". Optional. */
+typedef void (*sc_engine_hook_fn)(void *user);
 
 typedef struct sc_engine_def {
     sc_sched_def sched;
@@ -52,10 +117,13 @@ typedef struct sc_engine_def {
     uint32_t phys_fault_hold_ms;   /* PHYS_UNSTABLE stays active this long after a reset */
     uint32_t phys_resets_fatal;    /* this many guard resets within phys_fault_hold_ms * 10:
                                     * PHYS_REPEATED (fatal) until a reset command */
+    uint32_t case_check_slice_bytes; /* case bytes validated per control slice (>= 4096) */
+    uint32_t control_slice_estimate_ns; /* assumed cost of a slice not measured yet */
+    uint32_t control_wait_frames;  /* a slice waits at most this many frames for slack */
     sc_tracker_def tracker;
     sc_tissue_def tissue;          /* mesh region and materials come from the case */
     sc_bscan_def bscan;            /* calibration comes from the case */
-    /* Case catalogue for the select-case command: case id i names case_names[i] in storage. */
+    /* Case catalogue: catalogue index i (CmdSelectCase) names case_names[i] in storage. */
     const char *case_names[SC_ENGINE_MAX_CASES];
     uint32_t case_count;
 } sc_engine_def;
@@ -65,13 +133,18 @@ typedef struct sc_engine_counters {
     uint64_t can_rx_burst_limited;  /* frames in which the rx drain stopped at its bound */
     uint64_t can_tx_failed;         /* status frames the controller refused */
     uint64_t commands_applied;
-    uint64_t commands_refused;      /* unknown case id, load failure, bad settings */
-    uint64_t case_loads;
-    uint64_t case_load_failures;
+    uint64_t commands_refused;      /* unknown case id, switch busy, bad settings */
+    uint64_t case_loads;            /* switches completed */
+    uint64_t case_load_failures;    /* switches refused (storage, validation, rebuild) */
     int last_case_error;            /* sc_err of the last refused case */
     uint64_t phys_resets;           /* stability guard resets */
     uint64_t imaging_errors;        /* frames whose synthesis or display returned an error */
     uint64_t watchdog_kicks;
+    uint64_t control_slices[SC_ENGINE_SLICE_COUNT]; /* slices run, by kind */
+    uint64_t control_deferred;      /* frames in which a slice waited for slack */
+    uint64_t control_forced;        /* slices run after control_wait_frames without slack */
+    uint64_t control_worst_ns[SC_ENGINE_SLICE_COUNT]; /* longest slice of each kind (HAL clock) */
+    uint64_t case_check_bytes_worst; /* most case bytes validated in one frame */
 } sc_engine_counters;
 
 typedef struct sc_engine_status {
@@ -82,13 +155,62 @@ typedef struct sc_engine_status {
     uint64_t worst_frame_ns;
     uint64_t p99_frame_ns;
     uint8_t case_loaded;
-    uint8_t case_id;
+    uint8_t case_id;        /* catalogue index; SC_ENGINE_CASE_UNLISTED; SC_STATUS_CASE_NONE */
+    uint8_t switching;      /* a case switch is being prepared */
     sc_tissue_method method;
     uint8_t probe_tracked;  /* a valid pose this frame */
     uint8_t probe_contact;  /* the collider touches the tissue */
     float vein_area_ratio;  /* image area of the vein now / at rest; < 0: not available */
     float artery_area_ratio;
 } sc_engine_status;
+
+/* Case id reported for a case loaded by a name that is not in the catalogue. */
+#define SC_ENGINE_CASE_UNLISTED 254u
+
+/* ---- the stages' typed inputs and outputs ------------------------------------------------ */
+
+/* rx -> physics, imaging: this frame's probe. */
+typedef struct sc_probe_in {
+    uint8_t tracked;         /* a valid pose this frame (else: lifted) */
+    sc_pose pose_tracker;    /* tracker frame, as received */
+    sc_xform to_volume;      /* probe frame -> volume frame (identity without a case) */
+    sc_pose pose_volume;
+} sc_probe_in;
+
+/* physics -> imaging: the deformed mesh. */
+typedef struct sc_tissue_out {
+    uint8_t contact;         /* the collider touches the tissue */
+    uint8_t reset;           /* the stability guard reset the tissue this frame */
+    const sc_mesh *mesh;     /* NULL without a case */
+    const sc_nodes *nodes;
+} sc_tissue_out;
+
+/* imaging -> status: what the image showed. */
+typedef struct sc_image_out {
+    int rc;                  /* sc_bscan_frame's result */
+    float vein_area_ratio;   /* the compression measure; < 0: not available */
+    float artery_area_ratio;
+} sc_image_out;
+
+/* A case switch in progress (control step). */
+typedef enum sc_switch_phase {
+    SC_SWITCH_IDLE = 0,
+    SC_SWITCH_OPEN,
+    SC_SWITCH_VALIDATE,
+    SC_SWITCH_BUILD,
+    SC_SWITCH_SWAP,
+} sc_switch_phase;
+
+typedef struct sc_case_switch {
+    sc_switch_phase phase;
+    char name[SC_ENGINE_CASE_NAME_MAX];
+    uint8_t case_id;          /* catalogue index or SC_ENGINE_CASE_UNLISTED */
+    uint32_t waited;          /* frames the next slice has waited for slack */
+    const uint8_t *data;      /* the new case's mapping (open from OPEN until the swap) */
+    size_t size;
+    sc_case_check check;
+    sc_case c;
+} sc_case_switch;
 
 typedef struct sc_engine {
     const sc_hal *hal;
@@ -97,17 +219,16 @@ typedef struct sc_engine {
     sc_health health;
     sc_engine_counters counters;
     sc_tracker tracker;
-    /* the running case: a validated view into storage bytes kept open while it runs
-     * (slot.c); case_loaded once the tissue and imaging are built for it */
+    /* the running case: a validated view into storage bytes kept open while it runs */
     sc_case_slot slot;
     uint8_t case_loaded;
     uint8_t case_id;
-    /* this frame's probe */
-    uint8_t probe_tracked;
-    uint8_t probe_contact;
-    sc_pose probe_tracker;   /* tracker frame */
-    sc_xform probe_to_volume;
-    sc_pose probe_volume;
+    uint8_t active;          /* tissue slot of the running case */
+    sc_case_switch sw;
+    /* the last frame's stage outputs (status, getters) */
+    sc_probe_in probe;
+    sc_tissue_out tissue_out;
+    sc_image_out image;
     /* bookkeeping of time-held faults */
     uint64_t last_tracker_reject_ns;
     uint32_t tracker_rejects_seen;
@@ -118,35 +239,62 @@ typedef struct sc_engine {
     uint32_t frame_no;
     uint64_t miss_logged_ns;  /* end of the frame of the last miss line; 0: none yet */
     uint32_t misses_unlogged; /* misses since then that got no line of their own */
+    sc_engine_hook_fn hook;
+    void *hook_user;
     sc_bscan bscan;
-    sc_tissue tissue; /* the large one last */
+    sc_tissue tissue[SC_ENGINE_TISSUE_SLOTS]; /* the large ones last */
 } sc_engine;
 
+/* Defaults: 60 Hz, watchdog 500 ms, status every 100 ms, 1 MiB of case check per slice,
+ * slices assumed to cost 2 ms until measured, at most 30 frames of waiting. O(1). */
 sc_engine_def sc_engine_default_def(void);
 
-/* Validate def, reset all state, register the stages. The engine starts without a case (fault
- * SC_FAULT_NO_CASE) until sc_engine_load_case succeeds. O(stages). Never allocates.
- * Errors: SC_ERR_INVALID_ARG (NULL, a mandatory HAL op missing, case catalogue too long),
- * SC_ERR_RANGE (rate, periods), errors of sc_tracker_def_validate and sc_bscan_init. */
+/* Validate def, reset all state, name the stages. The engine starts without a case (fault
+ * SC_FAULT_NO_CASE) until a switch completes. O(1) plus the subsystems' inits (no tissue
+ * build). Never allocates. Errors: SC_ERR_INVALID_ARG (NULL, a mandatory HAL op missing, case
+ * catalogue too long or with a NULL or too long name), SC_ERR_RANGE (rate, periods, slice
+ * budget), errors of sc_tracker_def_validate and sc_bscan_init. */
 int sc_engine_init(sc_engine *e, const sc_engine_def *def, const sc_hal *hal);
 
-/* Open `name` in case storage, validate it, and only then replace the running case: tissue
- * (mesh, materials, solvers) rebuilt at rest, imaging attached to the new mesh, calibration
- * taken. O(case bytes) for the validation plus O(tets) for the rebuild: a load-time
- * operation (a frame that loads a case misses its deadline, which is counted). Never
- * allocates. Errors: SC_ERR_NOT_FOUND and storage errors, every sc_case_load error (the
- * running case stays), and errors of the rebuild (then no case runs: SC_FAULT_NO_CASE). */
+/* Switch to case `name` now, outside the frame loop (start-up): every slice of the control
+ * step's switch in one call. O(case bytes + tets). Errors: SC_ERR_INVALID_ARG, SC_ERR_RANGE
+ * (name longer than SC_ENGINE_CASE_NAME_MAX - 1), SC_ERR_STATE (a switch is running), the
+ * storage's open errors, every sc_case_load error (the running case stays), and errors of the
+ * rebuild (then no case runs: SC_FAULT_NO_CASE). */
 int sc_engine_load_case(sc_engine *e, const char *name);
 
-/* Register an extra stage after the built-in ones (platform work, tests). SC_ERR_NO_SPACE. */
-int sc_engine_add_stage(sc_engine *e, const char *name, sc_stage_fn fn);
+/* Ask for a switch to case `name` (a name in case storage; catalogue or not); it is prepared
+ * in slices between frames while the running case runs, and swapped in between two frames.
+ * Its outcome is counted (case_loads / case_load_failures, last_case_error) and logged
+ * (case_loaded / case_refused). O(name). Errors (refused at once, counted in
+ * commands_refused, SC_FAULT_CONFIG raised): SC_ERR_INVALID_ARG, SC_ERR_RANGE (name too long),
+ * SC_ERR_STATE (a switch is already running). */
+int sc_engine_select_case(sc_engine *e, const char *name);
 
-/* Run one frame through the scheduler. Bounded by the stages' fixed worst cases. */
+/* Set the platform hook (NULL: none). O(1). SC_ERR_INVALID_ARG for a NULL engine. */
+int sc_engine_set_hook(sc_engine *e, sc_engine_hook_fn fn, void *user);
+
+/* Run one frame: sleep until its release, then rx, physics, imaging, status, control (and the
+ * hook), miss detection, watchdog. Bounded by the stages' worst cases above. */
 void sc_engine_step(sc_engine *e, sc_frame_result *out);
 
-void sc_engine_get_status(const sc_engine *e, sc_engine_status *out);
+/* ---- read-only views (between steps) -------------------------------------------------- */
 
+void sc_engine_get_status(const sc_engine *e, sc_engine_status *out);
 /* Hash of the engine's physical state (tissue nodes and skin): the determinism check. */
 uint64_t sc_engine_state_hash(const sc_engine *e);
+const sc_engine_counters *sc_engine_get_counters(const sc_engine *e);
+/* The scheduler: frames, misses, per-stage and frame statistics, the next release. */
+const sc_sched *sc_engine_get_sched(const sc_engine *e);
+/* The running case, or NULL. */
+const sc_case *sc_engine_get_case(const sc_engine *e);
+/* The running case's tissue (mesh, nodes, solvers), or NULL. */
+const sc_tissue *sc_engine_get_tissue(const sc_engine *e);
+const sc_tracker *sc_engine_get_tracker(const sc_engine *e);
+const sc_bscan_status *sc_engine_get_bscan_status(const sc_engine *e);
+/* The release time of the next frame on the HAL clock (now, before the first frame). */
+uint64_t sc_engine_next_release_ns(const sc_engine *e);
+/* This frame's probe as the rx stage produced it. */
+const sc_probe_in *sc_engine_get_probe(const sc_engine *e);
 
 #endif /* SC_ENGINE_H */

@@ -43,9 +43,9 @@ int sc_sched_init(sc_sched *s, const sc_sched_def *def, const sc_clock_dev *cloc
     return SC_OK;
 }
 
-int sc_sched_add_stage(sc_sched *s, const char *name, sc_stage_fn fn)
+int sc_sched_add_stage(sc_sched *s, const char *name)
 {
-    if (!s || !name || !fn) {
+    if (!s || !name) {
         return SC_ERR_INVALID_ARG;
     }
     if (s->started) {
@@ -54,11 +54,10 @@ int sc_sched_add_stage(sc_sched *s, const char *name, sc_stage_fn fn)
     if (s->stage_count >= SC_SCHED_MAX_STAGES) {
         return SC_ERR_NO_SPACE;
     }
-    sc_sched_stage *st = &s->stages[s->stage_count++];
+    sc_sched_stage *st = &s->stages[s->stage_count];
     st->name = name;
-    st->fn = fn;
     sc_stats_reset(&st->stats);
-    return SC_OK;
+    return (int)s->stage_count++;
 }
 
 int sc_sched_set_rate(sc_sched *s, uint32_t rate_hz)
@@ -73,25 +72,42 @@ int sc_sched_set_rate(sc_sched *s, uint32_t rate_hz)
     return SC_OK;
 }
 
-void sc_sched_run_frame(sc_sched *s, void *user, sc_frame_result *out)
+void sc_sched_begin_frame(sc_sched *s)
 {
-    SC_ASSERT(s && s->clock);
+    SC_ASSERT(s && s->clock && !s->in_frame);
     if (!s->started) {
         s->started = 1;
         s->next_release_ns = sc_clock_now_ns(s->clock);
     }
-    const uint64_t release = s->next_release_ns;
-    (void)sc_clock_sleep_until_ns(s->clock, release);
+    s->release_ns = s->next_release_ns;
+    (void)sc_clock_sleep_until_ns(s->clock, s->release_ns);
+    s->start_ns = sc_clock_now_ns(s->clock);
+    s->mark_ns = s->start_ns;
+    s->in_frame = 1;
+}
 
-    const uint64_t start = sc_clock_now_ns(s->clock);
-    uint64_t t0 = start;
-    for (uint32_t i = 0; i < s->stage_count; i++) {
-        s->stages[i].fn(user);
-        const uint64_t t1 = sc_clock_now_ns(s->clock);
-        sc_stats_add(&s->stages[i].stats, t1 - t0);
-        t0 = t1;
-    }
-    const uint64_t end = t0;
+void sc_sched_stage_done(sc_sched *s, uint32_t stage)
+{
+    SC_ASSERT(s && s->in_frame && stage < s->stage_count);
+    const uint64_t t = sc_clock_now_ns(s->clock);
+    sc_stats_add(&s->stages[stage].stats, t - s->mark_ns);
+    s->mark_ns = t;
+}
+
+uint64_t sc_sched_slack_ns(const sc_sched *s)
+{
+    const uint64_t deadline = s->release_ns + s->period_ns;
+    const uint64_t now = sc_clock_now_ns(s->clock);
+    return now < deadline ? deadline - now : 0u;
+}
+
+void sc_sched_end_frame(sc_sched *s, sc_frame_result *out)
+{
+    SC_ASSERT(s && s->in_frame);
+    s->in_frame = 0;
+    const uint64_t release = s->release_ns;
+    const uint64_t start = s->start_ns;
+    const uint64_t end = sc_clock_now_ns(s->clock);
     sc_stats_add(&s->frame_stats, end - start);
     sc_stats_add(&s->lateness_stats, start >= release ? start - release : 0u);
 

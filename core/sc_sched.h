@@ -1,11 +1,13 @@
 /*
  * sc_sched.h: the frame scheduler.
  *
- * A fixed period (default 60 Hz) and a fixed list of stages, run in order once per frame.
- * Each frame: sleep until the release time (absolute, through the HAL clock), run every
- * stage timing it on the HAL clock, then compare the end with the deadline (release + period).
+ * A fixed period (default 60 Hz). The caller runs the frame's stages itself, in its own code,
+ * and marks the end of each: sc_sched_begin_frame() sleeps until the release time (absolute,
+ * through the HAL clock), sc_sched_stage_done() charges the time since the previous mark to a
+ * named stage, sc_sched_end_frame() compares the end with the deadline (release + period).
  * A miss is counted and the schedule resynchronises to the next period boundary after the end:
- * late frames are never queued up or run back to back to "catch up".
+ * late frames are never queued up or run back to back to "catch up". sc_sched_slack_ns() tells
+ * work between stages how much of the period is left.
  *
  * Memory: all state inside sc_sched (about 12 KiB with 8 stages); never allocates.
  * Threads: one sc_sched is driven by one thread. Never calls the OS: time comes from hal clock.
@@ -19,16 +21,13 @@
 #include "sc_hal_clock.h"
 #include "sc_stats.h"
 
-typedef void (*sc_stage_fn)(void *user);
-
 typedef struct sc_sched_def {
     uint32_t rate_hz; /* SC_FRAME_RATE_MIN_HZ .. SC_FRAME_RATE_MAX_HZ */
 } sc_sched_def;
 
 typedef struct sc_sched_stage {
     const char *name; /* static string */
-    sc_stage_fn fn;
-    sc_stats stats; /* execution time of this stage */
+    sc_stats stats;   /* execution time of this stage */
 } sc_sched_stage;
 
 typedef struct sc_frame_result {
@@ -50,6 +49,10 @@ typedef struct sc_sched {
     uint64_t miss_window; /* bit i: frame (frames-1-i) missed */
     uint32_t stage_count;
     uint8_t started;
+    uint8_t in_frame;
+    uint64_t release_ns; /* of the running frame */
+    uint64_t start_ns;
+    uint64_t mark_ns;    /* end of the last stage marked */
     sc_stats frame_stats;    /* execution time start..end of whole frames */
     sc_stats lateness_stats; /* start - release: wake-up latency */
     sc_sched_stage stages[SC_SCHED_MAX_STAGES];
@@ -61,15 +64,26 @@ sc_sched_def sc_sched_default_def(void);
  * (NULL), SC_ERR_RANGE (rate outside limits). */
 int sc_sched_init(sc_sched *s, const sc_sched_def *def, const sc_clock_dev *clock);
 
-/* Append a stage. O(1). SC_ERR_NO_SPACE beyond SC_SCHED_MAX_STAGES, SC_ERR_STATE once started. */
-int sc_sched_add_stage(sc_sched *s, const char *name, sc_stage_fn fn);
+/* Name the next timing slot (a stage). Returns its index (>= 0). O(1). SC_ERR_INVALID_ARG,
+ * SC_ERR_NO_SPACE beyond SC_SCHED_MAX_STAGES, SC_ERR_STATE once started. */
+int sc_sched_add_stage(sc_sched *s, const char *name);
 
 /* Change the period between frames; takes effect from the next release. SC_ERR_RANGE. */
 int sc_sched_set_rate(sc_sched *s, uint32_t rate_hz);
 
-/* Run one frame: wait for the release, run all stages, detect a miss, plan the next release.
- * O(stages) plus the stages' own cost. The first call releases immediately. */
-void sc_sched_run_frame(sc_sched *s, void *user, sc_frame_result *out);
+/* Wait for the frame's release (the first frame releases immediately) and start timing it.
+ * O(1) plus the sleep. */
+void sc_sched_begin_frame(sc_sched *s);
+
+/* The stage `stage` (an index of sc_sched_add_stage) ended now: its time is the time since the
+ * frame began or the previous mark. O(log) (statistics insert). */
+void sc_sched_stage_done(sc_sched *s, uint32_t stage);
+
+/* Time left until the running frame's deadline; 0 when it has passed. O(1). */
+uint64_t sc_sched_slack_ns(const sc_sched *s);
+
+/* The frame ended now: frame statistics, miss detection, the next release. O(1). */
+void sc_sched_end_frame(sc_sched *s, sc_frame_result *out);
 
 /* Misses among the last n (<= 64) frames. */
 uint32_t sc_sched_recent_misses(const sc_sched *s, uint32_t n);

@@ -666,6 +666,7 @@ int sc_case_check_step(sc_case_check *k, size_t budget_bytes)
         const size_t n = todo < (uint64_t)left ? (size_t)todo : left;
         k->crc = sc_crc32_update(k->crc, k->bytes + k->sec_off[k->sec_index] + k->sec_done, n);
         k->sec_done += n;
+        k->bytes_done += n;
         left -= n;
         if (k->sec_done == n_sec) {
             if (sc_crc32_final(k->crc) != k->sec_crc[k->sec_index]) {
@@ -684,6 +685,7 @@ int sc_case_check_step(sc_case_check *k, size_t budget_bytes)
         const uint8_t m = label_max(k->labels + k->label_done, n);
         k->label_max = m > k->label_max ? m : k->label_max;
         k->label_done += n;
+        k->bytes_done += n;
         left -= n;
     }
     if (k->sec_index == k->sec_count && k->label_done == k->label_count) {

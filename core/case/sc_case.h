@@ -173,6 +173,7 @@ typedef struct sc_case_check {
     uint64_t label_count;
     uint64_t label_done;
     uint8_t label_max;
+    uint64_t bytes_done;  /* payload and label bytes checked so far */
 } sc_case_check;
 
 /* O(sections). Errors: SC_ERR_INVALID_ARG and the framing errors of sc_case_load. */

@@ -414,7 +414,7 @@ int main(int argc, char **argv)
                                        : "");
         return 1;
     }
-    const sc_case *cs = &rig.engine.slot.c;
+    const sc_case *cs = sc_engine_get_case(&rig.engine);
 
     /* probe: emulator script or replay */
     FILE *replay = NULL;
@@ -508,13 +508,12 @@ int main(int argc, char **argv)
     sc_stats wall;
     sc_stats_reset(&wall);
 
-    const uint64_t period = rig.engine.sched.period_ns;
+    const uint64_t period = sc_engine_get_sched(&rig.engine)->period_ns;
     const uint64_t t0 = rig.clock.now_ns;
     const uint32_t frames = (uint32_t)ceil(o.seconds * 1e9 / (double)period);
     for (uint32_t i = 0; i < frames; i++) {
         /* release time of the frame about to run */
-        const uint64_t release = rig.engine.sched.started ? rig.engine.sched.next_release_ns
-                                                          : rig.clock.now_ns;
+        const uint64_t release = sc_engine_next_release_ns(&rig.engine);
         if (replay) {
             for (;;) {
                 if (!have_pending) {
@@ -593,7 +592,9 @@ int main(int argc, char **argv)
     /* summary */
     sc_engine_status st;
     sc_engine_get_status(&rig.engine, &st);
-    const sc_trk_counters *tc = sc_tracker_counters(&rig.engine.tracker);
+    const sc_tracker *trk = sc_engine_get_tracker(&rig.engine);
+    const sc_trk_counters *tc = sc_tracker_counters(trk);
+    const sc_tissue *tis = sc_engine_get_tissue(&rig.engine);
     const uint64_t last_hash =
         rig.display.hash_count ? rig.display.hashes[rig.display.hash_count - 1u] : 0u;
     snprintf(path, sizeof(path), "%s/summary.txt", o.out_dir);
@@ -607,8 +608,8 @@ int main(int argc, char **argv)
         fprintf(f, "sonocomp host simulator run\n");
         fprintf(f, "case            %s (%s), volume %ux%ux%u, mesh %ux%ux%u = %u nodes, %u tets\n",
                 cs->name, case_name, cs->volume.dim[0], cs->volume.dim[1], cs->volume.dim[2],
-                cs->mesh.nx, cs->mesh.ny, cs->mesh.nz, rig.engine.tissue.mesh.node_count,
-                rig.engine.tissue.mesh.tet_count);
+                cs->mesh.nx, cs->mesh.ny, cs->mesh.nz, tis ? tis->mesh.node_count : 0u,
+                tis ? tis->mesh.tet_count : 0u);
         fprintf(f, "probe           %s%s, %.2f s simulated, %u frames at %u Hz\n",
                 replay ? "replay of " : (o.csv_path ? "csv " : "script "),
                 replay ? o.replay_path : (o.csv_path ? o.csv_path : o.script), o.seconds,
@@ -625,8 +626,8 @@ int main(int argc, char **argv)
         fprintf(f, "tracker         %u frames, %u poses accepted, %u E2E rejects, "
                    "%u implausible, %u lift events\n",
                 tc->frames, tc->outcome[SC_TRK_POSE_ACCEPTED],
-                sc_tracker_rejected_e2e(&rig.engine.tracker),
-                sc_tracker_rejected_implausible(&rig.engine.tracker), tc->lift_events);
+                sc_tracker_rejected_e2e(trk), sc_tracker_rejected_implausible(trk),
+                tc->lift_events);
         fprintf(f, "bus faults      injected: %" PRIu64 " dropped, %" PRIu64 " corrupted, %" PRIu64
                    " duplicated, %" PRIu64 " reordered\n",
                 rig.bus.injected.dropped, rig.bus.injected.corrupted,

@@ -244,7 +244,30 @@ static int apply_sets(const cli *a, sc_rtcfg *cfg)
 
 /* ---- engine definition from the configuration ------------------------------------------- */
 
-static sc_engine_def engine_def_from(const sc_rtcfg *c)
+/* The case catalogue of CmdSelectCase: the configured case is index 0, then every other
+ * *.scase file of the case folder in name order, up to SC_ENGINE_MAX_CASES. */
+static void catalogue(const sc_rtcfg *c, const char *case_dir, sc_engine_def *d)
+{
+    static char listed[SC_ENGINE_MAX_CASES][SC_STORAGE_LINUX_NAME_MAX];
+    uint32_t n = 0;
+    const int rc = sc_storage_linux_list(case_dir, ".scase", listed, SC_ENGINE_MAX_CASES, &n);
+    if (rc != 0 && rc != SC_ERR_NO_SPACE) {
+        sc_log_linux_msg(&g_log, SC_LOG_WARN, "case_folder_unreadable", "dir=%s err=%s",
+                         case_dir ? case_dir : ".", sc_err_name(rc));
+    } else if (rc == SC_ERR_NO_SPACE) {
+        sc_log_linux_msg(&g_log, SC_LOG_WARN, "case_catalogue_full", "dir=%s listed=%u",
+                         case_dir ? case_dir : ".", (unsigned)n);
+    }
+    d->case_names[0] = c->case_path;
+    d->case_count = 1u;
+    for (uint32_t i = 0; i < n && d->case_count < SC_ENGINE_MAX_CASES; i++) {
+        if (strcmp(listed[i], c->case_path) != 0) {
+            d->case_names[d->case_count++] = listed[i];
+        }
+    }
+}
+
+static sc_engine_def engine_def_from(const sc_rtcfg *c, const char *case_dir)
 {
     sc_engine_def d = sc_engine_default_def();
     d.sched.rate_hz = c->frame_rate_hz;
@@ -270,8 +293,7 @@ static sc_engine_def engine_def_from(const sc_rtcfg *c)
         d.bscan.tgc_db[i] = c->image_tgc_db[i];
     }
     d.bscan.dynamic_range_db = c->image_dynamic_range_db;
-    d.case_names[0] = c->case_path;
-    d.case_count = 1u;
+    catalogue(c, case_dir, &d);
     return d;
 }
 
@@ -296,8 +318,9 @@ static void status_tick(const sc_engine *e, double fps, const sc_rtcfg *cfg, int
         double pct = 100.0 * (1.0 - (double)st.vein_area_ratio);
         snprintf(comp, sizeof comp, "%.0f%%", pct < 0.0 ? 0.0 : pct);
     }
-    const char *slash = strrchr(cfg->case_path, '/');
-    const char *case_name = st.case_loaded ? (slash ? slash + 1 : cfg->case_path) : "none";
+    const sc_case *running = sc_engine_get_case(e);
+    const char *case_name = running ? running->name : "none";
+    (void)cfg;
     if (terminal) {
         char line[480];
         snprintf(line, sizeof line,
@@ -315,7 +338,7 @@ static void status_tick(const sc_engine *e, double fps, const sc_rtcfg *cfg, int
                          sc_health_state_name(st.state), fps, ms(st.worst_frame_ns),
                          ms(st.p99_frame_ns), (unsigned long long)st.misses,
                          st.probe_tracked ? "ok" : "lifted", st.probe_contact,
-                         st.case_loaded ? cfg->case_path : "none", method_name(st.method), comp,
+                         case_name, method_name(st.method), comp,
                          (unsigned)st.faults);
     }
 }
@@ -331,11 +354,12 @@ static void final_report(const sc_engine *e, double wall_s, const char *stop_rea
                          const sc_display_dev *disp, const sc_rt_report *rt,
                          const sc_udp_display *udp)
 {
-    const sc_sched *s = &e->sched;
-    const double period_ms = 1000.0 / (double)e->def.sched.rate_hz;
+    const sc_sched *s = sc_engine_get_sched(e);
+    const double period_ms = (double)s->period_ns / 1e6;
+    const unsigned rate_hz = (unsigned)(1e9 / (double)s->period_ns + 0.5);
     printf("sonocomp final statistics\n");
     printf("  stopped by %s after %.1f s; %llu frames at %u Hz (period %.3f ms), %.2f fps\n",
-           stop_reason, wall_s, (unsigned long long)s->frames, (unsigned)e->def.sched.rate_hz,
+           stop_reason, wall_s, (unsigned long long)s->frames, rate_hz,
            period_ms, wall_s > 0.0 ? (double)s->frames / wall_s : 0.0);
     printf("  deadline misses %llu (%.3f%%), release times skipped %llu\n",
            (unsigned long long)s->misses,
@@ -362,7 +386,7 @@ static void final_report(const sc_engine *e, double wall_s, const char *stop_rea
                (unsigned long long)udp->lines_sent, (unsigned long long)udp->lines_dropped,
                (unsigned long long)udp->lines_injected, (unsigned long long)udp->send_errors);
     }
-    const sc_engine_counters *c = &e->counters;
+    const sc_engine_counters *c = sc_engine_get_counters(e);
     printf("  CAN rx frames %llu (burst-limited frames %llu), tx failed %llu\n",
            (unsigned long long)c->can_rx_frames, (unsigned long long)c->can_rx_burst_limited,
            (unsigned long long)c->can_tx_failed);
@@ -674,7 +698,7 @@ int main(int argc, char **argv)
     sc_engine *e = &g_engine;
     int engine_ok = 0;
     if (exit_code == EXIT_OK) {
-        const sc_engine_def def = engine_def_from(&cfg);
+        const sc_engine_def def = engine_def_from(&cfg, a.case_dir);
         int rc = sc_engine_init(e, &def, &hal);
         if (rc != 0) {
             sc_log_linux_msg(&g_log, SC_LOG_ERROR, "engine_init_failed", "err=%s (%s)",
@@ -711,8 +735,9 @@ int main(int argc, char **argv)
             sc_engine_step(e, &fr);
             const uint64_t now = sc_rt_now_ns();
             if (now >= next_status) {
-                fps = (double)(e->sched.frames - frames_at_status) * 1e9 / (double)(now - t_status);
-                frames_at_status = e->sched.frames;
+                const uint64_t frames_now = sc_engine_get_sched(e)->frames;
+                fps = (double)(frames_now - frames_at_status) * 1e9 / (double)(now - t_status);
+                frames_at_status = frames_now;
                 t_status = now;
                 next_status += 1000000000u;
                 if (next_status <= now) {
@@ -722,7 +747,7 @@ int main(int argc, char **argv)
                     status_tick(e, fps, &cfg, terminal);
                 }
             }
-            if (a.frames && e->sched.frames >= a.frames) {
+            if (a.frames && sc_engine_get_sched(e)->frames >= a.frames) {
                 stop_reason = "frame limit";
                 break;
             }

@@ -1,6 +1,7 @@
 /* sc_storage_linux.c: mmap'd read-only case files, see sc_storage_linux.h. */
 #include "sc_storage_linux.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
@@ -98,4 +99,54 @@ void sc_storage_linux_init(sc_storage_linux *s, const char *base_dir)
 sc_storage_dev sc_storage_linux_dev(sc_storage_linux *s)
 {
     return (sc_storage_dev){.ops = &sc_storage_linux_ops, .ctx = s};
+}
+
+int sc_storage_linux_list(const char *dir, const char *suffix,
+                          char (*names)[SC_STORAGE_LINUX_NAME_MAX], uint32_t max,
+                          uint32_t *count)
+{
+    if (!suffix || !names || !count) {
+        return SC_ERR_INVALID_ARG;
+    }
+    *count = 0;
+    const char *d = (dir && dir[0] != '\0') ? dir : ".";
+    DIR *dp = opendir(d);
+    if (!dp) {
+        return errno == ENOENT ? SC_ERR_NOT_FOUND : SC_ERR_IO;
+    }
+    const size_t sl = strlen(suffix);
+    int rc = 0;
+    for (struct dirent *de = readdir(dp); de != NULL; de = readdir(dp)) {
+        const size_t n = strlen(de->d_name);
+        if (n <= sl || n >= SC_STORAGE_LINUX_NAME_MAX || strcmp(de->d_name + n - sl, suffix) != 0 ||
+            de->d_name[0] == '.') {
+            continue;
+        }
+        struct stat st;
+        if (fstatat(dirfd(dp), de->d_name, &st, 0) != 0 || !S_ISREG(st.st_mode)) {
+            continue;
+        }
+        /* insertion in order; beyond max the last in order falls off */
+        uint32_t i = *count;
+        while (i > 0u && strcmp(names[i - 1u], de->d_name) > 0) {
+            i--;
+        }
+        if (i >= max) {
+            rc = SC_ERR_NO_SPACE;
+            continue;
+        }
+        const uint32_t last = *count < max ? *count : max - 1u;
+        if (*count >= max) {
+            rc = SC_ERR_NO_SPACE;
+        }
+        for (uint32_t j = last; j > i; j--) {
+            memcpy(names[j], names[j - 1u], SC_STORAGE_LINUX_NAME_MAX);
+        }
+        memcpy(names[i], de->d_name, n + 1u);
+        if (*count < max) {
+            (*count)++;
+        }
+    }
+    closedir(dp);
+    return rc;
 }

@@ -27,6 +27,19 @@ typedef struct sc_storage_linux {
     uint32_t open_count;  /* mappings currently open */
 } sc_storage_linux;
 
+#ifndef SC_STORAGE_LINUX_NAME_MAX
+#define SC_STORAGE_LINUX_NAME_MAX 256u /* a listed file name, with the NUL */
+#endif
+
+/* The regular files in dir (NULL: the working directory) whose names end in suffix, sorted
+ * by name (strcmp), at most max of them into names[0..*count). Names that do not fit
+ * SC_STORAGE_LINUX_NAME_MAX are skipped. O(directory entries x max). Errors: SC_ERR_INVALID_ARG,
+ * SC_ERR_NOT_FOUND / SC_ERR_IO (the directory cannot be read), SC_ERR_NO_SPACE (more than max
+ * files: the first max in order are listed). */
+int sc_storage_linux_list(const char *dir, const char *suffix,
+                          char (*names)[SC_STORAGE_LINUX_NAME_MAX], uint32_t max,
+                          uint32_t *count);
+
 /* base_dir may be NULL; the string must outlive the storage. */
 void sc_storage_linux_init(sc_storage_linux *s, const char *base_dir);
 sc_storage_dev sc_storage_linux_dev(sc_storage_linux *s);

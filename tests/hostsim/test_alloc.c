@@ -90,7 +90,7 @@ static void run_frames(uint32_t n)
 {
     for (uint32_t i = 0; i < n; i++) {
         const uint64_t release =
-            rig.engine.sched.started ? rig.engine.sched.next_release_ns : rig.clock.now_ns;
+            sc_engine_next_release_ns(&rig.engine);
         (void)sc_emu_feed(&emu, release - t0, send_peer, &rig.peer);
         sc_engine_step(&rig.engine, NULL);
     }
@@ -137,7 +137,7 @@ static void counter_sees_an_allocation_inside_a_frame(void **state)
 {
     (void)state;
     rig_up(SC_TISSUE_MSDS);
-    assert_int_equal(sc_engine_add_stage(&rig.engine, "leaky", leaky_stage), SC_OK);
+    assert_int_equal(sc_engine_set_hook(&rig.engine, leaky_stage, NULL), SC_OK);
     allocs = 0;
     counting = 1;
     run_frames(100);

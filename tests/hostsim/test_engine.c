@@ -125,8 +125,7 @@ static run_result run(uint32_t n, int use_emu, double stop_emu_at_s)
     int more = use_emu;
     sc_can_frame f[SC_EMU_MAX_FRAMES];
     for (uint32_t i = 0; i < n; i++) {
-        const uint64_t release = rig.engine.sched.started ? rig.engine.sched.next_release_ns
-                                                          : rig.clock.now_ns;
+        const uint64_t release = sc_engine_next_release_ns(&rig.engine);
         while (more && t0 + next_ns <= release) {
             if (stop_emu_at_s >= 0.0 && (double)next_ns * 1e-9 >= stop_emu_at_s) {
                 more = 0;
@@ -155,7 +154,7 @@ static run_result run(uint32_t n, int use_emu, double stop_emu_at_s)
             hashes[i] = rig.display.hash_count ? rig.display.hashes[rig.display.hash_count - 1u]
                                                : 0u;
         }
-        if (st.probe_tracked && !pose_was_sent(&rig.engine.probe_tracker)) {
+        if (st.probe_tracked && !pose_was_sent(&rig.engine.probe.pose_tracker)) {
             r.bad_pose_frames++;
         }
         if (st.probe_contact) {
@@ -283,8 +282,7 @@ static void replay_of_a_recorded_faulty_session_reproduces_every_frame(void **st
     rig_up("block", 99);
     uint32_t next = 0;
     for (uint32_t i = 0; i < 180; i++) {
-        const uint64_t release = rig.engine.sched.started ? rig.engine.sched.next_release_ns
-                                                          : rig.clock.now_ns;
+        const uint64_t release = sc_engine_next_release_ns(&rig.engine);
         while (next < rec_tape.n) {
             sc_candump_rec r;
             sc_candump_reject why;
@@ -372,7 +370,7 @@ static void silent_tracker_lifts_the_probe_and_the_tissue_relaxes(void **state)
     start_emu(&d);
     /* press script: descend 0.5..1.5 s, hold 1.5..2.5 s: silence from 2.0 s, mid-hold */
     run(120, 1, 2.0);
-    assert_true(rig.engine.probe_contact);
+    assert_true(rig.engine.tissue_out.contact);
     run_result r = run(150, 1, 2.0); /* 2.5 s of silence */
     (void)r;
     sc_engine_status st;
@@ -383,8 +381,8 @@ static void silent_tracker_lifts_the_probe_and_the_tissue_relaxes(void **state)
     assert_int_equal(st.state, SC_HEALTH_DEGRADED);
     assert_true(sc_tracker_counters(&rig.engine.tracker)->lift_events >= 1u);
     /* back at rest: within 1% of the box size (the physics issue's criterion) */
-    const sc_mesh *m = &rig.engine.tissue.mesh;
-    const sc_nodes *nd = &rig.engine.tissue.nodes;
+    const sc_mesh *m = &sc_engine_get_tissue(&rig.engine)->mesh;
+    const sc_nodes *nd = &sc_engine_get_tissue(&rig.engine)->nodes;
     const float box = fmaxf(block.scene.mesh.size_mm[0],
                             fmaxf(block.scene.mesh.size_mm[1], block.scene.mesh.size_mm[2]));
     float worst = 0.0f;
@@ -473,7 +471,7 @@ static void sustained_misses_are_logged_once_a_second_and_all_counted(void **sta
 {
     (void)state;
     rig_up("block", 6);
-    assert_int_equal(sc_engine_add_stage(&rig.engine, "slow", slow_stage), SC_OK);
+    assert_int_equal(sc_engine_set_hook(&rig.engine, slow_stage, NULL), SC_OK);
     overload = 1;
     const uint64_t t_start = rig.clock.now_ns;
     run(200, 0, -1.0); /* 200 frames of 1.5 periods: 5 s at 60 Hz */
@@ -514,9 +512,12 @@ static void commands_over_can_select_case_and_method_and_bad_ones_are_refused(vo
     send_cmd(&c, 0);
     sc_cmd m = {.kind = SC_CMD_SET_METHOD, .method = SC_METHOD_FEM};
     send_cmd(&m, 0);
+    /* the switch is prepared between frames (open, validate, build, swap) */
     run(2, 0, -1.0);
+    assert_int_equal(rig.engine.case_id, 0);
+    run(4, 0, -1.0);
     assert_int_equal(rig.engine.case_id, 1);
-    assert_int_equal(rig.engine.tissue.method, SC_TISSUE_FEM);
+    assert_int_equal(sc_engine_get_tissue(&rig.engine)->method, SC_TISSUE_FEM);
     sc_cmd bad = {.kind = SC_CMD_SELECT_CASE, .case_id = 9}; /* not in the catalogue */
     send_cmd(&bad, 1);
     run(2, 0, -1.0);
