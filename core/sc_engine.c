@@ -351,10 +351,10 @@ static void switch_refused(sc_engine *e, int rc)
     sc_log(&e->hal->log, SC_LOG_ERROR, "case_refused", rc, (int64_t)e->sw.case_id, 0);
 }
 
-/* Build the next case's tissue into `slot` (the standby slot, or the running one with a single
- * slot). Limits were checked by the loader, so this fails only on a capacity the loader cannot
- * see. */
-static int build_tissue(sc_engine *e, uint32_t slot)
+/* Begin building the next case's tissue into `slot` (the standby slot, or the running one with
+ * a single slot). Limits were checked by the loader, so the build fails only on a capacity the
+ * loader cannot see. */
+static int build_begin(sc_engine *e, uint32_t slot)
 {
     const sc_case *c = &e->sw.c;
     sc_material_table mat;
@@ -374,7 +374,7 @@ static int build_tissue(sc_engine *e, uint32_t slot)
         td.skin.size_mm[a] = c->mesh.size_mm[a] + 2.0f * SC_ENGINE_SKIN_MARGIN_MM;
     }
     td.skin.z_mm = c->mesh.origin_mm[2];
-    return sc_tissue_init(&e->tissue[slot], &td, &c->volume, &mat, (uint8_t)SC_LABEL_FAT);
+    return sc_tissue_build_begin(&e->tissue[slot], &td, &c->volume, &mat, (uint8_t)SC_LABEL_FAT);
 }
 
 /* Between two frames: the new case becomes the running one. */
@@ -382,7 +382,11 @@ static int swap_case(sc_engine *e, uint32_t slot)
 {
     sc_bscan_def bd = e->bscan.def;
     bd.scan.image_to_probe = e->sw.c.image_to_probe;
-    int rc = sc_bscan_set_def(&e->bscan, &bd);
+    /* a method command during the build applies to the new tissue too */
+    int rc = sc_tissue_set_method(&e->tissue[slot], e->def.tissue.method);
+    if (rc == SC_OK) {
+        rc = sc_bscan_set_def(&e->bscan, &bd);
+    }
     if (rc == SC_OK) {
         rc = sc_bscan_attach_mesh(&e->bscan, &e->tissue[slot].mesh);
     }
@@ -440,25 +444,22 @@ static void switch_slice(sc_engine *e)
                 sw->phase = SC_SWITCH_BUILD;
             }
         }
+        if (rc == SC_OK && sw->phase == SC_SWITCH_BUILD) {
+            rc = build_begin(e, standby);
+        }
         rc = rc > 0 ? SC_OK : rc;
         break;
     }
     case SC_SWITCH_BUILD:
-        if (SC_ENGINE_TISSUE_SLOTS == 1u) {
-            /* in place: the running case ends here */
-            e->case_loaded = 0;
-        }
-        rc = build_tissue(e, standby);
-        if (rc == SC_OK) {
-            sw->phase = SC_SWITCH_SWAP;
-            if (SC_ENGINE_TISSUE_SLOTS > 1u) {
-                break; /* swapped in a slice of its own */
-            }
-            rc = swap_case(e, standby);
-            sw->phase = SC_SWITCH_IDLE;
-        } else if (SC_ENGINE_TISSUE_SLOTS == 1u) {
+        if (SC_ENGINE_TISSUE_SLOTS == 1u && e->case_loaded) {
+            /* in place: the running case ends here, no case runs until the swap */
             sc_case_slot_close(&e->slot);
             set_no_case(e);
+        }
+        rc = sc_tissue_build_step(&e->tissue[standby]);
+        if (rc == 1) {
+            sw->phase = SC_SWITCH_SWAP;
+            rc = SC_OK;
         }
         break;
     case SC_SWITCH_SWAP:
@@ -473,15 +474,16 @@ static void switch_slice(sc_engine *e)
     }
 }
 
-static sc_engine_slice slice_kind(sc_switch_phase p)
+static sc_engine_slice slice_kind(const sc_engine *e)
 {
-    switch (p) {
+    const uint32_t standby = SC_ENGINE_TISSUE_SLOTS > 1u ? 1u - e->active : 0u;
+    switch (e->sw.phase) {
     case SC_SWITCH_OPEN:
         return SC_ENGINE_SLICE_OPEN;
     case SC_SWITCH_VALIDATE:
         return SC_ENGINE_SLICE_VALIDATE;
     case SC_SWITCH_BUILD:
-        return SC_ENGINE_SLICE_BUILD;
+        return (sc_engine_slice)(SC_ENGINE_SLICE_BUILD + e->tissue[standby].build_phase);
     case SC_SWITCH_SWAP:
     case SC_SWITCH_IDLE:
         break;
@@ -492,7 +494,7 @@ static sc_engine_slice slice_kind(sc_switch_phase p)
 /* Run one slice now; its cost is recorded. */
 static void run_slice(sc_engine *e)
 {
-    const sc_engine_slice kind = slice_kind(e->sw.phase);
+    const sc_engine_slice kind = slice_kind(e);
     const uint64_t bytes_before = e->sw.check.bytes_done;
     const uint64_t t0 = now_ns(e);
     switch_slice(e);
@@ -517,7 +519,7 @@ static void control_step(sc_engine *e)
     if (e->sw.phase == SC_SWITCH_IDLE) {
         return;
     }
-    const sc_engine_slice kind = slice_kind(e->sw.phase);
+    const sc_engine_slice kind = slice_kind(e);
     const uint64_t need = e->counters.control_slices[kind] > 0u
                               ? e->counters.control_worst_ns[kind]
                               : (uint64_t)e->def.control_slice_estimate_ns;

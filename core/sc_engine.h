@@ -34,16 +34,17 @@
  *            (O(SC_CAN_CMD_QUEUE_MAX)), then at most one slice of a pending case switch:
  *              open      the storage mapping, the file's framing (O(sections));
  *              validate  at most case_check_slice_bytes of CRC / label pass (sc_case.h);
- *              build     the next case's tissue in the standby slot (sc_tissue_init:
- *                        O(tets + nodes) plus the FEM assembly) while the running case runs;
+ *              build     the next case's tissue in the standby slot, one build phase per
+ *                        slice (sc_tissue_build_step: mesh and labels, springs, MSDS, FEM,
+ *                        contact; each O(tets) or O(nodes)) while the running case runs;
  *              swap      imaging attached to the new mesh (O(tets)), calibration taken, the
  *                        slots exchanged: the next frame runs the new case.
  *            A slice runs only when the slack left is at least the longest that kind of slice
  *            has taken so far (measured on the HAL clock; def.control_slice_estimate_ns until
  *            then), so a switch never makes a frame miss; a slice that has waited
  *            control_wait_frames frames runs anyway (counted in control_forced). With one
- *            tissue slot (SC_ENGINE_TISSUE_SLOTS 1, the MCU) build and swap are one slice that
- *            replaces the running tissue.
+ *            tissue slot (SC_ENGINE_TISSUE_SLOTS 1, the MCU) the build replaces the running
+ *            tissue: from its first phase to the swap no case runs (dark frames).
  *
  * ---- Rules ----------------------------------------------------------------------------------
  * Threads: one thread drives an engine; the getters may be called between steps.
@@ -96,12 +97,13 @@ typedef enum sc_engine_stage {
 } sc_engine_stage;
 _Static_assert(SC_ENGINE_STAGE_COUNT <= SC_SCHED_MAX_STAGES, "scheduler timing slots");
 
-/* Kinds of control slices (their worst times are tracked separately). */
+/* Kinds of control slices (their worst times are tracked separately); the build slices are
+ * the tissue's build phases (sc_tissue_build_phase), one per slice. */
 typedef enum sc_engine_slice {
     SC_ENGINE_SLICE_OPEN = 0,
     SC_ENGINE_SLICE_VALIDATE,
-    SC_ENGINE_SLICE_BUILD,
-    SC_ENGINE_SLICE_SWAP,
+    SC_ENGINE_SLICE_BUILD, /* + sc_tissue_build_phase */
+    SC_ENGINE_SLICE_SWAP = SC_ENGINE_SLICE_BUILD + SC_TISSUE_BUILD_DONE,
     SC_ENGINE_SLICE_COUNT
 } sc_engine_slice;
 

@@ -52,8 +52,8 @@ void sc_tissue_reset(sc_tissue *t)
     t->stats.max_disp_mm = 0.0f;
 }
 
-int sc_tissue_init(sc_tissue *t, const sc_tissue_def *def, const sc_volume *vol,
-                   const sc_material_table *mat, uint8_t default_label)
+int sc_tissue_build_begin(sc_tissue *t, const sc_tissue_def *def, const sc_volume *vol,
+                          const sc_material_table *mat, uint8_t default_label)
 {
     if (t == NULL || def == NULL || mat == NULL) {
         return SC_ERR_INVALID_ARG;
@@ -61,41 +61,29 @@ int sc_tissue_init(sc_tissue *t, const sc_tissue_def *def, const sc_volume *vol,
     if (def->method != SC_TISSUE_MSDS && def->method != SC_TISSUE_FEM) {
         return SC_ERR_INVALID_ARG;
     }
-    int rc = sc_material_table_validate(mat);
+    t->build_phase = SC_TISSUE_BUILD_DONE; /* not usable until the last phase */
+    const int rc = sc_material_table_validate(mat);
     if (rc != SC_OK) {
         return rc;
     }
     t->def = *def;
     t->method = def->method;
     t->mat = *mat;
+    t->build_vol = vol;
+    t->build_label = default_label;
     memset(&t->stats, 0, sizeof t->stats);
-    rc = sc_mesh_build(&t->mesh, &def->mesh);
+    t->build_phase = SC_TISSUE_BUILD_MESH;
+    return SC_OK;
+}
+
+static int build_contact(sc_tissue *t)
+{
+    int rc = sc_collider_init(&t->collider, &t->def.collider);
     if (rc != SC_OK) {
         return rc;
     }
-    rc = sc_material_assign(&t->mesh, vol, &t->mat, default_label);
-    if (rc != SC_OK) {
-        return rc;
-    }
-    rc = sc_springs_from_tets(&t->springs, (const uint32_t(*)[4])t->mesh.tet,
-                              t->mesh.tet_label, t->mesh.tet_count, &t->mat);
-    if (rc != SC_OK) {
-        return rc;
-    }
-    rc = sc_msds_init(&t->msds, &t->mesh, &t->springs, &t->mat, &def->msds);
-    if (rc != SC_OK) {
-        return rc;
-    }
-    rc = sc_fem_init(&t->fem, &t->mesh, &t->mat, &def->fem);
-    if (rc != SC_OK) {
-        return rc;
-    }
-    rc = sc_collider_init(&t->collider, &def->collider);
-    if (rc != SC_OK) {
-        return rc;
-    }
-    sc_skin_def sd = def->skin;
-    if (!def->skin_enabled) {
+    sc_skin_def sd = t->def.skin;
+    if (!t->def.skin_enabled) {
         /* a minimal, never stepped surface keeps the struct valid */
         sd = sc_skin_default_def();
         sd.nx = 2u;
@@ -105,10 +93,57 @@ int sc_tissue_init(sc_tissue *t, const sc_tissue_def *def, const sc_volume *vol,
     if (rc != SC_OK) {
         return rc;
     }
-    const float *s = def->mesh.size_mm;
+    const float *s = t->def.mesh.size_mm;
     t->box_diag_mm = sqrtf(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
     sc_tissue_reset(t);
     return SC_OK;
+}
+
+int sc_tissue_build_step(sc_tissue *t)
+{
+    if (t == NULL || t->build_phase >= SC_TISSUE_BUILD_DONE) {
+        return SC_ERR_STATE;
+    }
+    int rc = SC_OK;
+    switch ((sc_tissue_build_phase)t->build_phase) {
+    case SC_TISSUE_BUILD_MESH:
+        rc = sc_mesh_build(&t->mesh, &t->def.mesh);
+        if (rc == SC_OK) {
+            rc = sc_material_assign(&t->mesh, t->build_vol, &t->mat, t->build_label);
+        }
+        break;
+    case SC_TISSUE_BUILD_SPRINGS:
+        rc = sc_springs_from_tets(&t->springs, (const uint32_t(*)[4])t->mesh.tet,
+                                  t->mesh.tet_label, t->mesh.tet_count, &t->mat);
+        break;
+    case SC_TISSUE_BUILD_MSDS:
+        rc = sc_msds_init(&t->msds, &t->mesh, &t->springs, &t->mat, &t->def.msds);
+        break;
+    case SC_TISSUE_BUILD_FEM:
+        rc = sc_fem_init(&t->fem, &t->mesh, &t->mat, &t->def.fem);
+        break;
+    case SC_TISSUE_BUILD_CONTACT:
+        rc = build_contact(t);
+        break;
+    case SC_TISSUE_BUILD_DONE:
+        break;
+    }
+    if (rc != SC_OK) {
+        t->build_phase = SC_TISSUE_BUILD_DONE;
+        return rc;
+    }
+    t->build_phase++;
+    return t->build_phase == SC_TISSUE_BUILD_DONE ? 1 : 0;
+}
+
+int sc_tissue_init(sc_tissue *t, const sc_tissue_def *def, const sc_volume *vol,
+                   const sc_material_table *mat, uint8_t default_label)
+{
+    int rc = sc_tissue_build_begin(t, def, vol, mat, default_label);
+    while (rc == SC_OK) {
+        rc = sc_tissue_build_step(t);
+    }
+    return rc == 1 ? SC_OK : rc;
 }
 
 int sc_tissue_set_method(sc_tissue *t, sc_tissue_method m)

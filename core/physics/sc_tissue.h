@@ -80,8 +80,21 @@ typedef struct sc_tissue_stats {
     float max_disp_mm;          /* largest node displacement after the last frame */
 } sc_tissue_stats;
 
+/* The phases of a build, in order (sc_tissue_build_step runs one). */
+typedef enum sc_tissue_build_phase {
+    SC_TISSUE_BUILD_MESH = 0, /* grid, tets, labels from the volume: O(tets) */
+    SC_TISSUE_BUILD_SPRINGS,  /* Algorithm 1: O(tets) */
+    SC_TISSUE_BUILD_MSDS,     /* masses, spring families, mass scaling: O(nodes x power its) */
+    SC_TISSUE_BUILD_FEM,      /* pattern and assembly: O(tets) */
+    SC_TISSUE_BUILD_CONTACT,  /* collider, skin, state at rest: O(nodes + skin) */
+    SC_TISSUE_BUILD_DONE
+} sc_tissue_build_phase;
+
 typedef struct sc_tissue {
     sc_tissue_def def;
+    uint8_t build_phase;         /* sc_tissue_build_phase; DONE once usable or after an error */
+    uint8_t build_label;         /* default label of the build */
+    const sc_volume *build_vol;  /* the build's label source (may be NULL) */
     sc_tissue_method method;
     sc_material_table mat;
     sc_mesh mesh;
@@ -109,6 +122,15 @@ sc_tissue_def sc_tissue_default_def(void);
  * sc_fem_init, sc_collider_init, sc_skin_init. */
 int sc_tissue_init(sc_tissue *t, const sc_tissue_def *def, const sc_volume *vol,
                    const sc_material_table *mat, uint8_t default_label);
+
+/* The same build in phases (sc_tissue_build_phase), for a case switch prepared between frames
+ * while another tissue runs: begin validates and keeps the inputs (vol must stay valid until the
+ * last step; O(1)); each step runs the next phase (its cost above) and returns 0 (more
+ * phases), 1 (built, state at rest), or the phase's error (then the tissue is unusable until
+ * built again). Step errors: SC_ERR_STATE (no build begun), and those of sc_tissue_init. */
+int sc_tissue_build_begin(sc_tissue *t, const sc_tissue_def *def, const sc_volume *vol,
+                          const sc_material_table *mat, uint8_t default_label);
+int sc_tissue_build_step(sc_tissue *t);
 
 /* Run one frame with the probe at *probe (volume frame), or no contact (probe == NULL).
  * Cost: MSDS O(iterations * 14 N + iterations * contacts); FEM: see sc_fem_step; collider
