@@ -515,7 +515,10 @@ static void commands_over_can_select_case_and_method_and_bad_ones_are_refused(vo
     /* the switch is prepared between frames (open, validate, build, swap) */
     run(2, 0, -1.0);
     assert_int_equal(rig.engine.case_id, 0);
-    run(4, 0, -1.0);
+    assert_int_not_equal(rig.engine.sw.phase, SC_SWITCH_IDLE);
+    for (uint32_t i = 0; i < 60u && rig.engine.sw.phase != SC_SWITCH_IDLE; i++) {
+        run(1, 0, -1.0);
+    }
     assert_int_equal(rig.engine.case_id, 1);
     assert_int_equal(sc_engine_get_tissue(&rig.engine)->method, SC_TISSUE_FEM);
     sc_cmd bad = {.kind = SC_CMD_SELECT_CASE, .case_id = 9}; /* not in the catalogue */
