@@ -194,6 +194,9 @@ typedef struct sc_image_out {
     float artery_area_ratio;
 } sc_image_out;
 
+_Static_assert(sizeof(sc_probe_in) == 1u * 4u + 28u + 48u + 28u, "sc_probe_in: flag, 3 poses");
+_Static_assert(sizeof(sc_image_out) == 12u, "sc_image_out: rc and two ratios");
+
 /* A case switch in progress (control step). */
 typedef enum sc_switch_phase {
     SC_SWITCH_IDLE = 0,

@@ -19,6 +19,9 @@ typedef struct sc_xform {
     float r[9];     /* row-major rotation */
     float t_mm[3];  /* translation */
 } sc_xform;
+/* passed by value through every stage: keep them small and unpadded */
+_Static_assert(sizeof(sc_pose) == 28u, "sc_pose: 7 float32");
+_Static_assert(sizeof(sc_xform) == 48u, "sc_xform: 12 float32");
 
 sc_pose sc_pose_identity(void);
 sc_xform sc_xform_identity(void);

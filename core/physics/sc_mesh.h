@@ -14,6 +14,7 @@
 #ifndef SC_MESH_H
 #define SC_MESH_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "sc_config.h"
@@ -54,6 +55,13 @@ typedef struct sc_nodes {
     SC_ALIGN_HOT float fy[SC_MAX_NODES];
     SC_ALIGN_HOT float fz[SC_MAX_NODES];
 } sc_nodes;
+/* nine float32 rows, each on its own hot alignment: nothing else lives in the node state */
+_Static_assert(sizeof(sc_nodes) >= 9u * sizeof(float) * SC_MAX_NODES &&
+                   sizeof(sc_nodes) < 9u * (sizeof(float) * SC_MAX_NODES + 64u),
+               "sc_nodes is nine aligned float32 rows");
+_Static_assert(offsetof(sc_nodes, y) % 64u == 0u && offsetof(sc_nodes, vx) % 64u == 0u &&
+                   offsetof(sc_nodes, fx) % 64u == 0u,
+               "node rows start on cache lines");
 
 /* Default definition: 32x16x16 nodes over a 40 x 20 x 30 mm box at the origin. */
 sc_mesh_def sc_mesh_default_def(void);
