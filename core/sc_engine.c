@@ -214,7 +214,7 @@ static void stage_status(sc_engine *e, uint64_t now, const sc_probe_in *probe,
         .artery_area_ratio = in->artery_area_ratio,
     };
     sc_can_frame out[SC_STATUS_FRAMES];
-    if (sc_tracker_encode_status(&e->tracker, &s, out) != SC_OK) {
+    if (sc_status_tx_encode(&e->status_tx, &e->tracker, &s, out) != SC_OK) {
         e->counters.can_tx_failed += SC_STATUS_FRAMES;
         return;
     }
@@ -590,6 +590,7 @@ int sc_engine_init(sc_engine *e, const sc_engine_def *def, const sc_hal *hal)
     if (rc == SC_OK) {
         rc = sc_tracker_init(&e->tracker, &def->tracker);
     }
+    sc_status_tx_init(&e->status_tx);
     if (rc == SC_OK) {
         rc = sc_bscan_init(&e->bscan, &def->bscan);
     }

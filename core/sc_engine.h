@@ -67,6 +67,7 @@
 #include "sc_hal.h"
 #include "sc_health.h"
 #include "sc_sched.h"
+#include "sc_status_tx.h"
 #include "sc_tissue.h"
 #include "sc_tracker.h"
 
@@ -224,6 +225,7 @@ typedef struct sc_engine {
     sc_health health;
     sc_engine_counters counters;
     sc_tracker tracker;
+    sc_status_tx status_tx;
     /* the running case: a validated view into storage bytes kept open while it runs */
     sc_case_slot slot;
     uint8_t case_loaded;

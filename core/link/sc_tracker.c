@@ -7,7 +7,7 @@
 
 _Static_assert(SC_MSG_CMD_CASE == 0 && SC_MSG_POSE_FD == 7, "rx message indices 0..7");
 _Static_assert(SC_TRK_RX_MSGS == (unsigned)SC_MSG_POSE_FD + 1u, "rx state per message");
-/* 1,104 bytes on x86_64 with the default SC_CAN_CMD_QUEUE_MAX of 8: 8 E2E receivers of 64 B,
+/* 1,088 bytes on x86_64 with the default SC_CAN_CMD_QUEUE_MAX of 8: 8 E2E receivers of 64 B,
  * 2 assembly slots of 56 B, the command FIFO (28 B each), counters (116 B). */
 _Static_assert(sizeof(sc_tracker) <= 1200u + 28u * SC_CAN_CMD_QUEUE_MAX, "tracker state grew");
 
@@ -134,9 +134,6 @@ int sc_tracker_init(sc_tracker *t, const sc_tracker_def *def)
             return rc;
         }
     }
-    sc_e2e_tx_init(&t->tx[0], sc_canproto_info(SC_MSG_STATUS)->data_id);
-    sc_e2e_tx_init(&t->tx[1], sc_canproto_info(SC_MSG_TIMING)->data_id);
-    sc_e2e_tx_init(&t->tx[2], sc_canproto_info(SC_MSG_DIAG)->data_id);
     return 0;
 }
 
@@ -459,14 +456,4 @@ uint32_t sc_tracker_rejected_implausible(const sc_tracker *t)
 const sc_e2e_rx *sc_tracker_e2e(const sc_tracker *t, sc_msg m)
 {
     return (unsigned)m < SC_TRK_RX_MSGS ? &t->rx[m] : NULL;
-}
-
-int sc_tracker_encode_status(sc_tracker *t, sc_status_msg *s, sc_can_frame out[SC_STATUS_FRAMES])
-{
-    s->probe_lifted = (uint8_t)(t->have_pose ? 0u : 1u);
-    s->poses_accepted = t->n.outcome[SC_TRK_POSE_ACCEPTED];
-    s->rejected_e2e = sc_tracker_rejected_e2e(t);
-    s->rejected_plausibility = sc_tracker_rejected_implausible(t);
-    s->lift_events = t->n.lift_events;
-    return sc_canproto_encode_status(s, t->tx, out);
 }

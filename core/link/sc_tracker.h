@@ -16,15 +16,15 @@
  *    without a speed check (the probe may come back anywhere);
  *  - decodes and range-checks commands into a small FIFO (SC_CAN_CMD_QUEUE_MAX) the engine
  *    takes from;
- *  - records controller error frames (SC_CAN_ERRF_* classes) for the health state;
- *  - encodes the engine's status frames with its own E2E sender states.
+ *  - records controller error frames (SC_CAN_ERRF_* classes) for the health state.
+ * The send side (status frames) is sc_status_tx.h.
  * Every outcome is counted (saturating uint32). Receive times (frame time stamp, else now_ns)
  * are used rounded down to whole microseconds, the resolution of a candump -l log, so that
  * replaying a recorded log reproduces every time-dependent decision bit for bit.
  *
  * Thread and memory rules: one sc_tracker object, caller-owned (inside the engine object),
  * used from one thread. Never allocates, never calls the OS; deterministic for a given frame
- * sequence and time stamps. sizeof(sc_tracker) = 1,104 bytes (x86_64, default limits).
+ * sequence and time stamps. sizeof(sc_tracker) = 1,088 bytes (x86_64, default limits).
  */
 #ifndef SC_TRACKER_H
 #define SC_TRACKER_H
@@ -121,7 +121,6 @@ typedef struct sc_trk_asm {
 typedef struct sc_tracker {
     sc_tracker_def def;
     sc_e2e_rx rx[SC_TRK_RX_MSGS]; /* indexed by sc_msg (commands, then pose messages) */
-    sc_e2e_tx tx[SC_STATUS_FRAMES];
     sc_trk_asm slot[SC_TRK_ASM_SLOTS];
     uint32_t slot_seq;
     uint8_t have_pose; /* a fresh valid pose exists (not lifted) */
@@ -165,10 +164,5 @@ uint32_t sc_tracker_rejected_e2e(const sc_tracker *t);
 uint32_t sc_tracker_rejected_implausible(const sc_tracker *t);
 /* E2E receiver state of a received message (commands and pose); NULL for others. */
 const sc_e2e_rx *sc_tracker_e2e(const sc_tracker *t, sc_msg m);
-
-/* Fills the tracker's fields of *s (probe_lifted, poses_accepted, rejected_e2e,
- * rejected_plausibility, lift_events; the engine fills the rest) and encodes the three status
- * frames with the tracker's E2E sender counters. Errors of sc_canproto_encode_status. */
-int sc_tracker_encode_status(sc_tracker *t, sc_status_msg *s, sc_can_frame out[SC_STATUS_FRAMES]);
 
 #endif /* SC_TRACKER_H */

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "sc_err.h"
+#include "sc_status_tx.h"
 #include "sc_tracker.h"
 
 #define MS UINT64_C(1000000)
@@ -371,7 +372,9 @@ static void status_frames_carry_the_tracker_counters(void **s)
     sc_status_msg st = {
         .state = 1, .case_id = 3, .vein_area_ratio = 1.0f, .artery_area_ratio = 1.0f};
     sc_can_frame f[3];
-    assert_int_equal(sc_tracker_encode_status(&trk, &st, f), 0);
+    sc_status_tx stx;
+    sc_status_tx_init(&stx);
+    assert_int_equal(sc_status_tx_encode(&stx, &trk, &st, f), 0);
     sc_status_msg d = {0};
     for (int i = 0; i < 3; i++) {
         assert_int_equal(sc_canproto_decode_status_part(&f[i], &d), 0);
