@@ -380,7 +380,8 @@ static int build_begin(sc_engine *e, uint32_t slot)
 /* Between two frames: the new case becomes the running one. */
 static int swap_case(sc_engine *e, uint32_t slot)
 {
-    sc_bscan_def bd = e->bscan.def;
+    const sc_bscan_def running_def = e->bscan.def;
+    sc_bscan_def bd = running_def;
     bd.scan.image_to_probe = e->sw.c.image_to_probe;
     /* a method command during the build applies to the new tissue too */
     int rc = sc_tissue_set_method(&e->tissue[slot], e->def.tissue.method);
@@ -393,6 +394,7 @@ static int swap_case(sc_engine *e, uint32_t slot)
     if (rc != SC_OK) {
         /* imaging cannot show the new mesh: keep the running case if it is intact */
         if (e->case_loaded && slot != e->active) {
+            (void)sc_bscan_set_def(&e->bscan, &running_def);
             (void)sc_bscan_attach_mesh(&e->bscan, &running_tissue(e)->mesh);
         } else {
             sc_case_slot_close(&e->slot);
