@@ -190,6 +190,15 @@ _Static_assert((1u << SC_SPRINGS_HASH_BITS) >= 2u * SC_MAX_SPRINGS,
 #endif
 _Static_assert(SC_CAN_CMD_QUEUE_MAX >= 1u && SC_CAN_CMD_QUEUE_MAX <= 255u,
                "command queue length must fit uint8_t");
+/* Clock readings per estimate of the SocketCAN time stamp offset (REALTIME -> MONOTONIC,
+ * platform/linux/sc_socketcan.h); the narrowest bracket wins. In the HIL VM under TCG the
+ * readings were 0.4-0.5 us wide on average, the widest of ~1100 per run 2-139 us (preempted):
+ * one of 8 is narrow all but always. */
+#ifndef SC_SOCKETCAN_CLOCK_READINGS
+#define SC_SOCKETCAN_CLOCK_READINGS 8u
+#endif
+_Static_assert(SC_SOCKETCAN_CLOCK_READINGS >= 1u && SC_SOCKETCAN_CLOCK_READINGS <= 64u,
+               "1..64 clock readings per time stamp offset estimate");
 
 _Static_assert(SC_FRAME_RATE_DEFAULT_HZ >= SC_FRAME_RATE_MIN_HZ &&
                    SC_FRAME_RATE_DEFAULT_HZ <= SC_FRAME_RATE_MAX_HZ,

@@ -161,7 +161,88 @@ sc_socketcan_rawfilter sc_socketcan_filter_to_raw(const sc_can_filter *f)
     return r;
 }
 
+/* ---- time stamp conversion ------------------------------------------------------------------ */
+
+static int reading_usable(const sc_socketcan_clocks *r)
+{
+    return r->mono_after_ns >= r->mono_before_ns && r->real_ns != 0u;
+}
+
+int sc_socketcan_tsconv_estimate(sc_socketcan_tsconv *c, const sc_socketcan_clocks *r, size_t n)
+{
+    const sc_socketcan_clocks *best = NULL;
+    for (size_t i = 0; i < n; i++) {
+        if (reading_usable(&r[i]) &&
+            (best == NULL || r[i].mono_after_ns - r[i].mono_before_ns <
+                                 best->mono_after_ns - best->mono_before_ns)) {
+            best = &r[i];
+        }
+    }
+    if (best == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    const uint64_t width = best->mono_after_ns - best->mono_before_ns;
+    const uint64_t mid = best->mono_before_ns + width / 2u;
+    c->offset_ns = (int64_t)mid - (int64_t)best->real_ns;
+    c->uncertainty_ns = (width + 1u) / 2u;
+    c->valid = 1;
+    return 0;
+}
+
+int sc_socketcan_tsconv_stepped(const sc_socketcan_tsconv *c, const sc_socketcan_clocks *r)
+{
+    if (!c->valid || !reading_usable(r)) {
+        return 0;
+    }
+    /* the reading says the offset lies in [lo, hi]; the estimate, in offset +- uncertainty.
+     * 1 ns of slack per side for the clocks' rounding to whole ns */
+    const int64_t lo = (int64_t)r->mono_before_ns - (int64_t)r->real_ns;
+    const int64_t hi = (int64_t)r->mono_after_ns - (int64_t)r->real_ns;
+    const int64_t u = (int64_t)c->uncertainty_ns + 1;
+    return hi < c->offset_ns - u || lo > c->offset_ns + u;
+}
+
+uint64_t sc_socketcan_tsconv_to_mono(const sc_socketcan_tsconv *c, uint64_t real_ns)
+{
+    if (!c->valid || real_ns == 0u) {
+        return 0u;
+    }
+    const int64_t mono = (int64_t)real_ns + c->offset_ns;
+    return mono > 0 ? (uint64_t)mono : 0u;
+}
+
 /* ---- the node ------------------------------------------------------------------------------- */
+
+/* A fresh offset from SC_SOCKETCAN_CLOCK_READINGS readings. */
+static int estimate_offset(sc_socketcan *s)
+{
+    sc_socketcan_clocks r[SC_SOCKETCAN_CLOCK_READINGS];
+    for (size_t i = 0; i < SC_SOCKETCAN_CLOCK_READINGS; i++) {
+        const int rc = s->sys->read_clocks(s->sys_user, &r[i]);
+        if (rc != 0) {
+            return rc;
+        }
+    }
+    return sc_socketcan_tsconv_estimate(&s->tsconv, r, SC_SOCKETCAN_CLOCK_READINGS);
+}
+
+/* The kernel's REALTIME stamp on the HAL clock, re-estimating the offset first when a reading
+ * shows that REALTIME was stepped. When the clocks cannot be read the held offset serves. */
+static uint64_t stamp_to_mono(sc_socketcan *s, uint64_t real_ns)
+{
+    if (real_ns == 0u) {
+        return 0u;
+    }
+    sc_socketcan_clocks now;
+    if (s->sys->read_clocks(s->sys_user, &now) == 0 &&
+        (!s->tsconv.valid || sc_socketcan_tsconv_stepped(&s->tsconv, &now))) {
+        const int was_valid = s->tsconv.valid;
+        if (estimate_offset(s) == 0 && was_valid) {
+            s->tsconv.steps++;
+        }
+    }
+    return sc_socketcan_tsconv_to_mono(&s->tsconv, real_ns);
+}
 
 static void update_state(sc_socketcan *s, const sc_socketcan_raw *r, uint32_t errf)
 {
@@ -206,7 +287,7 @@ static int node_recv(void *ctx, sc_can_frame *out)
             s->rx_unconvertible++;
             continue;
         }
-        out->ts_ns = ts;
+        out->ts_ns = stamp_to_mono(s, ts);
         if (out->flags & SC_CAN_FLAG_ERR) {
             update_state(s, &r, out->id);
             s->rx_error_frames++;
@@ -297,6 +378,12 @@ int sc_socketcan_open(sc_socketcan *s, const sc_socketcan_sys *sys, void *sys_us
     }
     s->handle = h;
     s->fd_capable = fd_capable;
+    const int rc = estimate_offset(s);
+    if (rc != 0) {
+        sys->close(sys_user, h);
+        s->handle = -1;
+        return rc == SC_ERR_INVALID_ARG ? SC_ERR_IO : rc;
+    }
     s->state = SC_CAN_STATE_ERROR_ACTIVE;
     return 0;
 }
@@ -433,16 +520,20 @@ static int posix_recv(void *u, int h, sc_socketcan_raw *out, int *is_fd, uint64_
             memcpy(drops, CMSG_DATA(c), sizeof *drops);
         }
     }
-    if (*ts_ns != 0u) {
-        /* kernel stamps are CLOCK_REALTIME; the HAL clock is CLOCK_MONOTONIC */
-        struct timespec rt, mt;
-        clock_gettime(CLOCK_REALTIME, &rt);
-        clock_gettime(CLOCK_MONOTONIC, &mt);
-        const int64_t off = (int64_t)ts_to_ns(&mt) - (int64_t)ts_to_ns(&rt);
-        const int64_t mono = (int64_t)*ts_ns + off;
-        *ts_ns = mono > 0 ? (uint64_t)mono : 0u;
+    return 1; /* the stamp stays on CLOCK_REALTIME: the node converts it (sc_socketcan_tsconv) */
+}
+
+static int posix_read_clocks(void *u, sc_socketcan_clocks *out)
+{
+    (void)u;
+    struct timespec m0, rt, m1;
+    if (clock_gettime(CLOCK_MONOTONIC, &m0) != 0 || clock_gettime(CLOCK_REALTIME, &rt) != 0 ||
+        clock_gettime(CLOCK_MONOTONIC, &m1) != 0) {
+        return SC_ERR_IO;
     }
-    return 1;
+    *out = (sc_socketcan_clocks){
+        .mono_before_ns = ts_to_ns(&m0), .real_ns = ts_to_ns(&rt), .mono_after_ns = ts_to_ns(&m1)};
+    return 0;
 }
 
 static int posix_send(void *u, int h, const sc_socketcan_raw *f, int is_fd)
@@ -471,6 +562,7 @@ static const sc_socketcan_sys posix_sys = {
     .recv = posix_recv,
     .send = posix_send,
     .close = posix_close,
+    .read_clocks = posix_read_clocks,
 };
 
 const sc_socketcan_sys *sc_socketcan_sys_posix(void)

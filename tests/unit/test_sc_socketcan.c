@@ -1,6 +1,8 @@
 /* test_sc_socketcan.c: the SocketCAN node's logic over a fake syscall adapter (this host's
  * kernel has no CAN): frame conversion both ways, error frames -> classes and bus state,
- * kernel filters, FD gating, drop counting, bus-off refusal. The real adapter runs in the VM. */
+ * kernel filters, FD gating, drop counting, bus-off refusal, and the conversion of the kernel's
+ * REALTIME stamps to the MONOTONIC base (order kept, steps found). The real adapter runs in
+ * the VM. */
 #include "sc_test.h"
 
 #include <string.h>
@@ -26,6 +28,14 @@ typedef struct fake {
     sc_socketcan_rawfilter filt[SC_CAN_MAX_FILTERS];
     size_t filt_n;
     int closed;
+    /* clocks: MONOTONIC advances 1 us between readings; REALTIME (= MONOTONIC +
+     * real_minus_mono_ns) is read 100 ns after the first MONOTONIC read, the second MONOTONIC
+     * read follows after gap_ns[reading] (0 -> 100 ns): a preemption there */
+    uint64_t mono_ns;
+    int64_t real_minus_mono_ns;
+    uint64_t gap_ns[16];
+    int readings;
+    int clocks_rc;
 } fake;
 
 static int f_open(void *u, const char *ifname, int *fd_capable)
@@ -75,7 +85,23 @@ static void f_close(void *u, int h)
     (void)h;
     ((fake *)u)->closed = 1;
 }
-static const sc_socketcan_sys fake_sys = {f_open, f_set_filters, f_recv, f_send, f_close};
+static int f_read_clocks(void *u, sc_socketcan_clocks *c)
+{
+    fake *f = u;
+    if (f->clocks_rc) {
+        return f->clocks_rc;
+    }
+    const int i = f->readings++;
+    const uint64_t gap = i < 16 && f->gap_ns[i] ? f->gap_ns[i] : 100u;
+    f->mono_ns += 1000u;
+    c->mono_before_ns = f->mono_ns;
+    c->real_ns = (uint64_t)((int64_t)(f->mono_ns + 100u) + f->real_minus_mono_ns);
+    c->mono_after_ns = f->mono_ns + 100u + gap;
+    f->mono_ns = c->mono_after_ns;
+    return 0;
+}
+static const sc_socketcan_sys fake_sys = {f_open, f_set_filters, f_recv,
+                                          f_send, f_close,       f_read_clocks};
 
 static void push_rx(fake *f, uint32_t can_id, uint8_t len, int is_fd, uint64_t ts, uint32_t drops)
 {
@@ -232,6 +258,140 @@ static void error_classes_survive_linux_form_and_back(void **state)
     assert_int_equal(sc_socketcan_errf_from_linux(CAN_ERR_TX_TIMEOUT, z), SC_CAN_ERRF_CTRL);
 }
 
+/* the REALTIME epoch of a 2026 clock, in ns: the offset the conversion has to remove */
+#define REAL_MINUS_MONO_NS 1795000000000000000LL
+
+static void tsconv_estimate_takes_the_narrowest_bracket_midpoint(void **state)
+{
+    (void)state;
+    const sc_socketcan_clocks r[4] = {
+        {.mono_before_ns = 1000, .real_ns = 500000, .mono_after_ns = 6000},   /* 5 us wide */
+        {.mono_before_ns = 9000, .real_ns = 508100, .mono_after_ns = 9300},   /* 300 ns */
+        {.mono_before_ns = 20000, .real_ns = 519000, .mono_after_ns = 90000}, /* 70 us */
+        {.mono_before_ns = 95000, .real_ns = 594000, .mono_after_ns = 94000}, /* runs backwards */
+    };
+    sc_socketcan_tsconv c = {0};
+    assert_int_equal(sc_socketcan_tsconv_estimate(&c, r, 4), 0);
+    assert_true(c.valid);
+    assert_int_equal(c.offset_ns, 9150 - 508100);
+    assert_int_equal(c.uncertainty_ns, 150);
+    /* nothing usable: an error, and the held estimate stays */
+    assert_int_equal(sc_socketcan_tsconv_estimate(&c, &r[3], 1), SC_ERR_INVALID_ARG);
+    assert_int_equal(c.offset_ns, 9150 - 508100);
+}
+
+static void tsconv_conversion_keeps_the_order_of_ordered_stamps(void **state)
+{
+    (void)state;
+    const int64_t offsets[] = {-REAL_MINUS_MONO_NS, -1000, 0, 123456789};
+    for (size_t k = 0; k < sizeof offsets / sizeof offsets[0]; k++) {
+        const sc_socketcan_tsconv c = {.offset_ns = offsets[k], .valid = 1};
+        uint64_t prev = 0;
+        uint64_t real = (uint64_t)REAL_MINUS_MONO_NS + 5000000000u;
+        for (int i = 0; i < 1000; i++) {
+            real += (uint64_t)(i % 7) * 13u; /* ties and small steps: back-to-back frames */
+            const uint64_t mono = sc_socketcan_tsconv_to_mono(&c, real);
+            assert_true(mono >= prev);
+            assert_true(mono > 0u);
+            prev = mono;
+        }
+    }
+    const sc_socketcan_tsconv c = {.offset_ns = -REAL_MINUS_MONO_NS, .valid = 1};
+    assert_int_equal(sc_socketcan_tsconv_to_mono(&c, 0), 0);           /* no stamp */
+    assert_int_equal(sc_socketcan_tsconv_to_mono(&c, 1000000000u), 0); /* before boot */
+    const sc_socketcan_tsconv none = {0};
+    assert_int_equal(sc_socketcan_tsconv_to_mono(&none, 1000000000u), 0);
+}
+
+static void tsconv_finds_realtime_steps_but_not_in_delayed_readings(void **state)
+{
+    (void)state;
+    const sc_socketcan_clocks est = {
+        .mono_before_ns = 1000, .real_ns = 2000, .mono_after_ns = 1200};
+    sc_socketcan_tsconv c = {0};
+    assert_int_equal(sc_socketcan_tsconv_estimate(&c, &est, 1), 0);
+    assert_int_equal(c.offset_ns, -900); /* true offset in [-1000, -800] */
+    /* consistent readings, narrow or 1 ms wide (preempted anywhere): no step */
+    const sc_socketcan_clocks ok[] = {
+        {.mono_before_ns = 50000, .real_ns = 50900, .mono_after_ns = 50950},
+        {.mono_before_ns = 60000, .real_ns = 60800, .mono_after_ns = 1060000},
+        {.mono_before_ns = 70000, .real_ns = 1070800, .mono_after_ns = 1070900},
+    };
+    for (size_t i = 0; i < 3; i++) {
+        assert_int_equal(sc_socketcan_tsconv_stepped(&c, &ok[i]), 0);
+    }
+    /* REALTIME stepped 5 us forward, or back: no bracket can explain it */
+    const sc_socketcan_clocks fwd = {
+        .mono_before_ns = 80000, .real_ns = 85900, .mono_after_ns = 81000};
+    const sc_socketcan_clocks back = {
+        .mono_before_ns = 90000, .real_ns = 85900, .mono_after_ns = 90100};
+    assert_int_equal(sc_socketcan_tsconv_stepped(&c, &fwd), 1);
+    assert_int_equal(sc_socketcan_tsconv_stepped(&c, &back), 1);
+    const sc_socketcan_tsconv none = {0};
+    assert_int_equal(sc_socketcan_tsconv_stepped(&none, &fwd), 0);
+}
+
+/* Issue #19 as measured in the HIL VM: the clock reading at one frame was preempted for
+ * 138.8 us between its REALTIME and MONOTONIC reads, the next frame's took 250 ns, and the two
+ * frames were stamped 96.2 us apart. An offset per frame from those reads put them 42 us out of
+ * order; the held offset keeps their order and their distance. */
+static void kernel_stamps_keep_order_and_distance_when_a_clock_reading_is_preempted(void **state)
+{
+    (void)state;
+    fake fk = {.open_rc = 3, .real_minus_mono_ns = REAL_MINUS_MONO_NS};
+    fk.gap_ns[SC_SOCKETCAN_CLOCK_READINGS] = 138807u;   /* the reading at the first frame */
+    fk.gap_ns[SC_SOCKETCAN_CLOCK_READINGS + 1u] = 250u; /* at the second */
+    sc_socketcan s;
+    assert_int_equal(sc_socketcan_open(&s, &fake_sys, &fk, "vcan0"), 0);
+    sc_can_dev dev = sc_socketcan_dev(&s);
+    const uint64_t t1 = (uint64_t)REAL_MINUS_MONO_NS + 5000000000u;
+    push_rx(&fk, 0x100, 8, 0, t1, 0);
+    push_rx(&fk, 0x101, 8, 0, t1 + 96203u, 0);
+    push_rx(&fk, 0x102, 8, 0, t1 + 96203u, 0); /* a tie stays a tie */
+    sc_can_frame a, b, c;
+    assert_int_equal(sc_can_recv(&dev, &a), 0);
+    assert_int_equal(sc_can_recv(&dev, &b), 0);
+    assert_int_equal(sc_can_recv(&dev, &c), 0);
+    assert_int_equal(a.ts_ns, 5000000000u); /* the exact MONOTONIC time */
+    assert_int_equal(b.ts_ns - a.ts_ns, 96203u);
+    assert_int_equal(c.ts_ns, b.ts_ns);
+    assert_int_equal(s.tsconv.steps, 0);
+}
+
+static void a_realtime_step_reestimates_the_offset_and_is_counted(void **state)
+{
+    (void)state;
+    fake fk = {.open_rc = 3, .real_minus_mono_ns = REAL_MINUS_MONO_NS};
+    sc_socketcan s;
+    assert_int_equal(sc_socketcan_open(&s, &fake_sys, &fk, "vcan0"), 0);
+    sc_can_dev dev = sc_socketcan_dev(&s);
+    const uint64_t t1 = (uint64_t)REAL_MINUS_MONO_NS + 5000000000u;
+    push_rx(&fk, 0x100, 8, 0, t1, 0);
+    sc_can_frame f;
+    assert_int_equal(sc_can_recv(&dev, &f), 0);
+    assert_int_equal(f.ts_ns, 5000000000u);
+    /* REALTIME stepped 2 s forward (settimeofday); the next frame is stamped after it */
+    fk.real_minus_mono_ns += 2000000000;
+    push_rx(&fk, 0x101, 8, 0, t1 + 2000000000u + 1000u, 0);
+    assert_int_equal(sc_can_recv(&dev, &f), 0);
+    assert_int_equal(f.ts_ns, 5000001000u);
+    assert_int_equal(s.tsconv.steps, 1);
+    /* frames without a kernel stamp stay unknown */
+    push_rx(&fk, 0x102, 8, 0, 0, 0);
+    assert_int_equal(sc_can_recv(&dev, &f), 0);
+    assert_int_equal(f.ts_ns, 0);
+}
+
+static void open_fails_and_closes_when_the_clocks_cannot_be_read(void **state)
+{
+    (void)state;
+    fake fk = {.open_rc = 3, .clocks_rc = SC_ERR_IO};
+    sc_socketcan s;
+    assert_int_equal(sc_socketcan_open(&s, &fake_sys, &fk, "vcan0"), SC_ERR_IO);
+    assert_int_equal(fk.closed, 1);
+    assert_int_equal(s.handle, -1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -239,6 +399,12 @@ int main(void)
         cmocka_unit_test(sending_converts_frames_and_gates_fd_on_the_interface),
         cmocka_unit_test(filters_become_kernel_filters_that_separate_standard_and_extended),
         cmocka_unit_test(error_classes_survive_linux_form_and_back),
+        cmocka_unit_test(tsconv_estimate_takes_the_narrowest_bracket_midpoint),
+        cmocka_unit_test(tsconv_conversion_keeps_the_order_of_ordered_stamps),
+        cmocka_unit_test(tsconv_finds_realtime_steps_but_not_in_delayed_readings),
+        cmocka_unit_test(kernel_stamps_keep_order_and_distance_when_a_clock_reading_is_preempted),
+        cmocka_unit_test(a_realtime_step_reestimates_the_offset_and_is_counted),
+        cmocka_unit_test(open_fails_and_closes_when_the_clocks_cannot_be_read),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

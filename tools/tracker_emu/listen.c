@@ -224,6 +224,9 @@ int main(int argc, char **argv)
     (void)sc_can_get_state(&dev, &state, &cnt);
     printf("burst_limited=%llu\nkernel_drops=%u\ncan_state=%d\n", (unsigned long long)burst_limited,
            cnt.rx_dropped, (int)state);
+    /* REALTIME steps move kernel stamps taken before them (sc_socketcan.h): said, not hidden */
+    printf("clock_steps=%u\nclock_uncertainty_ns=%llu\n", node.tsconv.steps,
+           (unsigned long long)node.tsconv.uncertainty_ns);
     report(&trk, &st);
     sc_socketcan_close(&node);
     return 0;
