@@ -1,6 +1,8 @@
 /* test_casebuild_dicom.c: DICOM import through DCMTK (when built): slice series and enhanced
  * multi-frame files, 8/16-bit, signed, rescaled, RLE-compressed, oblique orientation, out of
- * order on disk; compared voxel by voxel. Fixtures are written at test time by DCMTK. */
+ * order on disk; compared voxel by voxel. Fixtures are written at test time by DCMTK, and by
+ * an independent writer (Debian's python3-pydicom, tests/casebuild/write_dicom_pydicom.py),
+ * with and without the optional Rescale Slope / Intercept. */
 #include "sc_test.h"
 
 #include <math.h>
@@ -157,6 +159,70 @@ static void enhanced_multiframe_rle_compressed_imports_into_a_valid_case(void **
     sc_import_result_free(&r);
 }
 
+/* The pydicom volumes: stored value at (x, y, z) as write_dicom_pydicom.py documents. */
+#define PX 12u
+#define PY 10u
+#define PZ 8u
+
+static double pydicom_value(uint32_t x, uint32_t y, uint32_t z, int bits, int is_signed)
+{
+    if (bits == 8) {
+        return (double)((7u * x + 13u * y + 29u * z) % 256u);
+    }
+    const double v = (double)((257u * x + 1031u * y + 4099u * z) % 65536u);
+    return is_signed ? v - 32768.0 : v;
+}
+
+static void check_pydicom(const char *name, int bits, int is_signed, double slope, double icpt)
+{
+    char path[300], err[256];
+    snprintf(path, sizeof path, "%s/pyd/%s", g_dir, name);
+    sc_image img;
+    const int rc = sc_image_read(path, &img, err, sizeof err);
+    if (rc != SC_OK) {
+        fail_msg("%s: %s", path, err);
+    }
+    assert_int_equal(img.dim[0], PX);
+    assert_int_equal(img.dim[1], PY);
+    assert_int_equal(img.dim[2], PZ);
+    assert_true(fabs(img.spacing[0] - 0.3) < 1e-9 && fabs(img.spacing[1] - 0.5) < 1e-9 &&
+                fabs(img.spacing[2] - 0.8) < 1e-9);
+    assert_true(fabs(img.origin[2] - 30.0) < 1e-9);
+    double lo = INFINITY, hi = -INFINITY;
+    for (uint32_t z = 0; z < PZ; z++) {
+        for (uint32_t y = 0; y < PY; y++) {
+            for (uint32_t x = 0; x < PX; x++) {
+                const double want = pydicom_value(x, y, z, bits, is_signed) * slope + icpt;
+                const double got = img.data[x + PX * (y + PY * (size_t)z)];
+                if (!(fabs(got - want) <= 1e-9 * fabs(want))) {
+                    fail_msg("%s: voxel (%u,%u,%u) is %g, want %g", name, x, y, z, got, want);
+                }
+                lo = got < lo ? got : lo;
+                hi = got > hi ? got : hi;
+            }
+        }
+    }
+    assert_true(hi > lo); /* not a constant (all-zero) volume */
+    sc_image_free(&img);
+}
+
+static void series_and_multiframe_by_pydicom_with_and_without_rescale_import_exactly(void **state)
+{
+    (void)state;
+    char cmd[600];
+    snprintf(cmd, sizeof cmd,
+             "mkdir -p '%s/pyd' && /usr/bin/python3 '%s/tests/casebuild/write_dicom_pydicom.py' "
+             "'%s/pyd' >/dev/null",
+             g_dir, SC_SOURCE_DIR, g_dir);
+    assert_int_equal(system(cmd), 0); /* needs python3-pydicom (tools/install-deps.sh base) */
+    /* no Rescale Slope / Intercept: the stored values, as the standard defaults say */
+    check_pydicom("series8", 8, 0, 1.0, 0.0);
+    check_pydicom("series16", 16, 0, 1.0, 0.0);
+    check_pydicom("usmf.dcm", 8, 0, 1.0, 0.0);
+    /* present: applied */
+    check_pydicom("series16r", 16, 1, 0.5, -20.0);
+}
+
 static void missing_or_empty_dicom_inputs_are_refused(void **state)
 {
     (void)state;
@@ -206,6 +272,7 @@ int main(void)
         cmocka_unit_test(series_of_16_bit_unsigned_rle_compressed_slices),
         cmocka_unit_test(enhanced_multiframe_8_bit_frames_out_of_order),
         cmocka_unit_test(enhanced_multiframe_rle_compressed_imports_into_a_valid_case),
+        cmocka_unit_test(series_and_multiframe_by_pydicom_with_and_without_rescale_import_exactly),
         cmocka_unit_test(missing_or_empty_dicom_inputs_are_refused),
 #else
         cmocka_unit_test(dicom_without_dcmtk_is_not_supported),

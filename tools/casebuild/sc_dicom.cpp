@@ -150,10 +150,37 @@ int load_one(const std::string &path, dicom_file &f, char *err, size_t errlen)
     if (f.ds->findAndGetOFString(DCM_SeriesInstanceUID, s).good()) {
         f.series = s.c_str();
     }
-    f.ds->findAndGetFloat64(DCM_RescaleSlope, f.slope);
-    f.ds->findAndGetFloat64(DCM_RescaleIntercept, f.intercept);
     DcmItem *shared = nullptr;
     f.ds->findAndGetSequenceItem(DCM_SharedFunctionalGroupsSequence, shared, 0);
+    /* Rescale Slope / Intercept are optional (ultrasound usually has neither): an absent tag
+     * means 1 / 0 (PS3.3 C.11.1.1.2). DCMTK's findAndGet sets the value to 0 when the tag is
+     * missing, which read as slope 0 made every voxel 0, so only a found value counts. An
+     * enhanced (multi-frame) object keeps them in the Pixel Value Transformation functional
+     * group. */
+    {
+        DcmItem *pvt = nullptr;
+        DcmItem *src = f.ds;
+        if (shared != nullptr &&
+            shared->findAndGetSequenceItem(DCM_PixelValueTransformationSequence, pvt, 0).good() &&
+            pvt != nullptr) {
+            src = pvt;
+        }
+        double v = 0.0;
+        if (src->findAndGetFloat64(DCM_RescaleSlope, v).good()) {
+            if (!std::isfinite(v) || v == 0.0) {
+                return fail(err, errlen, SC_ERR_PARSE, "%s: RescaleSlope %g is not usable",
+                            path.c_str(), v);
+            }
+            f.slope = v;
+        }
+        if (src->findAndGetFloat64(DCM_RescaleIntercept, v).good()) {
+            if (!std::isfinite(v)) {
+                return fail(err, errlen, SC_ERR_PARSE, "%s: RescaleIntercept is not finite",
+                            path.c_str());
+            }
+            f.intercept = v;
+        }
+    }
     f.fg.assign((size_t)f.frames, frame_geom());
     frame_geom top;
     read_plane(f.ds, f, &top);
