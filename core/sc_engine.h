@@ -35,8 +35,9 @@
  *              open      the storage mapping, the file's framing (O(sections));
  *              validate  at most case_check_slice_bytes of CRC / label pass (sc_case.h);
  *              build     the next case's tissue in the standby slot, one build phase per
- *                        slice (sc_tissue_build_step: mesh and labels, springs, MSDS, FEM,
- *                        contact; each O(tets) or O(nodes)) while the running case runs;
+ *                        slice (sc_tissue_build_step: mesh, labels, springs, MSDS, 10 of the
+ *                        MSDS mass scaling's 100 power iterations, FEM, contact; each O(tets)
+ *                        or O(nodes)) while the running case runs;
  *              swap      imaging attached to the new mesh (O(tets)), calibration taken, the
  *                        slots exchanged: the next frame runs the new case.
  *            A slice runs only when the slack left is at least the longest that kind of slice
@@ -45,6 +46,11 @@
  *            control_wait_frames frames runs anyway (counted in control_forced). With one
  *            tissue slot (SC_ENGINE_TISSUE_SLOTS 1, the MCU) the build replaces the running
  *            tissue: from its first phase to the swap no case runs (dark frames).
+ *
+ * Measured (release build, x86-64 host, the 11.8 MB phantoms, tests/hostsim/test_case_switch):
+ * a switch takes 35 frames; a frame without a switch at most 4.0 ms of host CPU, a frame with a
+ * slice at most 9.3 ms (the label pass; the mass-scaling slices 8.6 ms), inside the 16.7 ms
+ * period.
  *
  * ---- Rules ----------------------------------------------------------------------------------
  * Threads: one thread drives an engine; the getters may be called between steps.

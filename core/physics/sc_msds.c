@@ -160,8 +160,10 @@ static void stiffness_apply(sc_msds *s)
  * W^-1/2 K W^-1/2 from a fixed start (Rayleigh quotients approach mu from below; 100
  * iterations reach it within 0.5% on the default mesh, the factor 1.1 covers that), then
  * sigma = min(1, max(0.05, 1.1 mu / 2)); Gershgorin guarantees mu <= 2. Deterministic.
- * Uses the scratch arrays. O(SC_MSDS_POWER_ITERATIONS (9 N + tets)). */
-static void compute_mass_scale(sc_msds *s)
+ * Uses the scratch arrays. O(SC_MSDS_POWER_ITERATIONS (9 N + tets)), resumable: begin, then
+ * any number of runs of a few iterations (a case switch between frames), the same bits as in
+ * one go. */
+static void mass_scale_begin(sc_msds *s)
 {
     const uint32_t nn = s->node_count;
     uint32_t r = 12345u;
@@ -176,8 +178,17 @@ static void compute_mass_scale(sc_msds *s)
         s->ty[i] = free_node ? v[1] : 0.0f;
         s->tz[i] = free_node ? v[2] : 0.0f;
     }
-    double mu = 0.0;
-    for (uint32_t it = 0; it < SC_MSDS_POWER_ITERATIONS; it++) {
+    s->scale_mu = 0.0;
+    s->scale_it = 0u;
+}
+
+/* Up to max_its more power iterations; 1 when sigma is set (the scratch cleared). */
+static int mass_scale_run(sc_msds *s, uint32_t max_its)
+{
+    const uint32_t nn = s->node_count;
+    double mu = s->scale_mu;
+    uint32_t it = s->scale_it;
+    for (uint32_t n = 0; n < max_its && it < SC_MSDS_POWER_ITERATIONS; n++, it++) {
         double xx = 0.0;
         for (uint32_t i = 0; i < nn; i++) {
             xx += (double)s->tx[i] * (double)s->tx[i] + (double)s->ty[i] * (double)s->ty[i] +
@@ -203,6 +214,7 @@ static void compute_mass_scale(sc_msds *s)
         }
         if (!(xx > 0.0) || !(yy > 0.0)) {
             mu = 2.0; /* nothing to estimate: keep the Gershgorin bound */
+            it = SC_MSDS_POWER_ITERATIONS;
             break;
         }
         mu = uy / xx;
@@ -213,6 +225,11 @@ static void compute_mass_scale(sc_msds *s)
             s->tz[i] *= inv;
         }
     }
+    s->scale_mu = mu;
+    s->scale_it = it;
+    if (it < SC_MSDS_POWER_ITERATIONS) {
+        return 0;
+    }
     float sigma = 1.1f * (float)mu * 0.5f;
     sigma = sigma > 1.0f ? 1.0f : sigma;
     sigma = sigma < 0.05f ? 0.05f : sigma;
@@ -221,6 +238,13 @@ static void compute_mass_scale(sc_msds *s)
         s->fx[i] = s->fy[i] = s->fz[i] = 0.0f;
         s->tx[i] = s->ty[i] = s->tz[i] = 0.0f;
     }
+    return 1;
+}
+
+static void compute_mass_scale(sc_msds *s)
+{
+    mass_scale_begin(s);
+    (void)mass_scale_run(s, SC_MSDS_POWER_ITERATIONS);
 }
 
 static void compute_inv_mass(sc_msds *s, const sc_mesh *m)
@@ -326,8 +350,8 @@ static int init_cells(sc_msds *s, const sc_mesh *m)
     return SC_OK;
 }
 
-int sc_msds_init(sc_msds *s, const sc_mesh *m, const sc_springs *sp, const sc_material_table *mat,
-                 const sc_msds_def *def)
+int sc_msds_init_begin(sc_msds *s, const sc_mesh *m, const sc_springs *sp,
+                       const sc_material_table *mat, const sc_msds_def *def)
 {
     if (s == NULL || m == NULL || sp == NULL || mat == NULL || def == NULL) {
         return SC_ERR_INVALID_ARG;
@@ -433,15 +457,34 @@ int sc_msds_init(sc_msds *s, const sc_mesh *m, const sc_springs *sp, const sc_ma
     if (rc != SC_OK) {
         return rc;
     }
-    /* free-node flags first (inv_mass > 0), then sigma, then the masses */
+    /* free-node flags first (inv_mass > 0), then sigma (sc_msds_init_step), then the masses */
     s->mass_scale = 1.0f;
     compute_masses(s);
     compute_inv_mass(s, m);
-    compute_mass_scale(s);
+    mass_scale_begin(s);
+    return SC_OK;
+}
+
+int sc_msds_init_step(sc_msds *s, const sc_mesh *m, uint32_t iterations)
+{
+    if (s == NULL || m == NULL || iterations == 0u) {
+        return SC_ERR_INVALID_ARG;
+    }
+    if (mass_scale_run(s, iterations) == 0) {
+        return 0;
+    }
     compute_masses(s);
     compute_inv_mass(s, m);
     /* keep the fixed flags: inv_mass is 0 there; remember them through inv_mass only */
-    return SC_OK;
+    return 1;
+}
+
+int sc_msds_init(sc_msds *s, const sc_mesh *m, const sc_springs *sp, const sc_material_table *mat,
+                 const sc_msds_def *def)
+{
+    const int rc = sc_msds_init_begin(s, m, sp, mat, def);
+    return rc != SC_OK ? rc : (sc_msds_init_step(s, m, SC_MSDS_POWER_ITERATIONS) == 1 ? SC_OK
+                                                                                      : SC_ERR_STATE);
 }
 
 int sc_msds_set_def(sc_msds *s, const sc_msds_def *def)

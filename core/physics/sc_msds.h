@@ -138,6 +138,8 @@ typedef struct sc_msds {
     uint32_t cell_end;                                   /* origins 0..cell_end-1 are visited */
     SC_ALIGN_HOT float cell_g[8][3][SC_MSDS_CELL_BLOCK]; /* scratch: corner forces (mirrored) */
     float mass_scale; /* sigma (see above): 1.1 x spectral estimate / Gershgorin, <= 1 */
+    uint32_t scale_it; /* power iterations of sigma done (init in slices) */
+    double scale_mu;   /* their Rayleigh quotient so far */
     uint32_t nx, nxy; /* grid shape and cell (rest geometry for the spectral estimate) */
     float cell_mm[3];
 } sc_msds;
@@ -161,6 +163,14 @@ int sc_msds_def_validate(const sc_msds_def *def);
  * for all springs), SC_ERR_CASE_LABEL. */
 int sc_msds_init(sc_msds *s, const sc_mesh *m, const sc_springs *sp, const sc_material_table *mat,
                  const sc_msds_def *def);
+
+/* sc_msds_init in slices (a case switch between frames): begin does everything but sigma's
+ * power iterations (O(springs + N + tets)); each step runs at most `iterations` of them
+ * (O(iterations (9 N + tets))) and returns 0 (more to do) or 1 (masses final: the same bits as
+ * sc_msds_init). Errors: those of sc_msds_init (begin); SC_ERR_INVALID_ARG (step: NULL, 0). */
+int sc_msds_init_begin(sc_msds *s, const sc_mesh *m, const sc_springs *sp,
+                       const sc_material_table *mat, const sc_msds_def *def);
+int sc_msds_init_step(sc_msds *s, const sc_mesh *m, uint32_t iterations);
 
 /* Change the settings at run time: masses recomputed if the mass scaling or the volume
  * ratio changes (O(N); a new volume ratio also re-estimates sigma, O(100 (9 N + tets))).

@@ -108,16 +108,23 @@ int sc_tissue_build_step(sc_tissue *t)
     switch ((sc_tissue_build_phase)t->build_phase) {
     case SC_TISSUE_BUILD_MESH:
         rc = sc_mesh_build(&t->mesh, &t->def.mesh);
-        if (rc == SC_OK) {
-            rc = sc_material_assign(&t->mesh, t->build_vol, &t->mat, t->build_label);
-        }
+        break;
+    case SC_TISSUE_BUILD_LABELS:
+        rc = sc_material_assign(&t->mesh, t->build_vol, &t->mat, t->build_label);
         break;
     case SC_TISSUE_BUILD_SPRINGS:
         rc = sc_springs_from_tets(&t->springs, (const uint32_t(*)[4])t->mesh.tet,
                                   t->mesh.tet_label, t->mesh.tet_count, &t->mat);
         break;
     case SC_TISSUE_BUILD_MSDS:
-        rc = sc_msds_init(&t->msds, &t->mesh, &t->springs, &t->mat, &t->def.msds);
+        rc = sc_msds_init_begin(&t->msds, &t->mesh, &t->springs, &t->mat, &t->def.msds);
+        break;
+    case SC_TISSUE_BUILD_MSDS_SCALE:
+        rc = sc_msds_init_step(&t->msds, &t->mesh, SC_TISSUE_BUILD_POWER_ITS);
+        if (rc == 0) {
+            return 0; /* more iterations: the same phase again */
+        }
+        rc = rc == 1 ? SC_OK : rc;
         break;
     case SC_TISSUE_BUILD_FEM:
         rc = sc_fem_init(&t->fem, &t->mesh, &t->mat, &t->def.fem);

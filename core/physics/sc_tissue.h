@@ -80,11 +80,20 @@ typedef struct sc_tissue_stats {
     float max_disp_mm;          /* largest node displacement after the last frame */
 } sc_tissue_stats;
 
-/* The phases of a build, in order (sc_tissue_build_step runs one). */
+/* Power iterations of the MSDS mass scaling per build step (100 in all, sc_msds.c). */
+#ifndef SC_TISSUE_BUILD_POWER_ITS
+#define SC_TISSUE_BUILD_POWER_ITS 10u
+#endif
+
+/* The phases of a build, in order (sc_tissue_build_step runs one, or one slice of the mass
+ * scaling). */
 typedef enum sc_tissue_build_phase {
-    SC_TISSUE_BUILD_MESH = 0, /* grid, tets, labels from the volume: O(tets) */
+    SC_TISSUE_BUILD_MESH = 0, /* grid and tets: O(tets) */
+    SC_TISSUE_BUILD_LABELS,   /* each tet's label from the volume's label map: O(tets) */
     SC_TISSUE_BUILD_SPRINGS,  /* Algorithm 1: O(tets) */
-    SC_TISSUE_BUILD_MSDS,     /* masses, spring families, mass scaling: O(nodes x power its) */
+    SC_TISSUE_BUILD_MSDS,     /* spring families, volume terms, masses: O(springs + nodes + tets) */
+    SC_TISSUE_BUILD_MSDS_SCALE, /* the mass scaling's power iterations, at most
+                                 * SC_TISSUE_BUILD_POWER_ITS per step: O(its x (9 N + tets)) */
     SC_TISSUE_BUILD_FEM,      /* pattern and assembly: O(tets) */
     SC_TISSUE_BUILD_CONTACT,  /* collider, skin, state at rest: O(nodes + skin) */
     SC_TISSUE_BUILD_DONE

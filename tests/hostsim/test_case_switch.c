@@ -94,10 +94,10 @@ static uint64_t slices(void)
 
 /* Host CPU time of the heaviest frame that ran each kind of slice (all switches). */
 static double worst_by_kind_ms[SC_ENGINE_SLICE_COUNT];
-_Static_assert(SC_ENGINE_SLICE_COUNT == 8, "slice kinds and their names");
+_Static_assert(SC_ENGINE_SLICE_COUNT == 10, "slice kinds and their names");
 static const char *const k_kind_names[SC_ENGINE_SLICE_COUNT] = {
-    "open", "validate", "build mesh", "build springs", "build msds",
-    "build fem", "build contact", "swap",
+    "open",          "validate",   "build mesh", "build labels",  "build springs",
+    "build msds",    "msds scale", "build fem",  "build contact", "swap",
 };
 
 typedef struct switch_run {
