@@ -31,7 +31,8 @@ static int storage_open(void *ctx, const char *name, const uint8_t **data, size_
     if (n < 0 || (size_t)n >= sizeof path) {
         return SC_ERR_NO_SPACE;
     }
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    /* O_NONBLOCK: a FIFO (or a device) must not block the open; it is refused below */
+    int fd = open(path, O_RDONLY | O_CLOEXEC | O_NONBLOCK);
     if (fd < 0) {
         s->last_errno = errno;
         return (errno == ENOENT || errno == ENOTDIR) ? SC_ERR_NOT_FOUND : SC_ERR_IO;
@@ -42,7 +43,8 @@ static int storage_open(void *ctx, const char *name, const uint8_t **data, size_
         (void)close(fd);
         return SC_ERR_IO;
     }
-    if ((uint64_t)st.st_size > (uint64_t)SIZE_MAX) {
+    if ((uint64_t)st.st_size > (uint64_t)SIZE_MAX ||
+        (uint64_t)st.st_size > (uint64_t)SC_STORAGE_LINUX_MAX_BYTES) {
         s->last_errno = EFBIG;
         (void)close(fd);
         return SC_ERR_IO;
@@ -56,13 +58,31 @@ static int storage_open(void *ctx, const char *name, const uint8_t **data, size_
         s->open_count++;
         return SC_OK;
     }
-    void *p = mmap(NULL, len, PROT_READ, MAP_PRIVATE, fd, 0);
-    int map_errno = errno;
-    (void)close(fd); /* the mapping keeps the file */
+    /* The bytes are copied into memory the appliance owns (anonymous, read-only once filled):
+     * a file mapping would raise SIGBUS on access after the file was truncated underneath;
+     * the case loader reads every byte at load anyway. */
+    void *p = mmap(NULL, len, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (p == MAP_FAILED) {
-        s->last_errno = map_errno;
+        s->last_errno = errno;
+        (void)close(fd);
         return SC_ERR_IO;
     }
+    size_t got = 0;
+    while (got < len) {
+        const ssize_t r = read(fd, (uint8_t *)p + got, len - got);
+        if (r < 0 && errno == EINTR) {
+            continue;
+        }
+        if (r <= 0) { /* an error, or the file shrank while read */
+            s->last_errno = r < 0 ? errno : EIO;
+            (void)close(fd);
+            (void)munmap(p, len);
+            return SC_ERR_IO;
+        }
+        got += (size_t)r;
+    }
+    (void)close(fd);
+    (void)mprotect(p, len, PROT_READ);
     *data = (const uint8_t *)p;
     *size = len;
     s->last_errno = 0;

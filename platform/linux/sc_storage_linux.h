@@ -1,11 +1,14 @@
 /*
- * sc_storage_linux.h: hal storage (sc_hal_storage.h) for Linux: a case is a file, opened by
- * path and mmap'd read-only (PROT_READ, MAP_PRIVATE); the core reads the voxels in place and
- * never copies them. A relative name is resolved against the storage's base directory (or
- * the working directory when none is set); an absolute path is used as is.
+ * sc_storage_linux.h: hal storage (sc_hal_storage.h) for Linux: a case is a regular file,
+ * opened by path without blocking (a FIFO or a device is refused, never waited on) and read
+ * whole into anonymous memory the appliance owns, read-only once filled: the core reads the
+ * voxels there in place, and a file truncated or rewritten while its case runs cannot reach it
+ * (a file mapping would raise SIGBUS). O(file size) per open, at most
+ * SC_STORAGE_LINUX_MAX_BYTES. A relative name is resolved against the storage's base directory
+ * (or the working directory when none is set); an absolute path is used as is.
  *
- * open: SC_ERR_NOT_FOUND (no such file), SC_ERR_IO (not readable, not a regular file,
- * mmap failed; the reason is kept in last_errno), SC_ERR_NO_SPACE (path longer than
+ * open: SC_ERR_NOT_FOUND (no such file), SC_ERR_IO (not readable, not a regular file, larger
+ * than the ceiling (EFBIG), a short read; the reason is kept in last_errno), SC_ERR_NO_SPACE (path longer than
  * SC_STORAGE_LINUX_PATH_MAX), SC_ERR_INVALID_ARG. An empty file opens as size 0 (the case
  * loader then answers SC_ERR_CASE_TRUNCATED). close: munmap. One storage object per thread.
  */
@@ -17,6 +20,9 @@
 
 #include "sc_hal_storage.h"
 
+#ifndef SC_STORAGE_LINUX_MAX_BYTES
+#define SC_STORAGE_LINUX_MAX_BYTES (1024u * 1024u * 1024u) /* ceiling of a case file */
+#endif
 #ifndef SC_STORAGE_LINUX_PATH_MAX
 #define SC_STORAGE_LINUX_PATH_MAX 4096u
 #endif

@@ -1,10 +1,13 @@
-/* test_storage_linux.c: the Linux hal storage maps case files read-only, names missing and
- * unreadable files, and a corrupt file on disk is refused by the loader through it. */
+/* test_storage_linux.c: the Linux hal storage reads case files into memory it owns, names
+ * missing and unreadable files, refuses a FIFO without blocking, keeps a running case intact
+ * when its file is truncated underneath, and a corrupt file on disk is refused by the loader
+ * through it; the case folder listing. */
 #include "sc_test.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -112,6 +115,77 @@ static void missing_unreadable_and_empty_files_are_named(void **state)
     assert_int_equal(sc_storage_open(&dev, "", &data, &size), SC_ERR_INVALID_ARG);
 }
 
+static void fifo_is_refused_without_blocking(void **state)
+{
+    (void)state;
+    char p[256];
+    snprintf(p, sizeof p, "%s/pipe.scase", g_dir);
+    assert_int_equal(mkfifo(p, 0600), 0);
+    sc_storage_linux st;
+    sc_storage_linux_init(&st, g_dir);
+    sc_storage_dev dev = sc_storage_linux_dev(&st);
+    const uint8_t *data = NULL;
+    size_t size = 0;
+    /* no writer ever opens the FIFO: a blocking open would hang this test */
+    assert_int_equal(sc_storage_open(&dev, "pipe.scase", &data, &size), SC_ERR_IO);
+    assert_int_equal(st.open_count, 0);
+}
+
+static void truncating_the_file_under_a_running_case_changes_nothing(void **state)
+{
+    (void)state;
+    uint8_t *bytes = NULL;
+    const size_t n = make_case(&bytes);
+    write_file("run.scase", bytes, n);
+    sc_storage_linux st;
+    sc_storage_linux_init(&st, g_dir);
+    sc_storage_dev dev = sc_storage_linux_dev(&st);
+    const uint8_t *data = NULL;
+    size_t size = 0;
+    assert_int_equal(sc_storage_open(&dev, "run.scase", &data, &size), SC_OK);
+    char p[256];
+    snprintf(p, sizeof p, "%s/run.scase", g_dir);
+    assert_int_equal(truncate(p, 0), 0); /* a file mapping would now SIGBUS on every access */
+    sc_case c;
+    assert_int_equal(sc_case_load(data, size, &c), SC_OK);
+    assert_memory_equal(data, bytes, n);
+    sc_storage_close(&dev, data, size);
+    free(bytes);
+}
+
+static void case_folder_lists_only_regular_case_files_in_name_order(void **state)
+{
+    (void)state;
+    char d[256];
+    snprintf(d, sizeof d, "%s/folder", g_dir);
+    assert_int_equal(mkdir(d, 0700), 0);
+    const char *files[] = {"c.scase", "a.scase", "b.scase", "notes.txt", ".hidden.scase"};
+    for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
+        char p[300];
+        snprintf(p, sizeof p, "%s/%s", d, files[i]);
+        FILE *f = fopen(p, "w");
+        assert_non_null(f);
+        fclose(f);
+    }
+    char sub[300];
+    snprintf(sub, sizeof sub, "%s/dir.scase", d);
+    assert_int_equal(mkdir(sub, 0700), 0);
+    char names[4][SC_STORAGE_LINUX_NAME_MAX];
+    uint32_t count = 0;
+    assert_int_equal(sc_storage_linux_list(d, ".scase", names, 4, &count), SC_OK);
+    assert_int_equal(count, 3);
+    assert_string_equal(names[0], "a.scase");
+    assert_string_equal(names[1], "b.scase");
+    assert_string_equal(names[2], "c.scase");
+    /* more files than room: the first in order, and the caller is told */
+    assert_int_equal(sc_storage_linux_list(d, ".scase", names, 2, &count), SC_ERR_NO_SPACE);
+    assert_int_equal(count, 2);
+    assert_string_equal(names[0], "a.scase");
+    assert_string_equal(names[1], "b.scase");
+    snprintf(sub, sizeof sub, "%s/none", g_dir);
+    assert_int_equal(sc_storage_linux_list(sub, ".scase", names, 2, &count), SC_ERR_NOT_FOUND);
+}
+
 static void corrupt_file_on_disk_is_refused_through_storage(void **state)
 {
     (void)state;
@@ -156,6 +230,9 @@ int main(void)
         cmocka_unit_test(mapped_case_loads_and_points_into_the_mapping),
         cmocka_unit_test(missing_unreadable_and_empty_files_are_named),
         cmocka_unit_test(corrupt_file_on_disk_is_refused_through_storage),
+        cmocka_unit_test(fifo_is_refused_without_blocking),
+        cmocka_unit_test(truncating_the_file_under_a_running_case_changes_nothing),
+        cmocka_unit_test(case_folder_lists_only_regular_case_files_in_name_order),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
