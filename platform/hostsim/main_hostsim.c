@@ -423,7 +423,7 @@ int main(int argc, char **argv)
     int have_pending = 0;
     recorder rec = {0};
     if (o.replay_path) {
-        replay = fopen(o.replay_path, "r");
+        replay = sc_fopen_regular(o.replay_path);
         if (!replay) {
             fprintf(stderr, "sc-hostsim: cannot open %s: %s\n", o.replay_path, strerror(errno));
             return 1;
@@ -432,7 +432,7 @@ int main(int argc, char **argv)
     } else {
         sc_emu_def ed = sc_emu_default_def();
         if (o.csv_path) {
-            FILE *fp = fopen(o.csv_path, "r");
+            FILE *fp = sc_fopen_regular(o.csv_path);
             size_t n = 0, bad = 0;
             if (!fp) {
                 fprintf(stderr, "sc-hostsim: cannot open %s: %s\n", o.csv_path, strerror(errno));

@@ -189,9 +189,10 @@ static void print_config(FILE *f, const sc_rtcfg *c)
 /* Read the configuration file and apply it; print every refused line. 0 or EXIT_CONFIG. */
 static int load_config(const char *path, sc_rtcfg *cfg)
 {
-    FILE *f = fopen(path, "rb");
+    FILE *f = sc_fopen_regular(path); /* a FIFO or device is refused, never waited on */
     if (!f) {
-        fprintf(stderr, "sonocomp: %s: %s\n", path, strerror(errno));
+        fprintf(stderr, "sonocomp: %s: %s\n", path,
+                errno == EINVAL ? "not a regular file" : strerror(errno));
         return EXIT_CONFIG;
     }
     static char text[CONFIG_FILE_MAX + 1u];

@@ -8,6 +8,7 @@
 
 #include "sc_err.h"
 #include "sc_rt.h"
+#include "sc_storage_linux.h"
 
 static uint64_t rt_now(void *ctx)
 {
@@ -20,9 +21,9 @@ int sc_can_replay_open(sc_can_replay *r, const char *path, sc_can_replay_now_fn 
     memset(r, 0, sizeof *r);
     r->now = now ? now : rt_now;
     r->now_ctx = now_ctx;
-    FILE *fp = fopen(path, "r");
+    FILE *fp = sc_fopen_regular(path); /* a FIFO or device is refused, never waited on */
     if (!fp) {
-        return SC_ERR_NOT_FOUND;
+        return errno == ENOENT ? SC_ERR_NOT_FOUND : SC_ERR_IO;
     }
     sc_candump_reader rd;
     sc_candump_reader_init(&rd, fp);

@@ -170,3 +170,36 @@ int sc_storage_linux_list(const char *dir, const char *suffix,
     closedir(dp);
     return rc;
 }
+
+FILE *sc_fopen_regular(const char *path)
+{
+    if (path == NULL) {
+        errno = EINVAL;
+        return NULL;
+    }
+    const int fd = open(path, O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+    if (fd < 0) {
+        return NULL;
+    }
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        const int e = errno != 0 && !S_ISREG(st.st_mode) ? EINVAL : errno;
+        (void)close(fd);
+        errno = e != 0 ? e : EINVAL;
+        return NULL;
+    }
+    const int fl = fcntl(fd, F_GETFL);
+    if (fl < 0 || fcntl(fd, F_SETFL, fl & ~O_NONBLOCK) != 0) {
+        const int e = errno;
+        (void)close(fd);
+        errno = e;
+        return NULL;
+    }
+    FILE *f = fdopen(fd, "r");
+    if (f == NULL) {
+        const int e = errno;
+        (void)close(fd);
+        errno = e;
+    }
+    return f;
+}

@@ -17,6 +17,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "sc_hal_storage.h"
 
@@ -45,6 +46,12 @@ typedef struct sc_storage_linux {
 int sc_storage_linux_list(const char *dir, const char *suffix,
                           char (*names)[SC_STORAGE_LINUX_NAME_MAX], uint32_t max,
                           uint32_t *count);
+
+/* fopen(path, "r") for input files (configuration, CAN logs, pose scripts) that must be
+ * regular files: opened without blocking (a FIFO, device or directory is refused at once with
+ * errno EINVAL/ENOENT/..., never waited on), then used as an ordinary blocking stream. NULL with
+ * errno set on refusal. O(1). */
+FILE *sc_fopen_regular(const char *path);
 
 /* base_dir may be NULL; the string must outlive the storage. */
 void sc_storage_linux_init(sc_storage_linux *s, const char *base_dir);

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <errno.h>
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -129,6 +130,17 @@ static void fifo_is_refused_without_blocking(void **state)
     /* no writer ever opens the FIFO: a blocking open would hang this test */
     assert_int_equal(sc_storage_open(&dev, "pipe.scase", &data, &size), SC_ERR_IO);
     assert_int_equal(st.open_count, 0);
+    /* the same for the configuration, CAN logs and pose scripts */
+    errno = 0;
+    assert_null(sc_fopen_regular(p));
+    assert_int_equal(errno, EINVAL);
+    assert_null(sc_fopen_regular(g_dir)); /* a directory */
+    write_file("plain.txt", (const uint8_t *)"x\n", 2);
+    snprintf(p, sizeof p, "%s/plain.txt", g_dir);
+    FILE *f = sc_fopen_regular(p);
+    assert_non_null(f);
+    assert_int_equal(fgetc(f), 'x');
+    fclose(f);
 }
 
 static void truncating_the_file_under_a_running_case_changes_nothing(void **state)
