@@ -446,8 +446,21 @@ static int load_sections(const uint8_t *bytes, size_t size, section_ref sec[SC_C
 
 static int material_ok(const sc_case_material *m)
 {
-    return isfinite(m->e_pa) && m->e_pa > 0.0f && isfinite(m->poisson) && m->poisson >= 0.0f &&
-           m->poisson < 0.5f && isfinite(m->density_kg_m3) && m->density_kg_m3 > 0.0f;
+    return isfinite(m->e_pa) && m->e_pa >= SC_CASE_MIN_E_PA && m->e_pa <= SC_CASE_MAX_E_PA &&
+           isfinite(m->poisson) && m->poisson >= 0.0f && m->poisson < 0.5f &&
+           isfinite(m->density_kg_m3) && m->density_kg_m3 >= SC_CASE_MIN_DENSITY &&
+           m->density_kg_m3 <= SC_CASE_MAX_DENSITY;
+}
+
+/* every coordinate of v within the plausible extent */
+static int within_extent(const float v[3])
+{
+    for (int a = 0; a < 3; a++) {
+        if (!(fabsf(v[a]) <= SC_CASE_MAX_EXTENT_MM)) {
+            return 0;
+        }
+    }
+    return 1;
 }
 
 static uint8_t label_max(const uint8_t *lab, uint64_t n)
@@ -501,12 +514,23 @@ static int parse_case(const section_ref sec[SC_CASE_SECTION_COUNT], uint32_t cas
         return rc;
     }
     for (int a = 0; a < 3; a++) {
-        if (!isfinite(c.volume.spacing_mm[a]) || !(c.volume.spacing_mm[a] > 0.0f)) {
+        if (!isfinite(c.volume.spacing_mm[a]) || !(c.volume.spacing_mm[a] > 0.0f) ||
+            c.volume.spacing_mm[a] > SC_CASE_MAX_SPACING_MM) {
             return SC_ERR_CASE_SPACING;
         }
     }
-    if (!finite3(c.volume.origin_mm)) {
+    if (!finite3(c.volume.origin_mm) || !within_extent(c.volume.origin_mm)) {
         return SC_ERR_CASE_TRANSFORM;
+    }
+    {
+        float far_corner[3];
+        for (int a = 0; a < 3; a++) {
+            far_corner[a] = c.volume.origin_mm[a] +
+                            c.volume.spacing_mm[a] * (float)(c.volume.dim[a] - 1u);
+        }
+        if (!within_extent(far_corner)) {
+            return SC_ERR_CASE_TRANSFORM;
+        }
     }
     sc_xform orient = sc_xform_identity();
     memcpy(orient.r, c.orientation, sizeof orient.r);
@@ -565,7 +589,8 @@ static int parse_case(const section_ref sec[SC_CASE_SECTION_COUNT], uint32_t cas
     rd_xform(sec[6].p, &c.image_to_probe);
     rd_xform(sec[6].p + 48, &c.tracker_to_patient);
     if (!sc_xform_is_rigid(&c.image_to_probe, SC_CASE_RIGID_TOL) ||
-        !sc_xform_is_rigid(&c.tracker_to_patient, SC_CASE_RIGID_TOL)) {
+        !sc_xform_is_rigid(&c.tracker_to_patient, SC_CASE_RIGID_TOL) ||
+        !within_extent(c.image_to_probe.t_mm) || !within_extent(c.tracker_to_patient.t_mm)) {
         return SC_ERR_CASE_TRANSFORM;
     }
     /* patient p = O v  =>  v = O^T p: fold the orientation into the registration */

@@ -50,6 +50,17 @@
  * rotation written from doubles is ~1e-7; 1e-4 refuses anything visibly non-rigid). */
 #define SC_CASE_RIGID_TOL 1.0e-4f
 
+/* Physical plausibility (a value outside is refused by name, however finite): a voxel is at
+ * most 50 mm, the volume, the mesh box and every translation lie within 5 m of the origin,
+ * Young's modulus is 1 Pa .. 100 GPa (vein lumen .. ten times cortical bone), density
+ * 10 .. 25,000 kg/m^3. */
+#define SC_CASE_MAX_SPACING_MM 50.0f
+#define SC_CASE_MAX_EXTENT_MM  5000.0f
+#define SC_CASE_MIN_E_PA       1.0f
+#define SC_CASE_MAX_E_PA       1.0e11f
+#define SC_CASE_MIN_DENSITY    10.0f
+#define SC_CASE_MAX_DENSITY    25000.0f
+
 /* Section tags: four ASCII characters read as a little-endian u32. */
 #define SC_CASE_TAG(a, b, c, d)                                                                    \
     ((uint32_t)(a) | ((uint32_t)(b) << 8) | ((uint32_t)(c) << 16) | ((uint32_t)(d) << 24))

@@ -384,6 +384,42 @@ static void sliced_check_accepts_exactly_what_load_accepts_and_fills_the_same_vi
     assert_int_equal(check_sliced(g_buf, n2, 333u, &sliced, &steps), SC_ERR_CASE_LABEL);
 }
 
+static void physically_absurd_values_are_refused_by_name(void **state)
+{
+    (void)state;
+    sc_case c;
+    sc_case_def d = make_def();
+    d.materials[SC_LABEL_VEIN].e_pa = 3e38f;
+    size_t n = write_def(&d, g_buf);
+    assert_int_equal(sc_case_load(g_buf, n, &c), SC_ERR_CASE_MATERIAL);
+    d = make_def();
+    d.materials[SC_LABEL_FAT].density_kg_m3 = 1e9f;
+    n = write_def(&d, g_buf);
+    assert_int_equal(sc_case_load(g_buf, n, &c), SC_ERR_CASE_MATERIAL);
+    d = make_def();
+    d.volume.spacing_mm[1] = 1e30f;
+    n = write_def(&d, g_buf);
+    assert_int_equal(sc_case_load(g_buf, n, &c), SC_ERR_CASE_SPACING);
+    d = make_def();
+    d.tracker_to_patient.t_mm[2] = 3e38f;
+    n = write_def(&d, g_buf);
+    assert_int_equal(sc_case_load(g_buf, n, &c), SC_ERR_CASE_TRANSFORM);
+    d = make_def();
+    d.image_to_probe.t_mm[0] = -6000.0f;
+    n = write_def(&d, g_buf);
+    assert_int_equal(sc_case_load(g_buf, n, &c), SC_ERR_CASE_TRANSFORM);
+    d = make_def();
+    d.volume.origin_mm[0] = 4999.0f; /* the far corner is beyond 5 m */
+    n = write_def(&d, g_buf);
+    assert_int_equal(sc_case_load(g_buf, n, &c), SC_ERR_CASE_TRANSFORM);
+    /* the limits themselves pass */
+    d = make_def();
+    d.materials[SC_LABEL_BONE].e_pa = SC_CASE_MAX_E_PA;
+    d.materials[SC_LABEL_VEIN].e_pa = SC_CASE_MIN_E_PA;
+    n = write_def(&d, g_buf);
+    assert_int_equal(sc_case_load(g_buf, n, &c), SC_OK);
+}
+
 static void invalid_materials_are_refused(void **state)
 {
     (void)state;
@@ -672,6 +708,7 @@ int main(void)
         cmocka_unit_test(labels_outside_the_material_table_are_refused),
         cmocka_unit_test(sliced_check_accepts_exactly_what_load_accepts_and_fills_the_same_view),
         cmocka_unit_test(invalid_materials_are_refused),
+        cmocka_unit_test(physically_absurd_values_are_refused_by_name),
         cmocka_unit_test(mesh_box_outside_the_volume_is_refused),
         cmocka_unit_test(mesh_node_counts_outside_limits_are_refused),
         cmocka_unit_test(non_finite_or_non_rigid_transforms_are_refused),
