@@ -209,7 +209,7 @@ static void stage_physics(void *user)
             sc_health_raise(&e->health, SC_FAULT_PHYS_REPEATED);
         }
         sc_log(&e->hal->log, SC_LOG_ERROR, "tissue_reset", rc, (int64_t)e->counters.phys_resets,
-               0);
+               (int64_t)e->tissue.stats.last_fault); /* sc_tissue_guard: why */
     }
     const int unstable = e->counters.phys_resets != 0u &&
                          now - e->last_phys_reset_ns <

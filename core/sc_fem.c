@@ -22,7 +22,6 @@
  * SC_FEM_BLK_TRANSPOSED set (it holds K_ba = K_ab^T). */
 static const uint8_t k_pair_a[6] = {0u, 0u, 0u, 1u, 1u, 2u};
 static const uint8_t k_pair_b[6] = {1u, 2u, 3u, 2u, 3u, 3u};
-#define SC_FEM_BLK_TRANSPOSED 0x80000000u
 
 /* E in Pa -> N/mm^2; density kg/m^3 * mm^3 -> kg (1e-9) -> N s^2/mm (1e-3). */
 #define SC_FEM_PA_TO_NMM2      1.0e-6f
@@ -1011,7 +1010,15 @@ void sc_fem_step(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s, uint32_t 
 void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
                            uint32_t cg_iterations, const uint8_t *kinematic)
 {
+    sc_fem_step_custom(f, m, n, dt_s, cg_iterations, kinematic, NULL);
+}
+
+void sc_fem_step_custom(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
+                        uint32_t cg_iterations, const uint8_t *kinematic, const sc_fem_custom *cu)
+{
     SC_ASSERT(f != NULL && m != NULL && n != NULL);
+    SC_ASSERT(cu == NULL || (cu->assemble != NULL && isfinite(cu->beta_s) && cu->beta_s >= 0.0f &&
+                             isfinite(cu->alpha_per_s) && cu->alpha_per_s >= 0.0f));
     SC_ASSERT(f->node_count == m->node_count && f->tet_count == m->tet_count);
     SC_ASSERT(isfinite(dt_s) && dt_s > 0.0f);
     SC_ASSERT(cg_iterations >= 1u && cg_iterations <= SC_PHYS_ITERATIONS_MAX);
@@ -1031,11 +1038,12 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
      * stiffness-damped mode (mass negligible: (beta + dt) K v+ = -K u). Modes that the
      * fixed-count CG leaves unconverged then keep relaxing; a plain v0 = v lets them coast on
      * a stale velocity, which overshoots and oscillates at 1-5 CG iterations. */
-    const float damp_s = f->def.rayleigh_beta_s;
+    const float damp_s = cu != NULL ? cu->beta_s : f->def.rayleigh_beta_s;
+    const float alpha_per_s = cu != NULL ? cu->alpha_per_s : f->def.rayleigh_alpha_per_s;
     const float warm = damp_s / (damp_s + dt_s);
-    const float cm = 1.0f + dt_s * f->def.rayleigh_alpha_per_s;
-    const float ck = dt_s * f->def.rayleigh_beta_s + dt_s * dt_s;
-    const float dta = dt_s * f->def.rayleigh_alpha_per_s;
+    const float cm = 1.0f + dt_s * alpha_per_s;
+    const float ck = dt_s * damp_s + dt_s * dt_s;
+    const float dta = dt_s * alpha_per_s;
     /* Gather the shared SoA state; Dirichlet DOFs: fixed (v = 0) and kinematic (v given). */
     for (uint32_t i = 0; i < nn; i++) {
         uint8_t con = 0u;
@@ -1063,7 +1071,20 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
 
     /* r0 = b - A v0 with b = M v + dt (f_ext - f_int(x)) and v0 = v (warm start):
      *   r0 = dt f_ext - dt alpha M v0 - dt f_int(x) - ck K v0. */
-    if (f->def.corotated != 0u) {
+    if (cu != NULL) {
+        /* the caller's K(x) and dt f_int(x); then ck K v0 by one mat-vec */
+        zero_floats(&f->blk[0][0], SC_FEM_BLK_FLOATS * f->nnz_blocks);
+        cu->assemble(cu->ctx, f, dt_s, r3);
+        f->matrix_is_rest = 0u;
+        f->stats.degenerate_tets = 0u;
+        for (uint32_t k = 0; k < n3; k++) {
+            p3[k] = ck * v3[k];
+        }
+        matvec(f, p3, q3, 0.0f, 1.0f);
+        for (uint32_t k = 0; k < n3; k++) {
+            r3[k] -= q3[k];
+        }
+    } else if (f->def.corotated != 0u) {
         assemble_corotated(f, m, dt_s, ck, r3); /* element terms, with K v0 folded in */
     } else {
         if (f->matrix_is_rest == 0u) {

@@ -178,6 +178,30 @@ void sc_fem_step(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s, uint32_t 
 void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
                            uint32_t cg_iterations, const uint8_t *kinematic);
 
+/* A caller-supplied stiffness for sc_fem_step_custom (the stable MSDS, sc_msds_implicit.h):
+ * assemble() receives the matrix zeroed and must add a symmetric positive semi-definite K(x)
+ * of the positions f->x3 into f->blk in this pattern (diagonal block first in each row; a
+ * tet's pairs through tet_blk, SC_FEM_BLK_TRANSPOSED marking a stored K_ba), and subtract
+ * dt_s f_int(x) from r3 (4 floats per node, lane 3 untouched). Damping C = alpha M + beta K. */
+typedef struct sc_fem_custom {
+    void (*assemble)(void *ctx, sc_fem *f, float dt_s, float *r3);
+    void *ctx;
+    float beta_s;      /* stiffness-proportional damping, >= 0 */
+    float alpha_per_s; /* mass-proportional damping, >= 0 */
+} sc_fem_custom;
+
+/* Vertex pair p of tet_blk[e][p]: (0,1) (0,2) (0,3) (1,2) (1,3) (2,3); the stored block is
+ * (tet[a], tet[b]) if tet[a] < tet[b], else (tet[b], tet[a]) with this bit set. */
+#define SC_FEM_BLK_TRANSPOSED 0x80000000u
+
+/* sc_fem_step_kinematic with the stiffness, internal force and damping of cu instead of the
+ * elastic element model (cu == NULL: the element model). The same backward Euler step, warm
+ * start, Jacobi PCG with a fixed count and refusal of a non-finite solution; afterwards the
+ * matrix no longer holds the rest K (the next linear FEM step re-assembles it, O(T)).
+ * Cost: the caller's assembly plus (cg_iterations + 1) block mat-vecs. Never allocates. */
+void sc_fem_step_custom(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
+                        uint32_t cg_iterations, const uint8_t *kinematic, const sc_fem_custom *cu);
+
 /* Switch corotation on or off at run time; takes effect in the next step (switching off
  * re-assembles the rest K there once, at the cost of a corotated step). O(1). */
 void sc_fem_set_corotated(sc_fem *f, int on);

@@ -27,6 +27,7 @@ sc_msds_def sc_msds_default_def(void)
     d.drag_per_s = 2.5f;
     d.contact_stiffness_ratio = 0.5f;
     d.volume_stiffness_ratio = 6.0f;
+    d.integrator = (uint8_t)SC_MSDS_IMPLICIT;
     return d;
 }
 
@@ -44,6 +45,12 @@ int sc_msds_def_validate(const sc_msds_def *d)
         d->drag_per_s < 0.0f || d->contact_stiffness_ratio < 0.0f ||
         d->volume_stiffness_ratio < 0.0f || d->volume_stiffness_ratio > 100.0f) {
         return SC_ERR_RANGE;
+    }
+    if (d->integrator != (uint8_t)SC_MSDS_IMPLICIT && d->integrator != (uint8_t)SC_MSDS_EXPLICIT) {
+        return SC_ERR_RANGE;
+    }
+    if (d->integrator == (uint8_t)SC_MSDS_IMPLICIT) {
+        return SC_OK; /* unconditionally stable (sc_msds_implicit.h) */
     }
     /* explicit stability (sc_msds.h): largest eigenvalue of M^-1 K incl. contact, and the
      * largest damping rate */

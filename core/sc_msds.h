@@ -96,6 +96,12 @@
 _Static_assert(SC_MSDS_SWEEP_BLOCK % SC_MSDS_CELL_BLOCK == 0u,
                "a sweep block holds whole cell blocks");
 
+/* Time integrator of the MSDS (sc_tissue runs it): */
+typedef enum sc_msds_integrator {
+    SC_MSDS_IMPLICIT = 0, /* default: backward Euler, one step per frame (sc_msds_implicit.h) */
+    SC_MSDS_EXPLICIT = 1, /* the paper's explicit Euler, `iterations` substeps of dt */
+} sc_msds_integrator;
+
 typedef struct sc_msds_def {
     float dt_s;                    /* explicit Euler step, > 0 (default SC_PHYS_DT_DEFAULT_S) */
     uint32_t iterations;           /* Euler steps per frame, 1..SC_PHYS_ITERATIONS_MAX */
@@ -103,6 +109,8 @@ typedef struct sc_msds_def {
     float drag_per_s;              /* mass-proportional drag, >= 0 */
     float contact_stiffness_ratio; /* contact spring per node / its summed spring k, >= 0 */
     float volume_stiffness_ratio;  /* volume term (see above) / Lame lambda, 0..100; 0: off */
+    uint8_t integrator;            /* sc_msds_integrator; the stability bound above applies
+                                      to SC_MSDS_EXPLICIT only */
 } sc_msds_def;
 
 typedef struct sc_msds {
@@ -143,7 +151,7 @@ typedef struct sc_msds {
 } sc_msds;
 
 /* dt 0.01 s, 20 iterations (paper), mass scaling 1.2e-3 s^2, drag 2.5 / s, contact ratio
- * 0.5, volume term ratio 6. */
+ * 0.5, volume term ratio 6, the implicit integrator (SC_MSDS_IMPLICIT). */
 sc_msds_def sc_msds_default_def(void);
 
 /* Finite, ranges, and the explicit stability bound above. O(1).

@@ -71,9 +71,20 @@ typedef struct sc_tissue_def {
     sc_tissue_contact msds_contact;
 } sc_tissue_def;
 
+/* Why the stability guard reset the tissue (sc_tissue_stats.last_fault). */
+typedef enum sc_tissue_guard {
+    SC_TISSUE_GUARD_OK = 0,
+    SC_TISSUE_GUARD_NOT_FINITE = 1,   /* a position or velocity is NaN or infinite */
+    SC_TISSUE_GUARD_DISPLACEMENT = 2, /* a node moved further than the box diagonal */
+    SC_TISSUE_GUARD_ENERGY = 3,       /* MSDS kinetic energy above its runaway bound */
+    SC_TISSUE_GUARD_SOLVER = 4,       /* the implicit solve (FEM or MSDS) was not finite */
+    SC_TISSUE_GUARD_SKIN = 5,         /* the skin diverged */
+} sc_tissue_guard;
+
 typedef struct sc_tissue_stats {
     uint32_t frames;
     uint32_t faults;            /* guard resets since init */
+    uint32_t last_fault;        /* sc_tissue_guard of the last reset (0: none yet) */
     uint32_t contacts;          /* tet-mesh contacts of the last frame */
     uint32_t kinematic;         /* FEM: nodes held on the probe surface in the last frame */
     uint32_t mpr_calls;         /* narrow-phase calls of the last frame (mesh + skin) */

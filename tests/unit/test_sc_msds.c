@@ -345,10 +345,18 @@ static void unstable_or_invalid_settings_are_refused(void **state)
     (void)state;
     sc_msds_def d = sc_msds_default_def();
     assert_int_equal(sc_msds_def_validate(&d), SC_OK);
-    d.dt_s = 0.05f; /* (0.1 dt + dt^2) * 2 / mu = 5.5: unstable */
+    /* the implicit default has no stability bound; the paper's explicit Euler has */
+    d.dt_s = 0.05f;
+    assert_int_equal(sc_msds_def_validate(&d), SC_OK);
+    d.integrator = (uint8_t)SC_MSDS_EXPLICIT;
+    /* (0.1 dt + dt^2) * 2 / mu = 5.5: unstable */
     assert_int_equal(sc_msds_def_validate(&d), SC_ERR_RANGE);
     d = sc_msds_default_def();
+    d.integrator = (uint8_t)SC_MSDS_EXPLICIT;
     d.mass_per_stiffness_s2 = 5e-4f; /* below the 1.05e-3 bound */
+    assert_int_equal(sc_msds_def_validate(&d), SC_ERR_RANGE);
+    d = sc_msds_default_def();
+    d.integrator = 7u;
     assert_int_equal(sc_msds_def_validate(&d), SC_ERR_RANGE);
     d = sc_msds_default_def();
     d.iterations = 0;
@@ -365,6 +373,7 @@ static void unstable_or_invalid_settings_are_refused(void **state)
     /* runtime change: the old settings stay on error */
     build(4, 4, 4, 0, 1);
     d = sc_msds_default_def();
+    d.integrator = (uint8_t)SC_MSDS_EXPLICIT;
     d.dt_s = 0.05f;
     assert_int_equal(sc_msds_set_def(&g_msds, &d), SC_ERR_RANGE);
     assert_true(fabsf(g_msds.def.dt_s - 0.01f) <= 0.0f);
