@@ -215,6 +215,12 @@ static void stage_physics(void *user)
                          now - e->last_phys_reset_ns <
                              (uint64_t)e->def.phys_fault_hold_ms * NS_PER_MS;
     sc_health_set(&e->health, SC_FAULT_PHYS_UNSTABLE, unstable);
+    if (frozen && !unstable) {
+        /* recovery without a person: a hold time without a reset (the tissue ran at rest,
+         * without the probe) ends the freeze; the resets stay counted and logged */
+        sc_health_clear(&e->health, SC_FAULT_PHYS_REPEATED);
+        e->phys_resets_window = 0;
+    }
     e->probe_contact = (uint8_t)(probe != NULL && e->tissue.stats.contacts > 0u);
 }
 

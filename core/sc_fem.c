@@ -1047,10 +1047,13 @@ void sc_fem_step_custom(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
     /* Gather the shared SoA state; Dirichlet DOFs: fixed (v = 0) and kinematic (v given). */
     for (uint32_t i = 0; i < nn; i++) {
         uint8_t con = 0u;
-        if (m->node_fixed[i] != 0u || f->node_used[i] == 0u) {
+        const uint8_t fixed = m->node_fixed[i];
+        if (fixed == SC_MESH_FIXED_ALL || f->node_used[i] == 0u) {
             con = 1u;
         } else if (kinematic != NULL && kinematic[i] != 0u) {
             con = 2u;
+        } else if (fixed != 0u) {
+            con = (uint8_t)(0x80u | (fixed & (SC_MESH_ROLLER_X | SC_MESH_ROLLER_Y | SC_MESH_ROLLER_Z)));
         }
         f->constrained[i] = con;
         x3[4u * i] = n->x[i];
@@ -1058,9 +1061,10 @@ void sc_fem_step_custom(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
         x3[4u * i + 2u] = n->z[i];
         x3[4u * i + 3u] = 0.0f;
         const float keep = (con == 1u) ? 0.0f : (con == 2u) ? 1.0f : warm;
-        v3[4u * i] = keep * n->vx[i];
-        v3[4u * i + 1u] = keep * n->vy[i];
-        v3[4u * i + 2u] = keep * n->vz[i];
+        /* rollers: the held axes have velocity 0 (bit 1 << (d + 1) of axis d) */
+        v3[4u * i] = (con & SC_MESH_ROLLER_X) != 0u && con >= 0x80u ? 0.0f : keep * n->vx[i];
+        v3[4u * i + 1u] = (con & SC_MESH_ROLLER_Y) != 0u && con >= 0x80u ? 0.0f : keep * n->vy[i];
+        v3[4u * i + 2u] = (con & SC_MESH_ROLLER_Z) != 0u && con >= 0x80u ? 0.0f : keep * n->vz[i];
         v3[4u * i + 3u] = 0.0f;
         /* the node terms of r0 (below) */
         r3[4u * i] = dt_s * n->fx[i] - dta * mass[i] * v3[4u * i];
@@ -1106,7 +1110,9 @@ void sc_fem_step_custom(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
         const float *D = f->blk[f->row_start[i]];
         for (uint32_t d = 0; d < 3u; d++) {
             const float a = cm * mass[i] + ck * D[5u * d];
-            inv[4u * i + d] = (f->constrained[i] == 0u && a > 0.0f) ? 1.0f / a : 0.0f;
+            const uint8_t con = f->constrained[i];
+            const int free_dof = con == 0u || (con >= 0x80u && (con & (2u << d)) == 0u);
+            inv[4u * i + d] = (free_dof && a > 0.0f) ? 1.0f / a : 0.0f;
         }
         inv[4u * i + 3u] = 0.0f;
     }

@@ -128,7 +128,8 @@ typedef struct sc_fem {
     SC_ALIGN_HOT float p3[4u * SC_MAX_NODES];        /* search direction */
     SC_ALIGN_HOT float q3[4u * SC_MAX_NODES];        /* A p */
     SC_ALIGN_HOT float inv_diag3[4u * SC_MAX_NODES]; /* Jacobi, 0 on Dirichlet DOFs */
-    uint8_t constrained[SC_MAX_NODES];               /* this step: 1 fixed, 2 kinematic, 0 free */
+    uint8_t constrained[SC_MAX_NODES];               /* this step: 1 fixed, 2 kinematic, 0 free,
+                                                        0x80 | SC_MESH_ROLLER_* bits: rollers */
     uint8_t node_used[SC_MAX_NODES];                 /* node belongs to at least one tet */
 
     /* ---- per tet rest data (corotated re-assembly), in groups of SC_FEM_TET_LANES tets with

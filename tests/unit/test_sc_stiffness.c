@@ -1,0 +1,160 @@
+/* test_sc_stiffness.c: static stiffness of the MSDS (derived springs, implicit integrator) and
+ * of the FEM against the exact uniaxial answer E A / L, at three mesh resolutions.
+ *
+ * The block: a 16 mm cube of one material (E 10 kPa, Poisson 0.45), the bottom face on
+ * rollers (z held, x and y free; one corner also held in x and y, one more in y: no rigid
+ * motion, no constraint on the lateral expansion), a uniform pressure on the top face as
+ * consistent nodal loads (a node's share of the face area). Uniaxial stress is then the exact
+ * solution for any Poisson ratio, which linear tets represent exactly, so the FEM must give
+ * E A / L to rounding and the MSDS within 20% (sc_msds.h, SC_MSDS_SPRINGS_DERIVED). */
+#include "sc_test.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "sc_err.h"
+#include "sc_fem.h"
+#include "sc_labels.h"
+#include "sc_material.h"
+#include "sc_mesh.h"
+#include "sc_msds.h"
+#include "sc_msds_implicit.h"
+#include "sc_springs.h"
+
+static sc_mesh g_mesh;
+static sc_nodes g_nodes;
+static sc_springs g_springs;
+static sc_msds g_msds;
+static sc_fem g_fem;
+
+#define BLOCK_MM 16.0f
+#define E_PA 10000.0f
+#define NU 0.45f
+#define STRAIN 0.01f
+
+typedef enum { USE_FEM, USE_MSDS, USE_MSDS_PAPER } solver;
+
+/* Ratio of the measured stiffness F / (mean top displacement) to E A / L. */
+static double uniaxial_ratio(uint32_t n, solver which)
+{
+    const sc_mesh_def md = {n, n, n, {0.0f, 0.0f, 0.0f}, {BLOCK_MM, BLOCK_MM, BLOCK_MM}};
+    assert_int_equal(sc_mesh_build(&g_mesh, &md), SC_OK);
+    sc_material_table mat;
+    sc_material_table_default(&mat);
+    mat.row[SC_LABEL_FAT].e_pa = E_PA;
+    mat.row[SC_LABEL_FAT].poisson = NU;
+    assert_int_equal(sc_material_assign(&g_mesh, NULL, &mat, SC_LABEL_FAT), SC_OK);
+    const uint32_t nxy = n * n;
+    for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+        g_mesh.node_fixed[i] = (i / nxy == n - 1u) ? (uint8_t)SC_MESH_ROLLER_Z : 0u;
+    }
+    const uint32_t bottom = (n - 1u) * nxy;
+    g_mesh.node_fixed[bottom] = (uint8_t)(SC_MESH_ROLLER_X | SC_MESH_ROLLER_Y | SC_MESH_ROLLER_Z);
+    g_mesh.node_fixed[bottom + n - 1u] = (uint8_t)(SC_MESH_ROLLER_Y | SC_MESH_ROLLER_Z);
+    assert_int_equal(sc_springs_from_tets(&g_springs, (const uint32_t(*)[4])g_mesh.tet,
+                                          g_mesh.tet_label, g_mesh.tet_count, &mat),
+                     SC_OK);
+    sc_msds_def d = sc_msds_default_def();
+    d.integrator = (uint8_t)SC_MSDS_IMPLICIT;
+    if (which == USE_MSDS_PAPER) {
+        d.springs = (uint8_t)SC_MSDS_SPRINGS_PAPER;
+        d.volume_stiffness_ratio = 6.0f;
+    } else {
+        d.springs = (uint8_t)SC_MSDS_SPRINGS_DERIVED;
+        d.volume_stiffness_ratio = 1.0f;
+    }
+    assert_int_equal(sc_msds_init(&g_msds, &g_mesh, &g_springs, &mat, &d), SC_OK);
+    const sc_fem_def fd = sc_fem_default_def();
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &mat, &fd), SC_OK);
+    sc_nodes_reset_to_rest(&g_nodes, &g_mesh);
+    /* top face (k = 0): consistent nodal loads of a uniform pressure, +z (into the body) */
+    const float area = BLOCK_MM * BLOCK_MM;
+    const float e_nmm2 = E_PA * 1e-6f;
+    const float force_n = e_nmm2 * area * STRAIN;
+    /* consistent loads of the top face's triangles (the tets' hull faces at z = 0): a third
+     * of each triangle's area to each of its corners */
+    const float pressure = force_n / area;
+    for (uint32_t t = 0; t < g_mesh.tet_count; t++) {
+        for (uint32_t v = 0; v < 4u; v++) {
+            if (g_mesh.tet_nbr[t][v] >= 0) {
+                continue;
+            }
+            uint32_t f[3], c = 0;
+            for (uint32_t w = 0; w < 4u; w++) {
+                if (w != v) {
+                    f[c++] = g_mesh.tet[t][w];
+                }
+            }
+            if (g_mesh.rest_z[f[0]] > 1e-6f || g_mesh.rest_z[f[1]] > 1e-6f ||
+                g_mesh.rest_z[f[2]] > 1e-6f) {
+                continue;
+            }
+            const float ax = g_mesh.rest_x[f[1]] - g_mesh.rest_x[f[0]];
+            const float ay = g_mesh.rest_y[f[1]] - g_mesh.rest_y[f[0]];
+            const float bx = g_mesh.rest_x[f[2]] - g_mesh.rest_x[f[0]];
+            const float by = g_mesh.rest_y[f[2]] - g_mesh.rest_y[f[0]];
+            const float tri = 0.5f * fabsf(ax * by - ay * bx);
+            for (uint32_t w = 0; w < 3u; w++) {
+                g_nodes.fz[f[w]] += pressure * tri / 3.0f;
+            }
+        }
+    }
+    double prev = 0.0, mean = 0.0;
+    for (int it = 0; it < 2000; it++) {
+        if (which == USE_FEM) {
+            sc_fem_step(&g_fem, &g_mesh, &g_nodes, 0.2f, 20u);
+        } else {
+            sc_msds_implicit_step(&g_msds, &g_fem, &g_mesh, &g_nodes, 0.2f, 20u, NULL);
+        }
+        mean = 0.0;
+        for (uint32_t i = 0; i < nxy; i++) {
+            mean += (double)(g_nodes.z[i] - g_mesh.rest_z[i]);
+        }
+        mean /= (double)nxy;
+        if (it > 200 && fabs(mean - prev) <= 1e-7 * fabs(mean)) {
+            break;
+        }
+        prev = mean;
+    }
+    assert_int_equal(sc_fem_status(&g_fem), SC_OK);
+    const double k_measured = (double)force_n / mean;
+    const double k_exact = (double)e_nmm2 * (double)area / (double)BLOCK_MM;
+    return k_measured / k_exact;
+}
+
+static const uint32_t k_res[3] = {5u, 9u, 16u}; /* cells 4, 2, 1.07 mm */
+
+static void fem_uniaxial_block_gives_e_a_over_l_at_three_resolutions(void **state)
+{
+    (void)state;
+    for (uint32_t r = 0; r < 3u; r++) {
+        const double q = uniaxial_ratio(k_res[r], USE_FEM);
+        print_message("FEM  %2u^3 nodes (cell %.2f mm): stiffness / (E A / L) = %.3f\n", k_res[r],
+                      (double)(BLOCK_MM / (float)(k_res[r] - 1u)), q);
+        assert_true(q >= 0.98 && q <= 1.02);
+    }
+}
+
+static void msds_derived_springs_give_e_a_over_l_within_20_percent_at_three_resolutions(
+    void **state)
+{
+    (void)state;
+    for (uint32_t r = 0; r < 3u; r++) {
+        const double q = uniaxial_ratio(k_res[r], USE_MSDS);
+        const double p = uniaxial_ratio(k_res[r], USE_MSDS_PAPER);
+        print_message("MSDS %2u^3 nodes (cell %.2f mm): stiffness / (E A / L) = %.3f derived, "
+                      "%.3f paper (Algorithm 1, volume ratio 6)\n",
+                      k_res[r], (double)(BLOCK_MM / (float)(k_res[r] - 1u)), q, p);
+        assert_true(q >= 0.8 && q <= 1.2);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(fem_uniaxial_block_gives_e_a_over_l_at_three_resolutions),
+        cmocka_unit_test(msds_derived_springs_give_e_a_over_l_within_20_percent_at_three_resolutions),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
