@@ -338,7 +338,11 @@ void sc_collider_detect(const sc_collider *c, const sc_collider_grid *g, const f
                  * between two frames, bulldoze the tissue ahead of it until a node is pushed
                  * out of the box (the guard's displacement reset, measured with `--script
                  * sweep` on all three phantoms). */
-                if (c->def.shape == SC_COLLIDER_ROUNDED_BOX && d_real > 0.0 && l[2] < 0.0f) {
+                /* (also a contact within the margin above the face plane: a node left on
+                 * the face plane at the rounded rim lies just outside the rounding; with the
+                 * rounding's own plane it would not be held, would spring back into the
+                 * probe and chatter between the two every frame) */
+                if (c->def.shape == SC_COLLIDER_ROUNDED_BOX && l[2] < c->def.margin_mm) {
                     const float lf[3] = {l[0], l[1], 0.0f};
                     const float nz[3] = {0.0f, 0.0f, 1.0f};
                     sc_xform_apply(&c->to_vol, lf, ct->p_mm);

@@ -243,6 +243,8 @@ sc_fem_def sc_fem_default_def(void)
     d.rayleigh_beta_s = 0.1f; /* paper Algorithm 1: gamma = 0.1 k per spring */
     d.rayleigh_alpha_per_s = 0.0f;
     d.corotated = 0u;
+    d.floor_volume_ratio = 0.01f;
+    d.floor_pa = 100.0e3f;
     return d;
 }
 
@@ -251,11 +253,13 @@ int sc_fem_def_validate(const sc_fem_def *def)
     if (def == NULL || def->corotated > 1u) {
         return SC_ERR_INVALID_ARG;
     }
-    if (!isfinite(def->rayleigh_beta_s) || !isfinite(def->rayleigh_alpha_per_s)) {
+    if (!isfinite(def->rayleigh_beta_s) || !isfinite(def->rayleigh_alpha_per_s) ||
+        !isfinite(def->floor_volume_ratio) || !isfinite(def->floor_pa)) {
         return SC_ERR_NOT_FINITE;
     }
     if (def->rayleigh_beta_s < 0.0f || def->rayleigh_alpha_per_s < 0.0f ||
-        def->rayleigh_beta_s > 100.0f || def->rayleigh_alpha_per_s > 1.0e6f) {
+        def->rayleigh_beta_s > 100.0f || def->rayleigh_alpha_per_s > 1.0e6f ||
+        def->floor_volume_ratio < 0.0f || def->floor_volume_ratio > 0.5f || def->floor_pa < 0.0f) {
         return SC_ERR_RANGE;
     }
     return SC_OK;
@@ -779,6 +783,80 @@ static float cg_update(float *restrict v, float *restrict r, float *restrict z,
     return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
 }
 
+/* Floor term (sc_fem.h) of every tet below its floor volume: K_f / V0 grad V grad V^T into the
+ * blocks and r3 -= dt f + ck K_f v0 (f_a = K_f (V - V_f) / V0 grad_a V). Returns the number
+ * of tets below the floor. O(T). */
+static uint32_t floor_pass(sc_fem *f, const sc_mesh *m, float dt, float ck, float *restrict r3)
+{
+    const float frac = f->def.floor_volume_ratio;
+    const float kf = f->def.floor_pa * SC_FEM_PA_TO_NMM2;
+    if (!(frac > 0.0f) || !(kf > 0.0f)) {
+        return 0u;
+    }
+    const float *x3 = f->x3, *v3 = f->v3;
+    uint32_t active = 0;
+    for (uint32_t e = 0; e < f->tet_count; e++) {
+        const uint32_t *t = m->tet[e];
+        const float *p0 = &x3[4u * t[0]], *p1 = &x3[4u * t[1]], *p2 = &x3[4u * t[2]],
+                    *p3 = &x3[4u * t[3]];
+        const float e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+        const float e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+        const float e3[3] = {p3[0] - p0[0], p3[1] - p0[1], p3[2] - p0[2]};
+        float g[4][3];
+        g[1][0] = e2[1] * e3[2] - e2[2] * e3[1];
+        g[1][1] = e2[2] * e3[0] - e2[0] * e3[2];
+        g[1][2] = e2[0] * e3[1] - e2[1] * e3[0];
+        const float vol = (e1[0] * g[1][0] + e1[1] * g[1][1] + e1[2] * g[1][2]) / 6.0f;
+        const float v0 = SC_FEM_TET_AT(f->tet_vol, e, 0u);
+        const float vf = frac * v0;
+        if (!(vol < vf) || !(v0 > 0.0f)) {
+            continue;
+        }
+        active++;
+        g[2][0] = e3[1] * e1[2] - e3[2] * e1[1];
+        g[2][1] = e3[2] * e1[0] - e3[0] * e1[2];
+        g[2][2] = e3[0] * e1[1] - e3[1] * e1[0];
+        g[3][0] = e1[1] * e2[2] - e1[2] * e2[1];
+        g[3][1] = e1[2] * e2[0] - e1[0] * e2[2];
+        g[3][2] = e1[0] * e2[1] - e1[1] * e2[0];
+        for (uint32_t q = 0; q < 3u; q++) {
+            g[1][q] /= 6.0f; /* grad V */
+            g[2][q] /= 6.0f;
+            g[3][q] /= 6.0f;
+            g[0][q] = -(g[1][q] + g[2][q] + g[3][q]);
+        }
+        const float c = kf / v0;
+        float gv = 0.0f; /* grad V . v0 */
+        for (uint32_t a = 0; a < 4u; a++) {
+            const float *va = &v3[4u * t[a]];
+            gv += g[a][0] * va[0] + g[a][1] * va[1] + g[a][2] * va[2];
+        }
+        const float fr = dt * c * (vol - vf) + ck * c * gv; /* times g_a */
+        for (uint32_t a = 0; a < 4u; a++) {
+            float *B = f->blk[f->row_start[t[a]]];
+            for (uint32_t q = 0; q < 3u; q++) {
+                r3[4u * t[a] + q] -= fr * g[a][q];
+                for (uint32_t w = 0; w < 3u; w++) {
+                    B[4u * q + w] += c * g[a][q] * g[a][w];
+                }
+            }
+        }
+        for (uint32_t p = 0; p < 6u; p++) {
+            const uint32_t bi = f->tet_blk[e][p];
+            const int tr = (bi & SC_FEM_BLK_TRANSPOSED) != 0u;
+            const uint32_t a = tr ? k_pair_b[p] : k_pair_a[p];
+            const uint32_t b = tr ? k_pair_a[p] : k_pair_b[p];
+            float *B = f->blk[bi & ~SC_FEM_BLK_TRANSPOSED];
+            for (uint32_t q = 0; q < 3u; q++) {
+                for (uint32_t w = 0; w < 3u; w++) {
+                    B[4u * q + w] += c * g[a][q] * g[b][w];
+                }
+            }
+        }
+    }
+    return active;
+}
+
 /* Column code of the 27-stencil: (di + 1) + 3 (dj + 1) + 9 (dk + 1); -1 when not neighbours. */
 static int32_t stencil_code(const sc_mesh *m, uint32_t a, uint32_t b)
 {
@@ -1103,6 +1181,9 @@ void sc_fem_step_custom(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
         for (uint32_t k = 0; k < n3; k++) {
             r3[k] -= q3[k]; /* lane 3: 0 - 0 */
         }
+    }
+    if (cu == NULL && floor_pass(f, m, dt_s, ck, r3) != 0u) {
+        f->matrix_is_rest = 0u; /* the floor blocks are in it: the next linear step re-assembles */
     }
 
     /* Jacobi preconditioner, zero on Dirichlet DOFs (projects the CG onto the free DOFs). */

@@ -90,6 +90,9 @@ typedef struct sc_fem_def {
     float rayleigh_beta_s;      /* stiffness-proportional damping, >= 0 (MSDS: gamma = 0.1 k) */
     float rayleigh_alpha_per_s; /* mass-proportional damping, >= 0 */
     uint8_t corotated;          /* 1: stiffness warping for large rotations; 0: linear */
+    float floor_volume_ratio;   /* a tet below this fraction of its rest volume meets the
+                                   floor term (see below), 0..0.5; 0: off */
+    float floor_pa;             /* the floor term's bulk modulus, Pa, >= 0 */
 } sc_fem_def;
 
 /* Diagnostics of the last step, for tests, benchmarks and health reporting. */
@@ -141,7 +144,16 @@ typedef struct sc_fem {
     SC_ALIGN_HOT uint32_t tet_blk[SC_MAX_TETS][6]; /* block of each vertex pair, see sc_fem.c */
 } sc_fem;
 
-/* Defaults: beta 0.1 s (the MSDS damper ratio of Algorithm 1), alpha 0, linear (paper). */
+/* Floor term (an extension: walls that meet do not pass through each other): a tet whose
+ * volume V falls below V_f = floor_volume_ratio V0 gets the energy 1/2 K_f V0 ((V - V_f) / V0)^2
+ * (K_f = floor_pa) on top of its elastic energy, with the Gauss-Newton stiffness
+ * K_f / V0 grad V grad V^T; a collapsed lumen's tets flatten to V_f instead of turning inside
+ * out (an inverted tet overlaps its neighbours, and the B-scan then shows the lumen again).
+ * The same term runs in the implicit MSDS (sc_msds_implicit.h). While it is active the linear
+ * model's matrix is re-assembled each step (O(T)). */
+
+/* Defaults: beta 0.1 s (the MSDS damper ratio of Algorithm 1), alpha 0, linear (paper), floor
+ * at 1% of the rest volume with 100 kPa. */
 sc_fem_def sc_fem_default_def(void);
 
 /* Check a definition: finite, non-negative damping, corotated 0 or 1. O(1).

@@ -29,6 +29,8 @@ sc_msds_def sc_msds_default_def(void)
     d.volume_stiffness_ratio = 1.0f; /* derived springs: the FEM's lambda (sc_msds.h) */
     d.integrator = (uint8_t)SC_MSDS_IMPLICIT;
     d.springs = (uint8_t)SC_MSDS_SPRINGS_DERIVED;
+    d.floor_volume_ratio = 0.01f;
+    d.floor_pa = 100.0e3f;
     return d;
 }
 
@@ -38,13 +40,15 @@ int sc_msds_def_validate(const sc_msds_def *d)
         return SC_ERR_INVALID_ARG;
     }
     if (!isfinite(d->dt_s) || !isfinite(d->mass_per_stiffness_s2) || !isfinite(d->drag_per_s) ||
-        !isfinite(d->contact_stiffness_ratio) || !isfinite(d->volume_stiffness_ratio)) {
+        !isfinite(d->contact_stiffness_ratio) || !isfinite(d->volume_stiffness_ratio) ||
+        !isfinite(d->floor_volume_ratio) || !isfinite(d->floor_pa)) {
         return SC_ERR_NOT_FINITE;
     }
     if (!(d->dt_s > 0.0f) || d->dt_s > 1.0f || d->iterations < 1u ||
         d->iterations > SC_PHYS_ITERATIONS_MAX || !(d->mass_per_stiffness_s2 > 0.0f) ||
         d->drag_per_s < 0.0f || d->contact_stiffness_ratio < 0.0f ||
-        d->volume_stiffness_ratio < 0.0f || d->volume_stiffness_ratio > 100.0f) {
+        d->volume_stiffness_ratio < 0.0f || d->volume_stiffness_ratio > 100.0f ||
+        d->floor_volume_ratio < 0.0f || d->floor_volume_ratio > 0.5f || d->floor_pa < 0.0f) {
         return SC_ERR_RANGE;
     }
     if ((d->integrator != (uint8_t)SC_MSDS_IMPLICIT &&

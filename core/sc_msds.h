@@ -132,6 +132,10 @@ typedef struct sc_msds_def {
     uint8_t integrator;            /* sc_msds_integrator; the stability bound above applies
                                       to SC_MSDS_EXPLICIT only */
     uint8_t springs;               /* sc_msds_springs; read by sc_msds_init only */
+    float floor_volume_ratio;      /* implicit: a tet below this fraction of its rest volume
+                                      meets the floor term (walls that meet do not pass
+                                      through each other), 0..0.5; 0: off */
+    float floor_pa;                /* implicit: the floor term's bulk modulus, >= 0 */
 } sc_msds_def;
 
 typedef struct sc_msds {

@@ -71,15 +71,13 @@ static void assemble_springs(const sc_msds *s, sc_fem *f, float dt, float *r3)
 static void assemble_volume(const sc_msds *s, sc_fem *f, float dt, float *r3)
 {
     const float vr = s->def.volume_stiffness_ratio;
-    if (!(vr > 0.0f)) {
-        return;
-    }
+    const float floor_frac = s->def.floor_volume_ratio;
+    /* floor term: energy 1/2 K_f V0 ((V - V_f) / V0)^2 below V_f = floor_frac V0, i.e. per 6V
+     * k = K_f / (6 V0 x 6) = K_f / (6 d0) with d0 = 6 V0 (N/mm^2 from Pa: 1e-6) */
+    const float kf = s->def.floor_pa * 1e-6f / 6.0f;
     const float *x3 = f->x3;
     for (uint32_t t = 0; t < s->vol_count; t++) {
-        const float c = vr * s->kvol36[t];
-        if (!(c > 0.0f)) {
-            continue;
-        }
+        float c = vr * s->kvol36[t];
         const uint32_t v[4] = {s->tv[0][t], s->tv[1][t], s->tv[2][t], s->tv[3][t]};
         const float *p0 = &x3[4u * v[0]];
         const float *p1 = &x3[4u * v[1]];
@@ -104,7 +102,18 @@ static void assemble_volume(const sc_msds *s, sc_fem *f, float dt, float *r3)
         for (uint32_t q = 0; q < 3u; q++) {
             g[0][q] = -(g[1][q] + g[2][q] + g[3][q]);
         }
-        const float fd = c * (d6 - s->d0_mm3[t]); /* f_int_a = fd g_a */
+        float fd = c * (d6 - s->d0_mm3[t]); /* f_int_a = fd g_a */
+        const float d0 = s->d0_mm3[t];
+        const float dfloor = floor_frac * d0;
+        if (d6 < dfloor && d0 > 0.0f) {
+            /* walls that meet do not pass through each other (see sc_msds_implicit.h) */
+            const float cf = kf / d0;
+            fd += cf * (d6 - dfloor);
+            c += cf;
+        }
+        if (!(c > 0.0f)) {
+            continue;
+        }
         for (uint32_t a = 0; a < 4u; a++) {
             float *B = f->blk[f->row_start[v[a]]];
             for (uint32_t q = 0; q < 3u; q++) {

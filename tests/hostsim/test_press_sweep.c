@@ -4,8 +4,10 @@
  * simulator, both methods: the probe presses over the vessels from 0 to the deepest press in
  * 2 mm steps (ramp 0.25 s, hold 0.5 s), then lifts. Checked: no physics fault and no guard
  * reset at any step, every state finite, and 1 s after the lift every node back within
- * 0.4 mm of rest. Printed (the issue's press table): the image-area ratios of the vein, the
- * artery and the thrombus at the end of each hold.
+ * 0.4 mm of rest; at 16 mm a normal vein coapts (image-area ratio <= 0.05), the artery keeps
+ * >= 0.75 of its area and a thrombosed vein >= 0.8; the ratios fall monotonically with the
+ * press (tolerance 0.01). Printed (the issue's press table): the image-area ratios of the
+ * vein, the artery and the thrombus at the end of each hold.
  */
 #include "sc_test.h"
 
@@ -179,6 +181,27 @@ static void sweep(const char *case_name, sc_tissue_method m)
                   "faults 0x%04x\n",
                   (double)dev, (unsigned long long)rig.engine.counters.phys_resets,
                   (unsigned)st.faults);
+    /* the compression exam at a firm press (16 mm): a normal vein coapts, the artery keeps
+     * its area, a thrombosed vein does not collapse; every ratio falls with the press (within
+     * 0.01: the image's pixel counts move by a few pixels between steps) */
+    int at16 = 0;
+    for (uint32_t i = 0; i < np; i++) {
+        if (fabsf(pts[i].depth_mm - 16.0f) < 0.01f) {
+            at16 = 1;
+            assert_true(pts[i].artery >= 0.75f);
+            if (pts[i].thrombus >= 0.0f) {
+                assert_true(pts[i].thrombus >= 0.8f);
+            } else {
+                assert_true(pts[i].vein >= 0.0f && pts[i].vein <= 0.05f);
+            }
+        }
+        if (i >= 2u) {
+            assert_true(pts[i].vein <= pts[i - 1u].vein + 0.01f);
+            assert_true(pts[i].artery <= pts[i - 1u].artery + 0.01f);
+            assert_true(pts[i].thrombus <= pts[i - 1u].thrombus + 0.01f);
+        }
+    }
+    assert_true(at16);
     assert_true(rig.engine.counters.phys_resets == 0u);
     assert_true(rig.engine.tissue.stats.faults == 0u);
     assert_true((st.faults & ((1u << SC_FAULT_PHYS_UNSTABLE) | (1u << SC_FAULT_PHYS_REPEATED))) ==
