@@ -1131,7 +1131,8 @@ void sc_fem_step_custom(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
         } else if (kinematic != NULL && kinematic[i] != 0u) {
             con = 2u;
         } else if (fixed != 0u) {
-            con = (uint8_t)(0x80u | (fixed & (SC_MESH_ROLLER_X | SC_MESH_ROLLER_Y | SC_MESH_ROLLER_Z)));
+            const uint32_t axes = SC_MESH_ROLLER_X | SC_MESH_ROLLER_Y | SC_MESH_ROLLER_Z;
+            con = (uint8_t)(0x80u | (fixed & axes));
         }
         f->constrained[i] = con;
         x3[4u * i] = n->x[i];

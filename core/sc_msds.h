@@ -1,6 +1,13 @@
 /*
  * sc_msds.h: mass-spring-damper soft tissue, the paper's appendix (eqs. 1-5).
  *
+ * The defaults are not the paper's: the springs are derived from the tets (springs, below:
+ * SC_MSDS_SPRINGS_DERIVED, volume ratio 1) and the tissue facade integrates them with the
+ * stable backward Euler of sc_msds_implicit.h (integrator SC_MSDS_IMPLICIT), with the volume
+ * floor (floor_*). The paper's MSDS is def.springs = SC_MSDS_SPRINGS_PAPER, def.integrator =
+ * SC_MSDS_EXPLICIT and volume_stiffness_ratio 0 (6 was the former default calibration); what
+ * follows describes the explicit path and its springs, which this module's step runs.
+ *
  * Voigt springs from Algorithm 1 (sc_springs.h) on the regular 5-tet grid; per particle
  *   s_i = sum over its springs of [k (|d| - L0) + gamma d|d|/dt] * (-u),  u = d / |d|   (eq. 1)
  *   a_i = (f_i - s_i) / m_i                                                      (eqs. 2, 3)

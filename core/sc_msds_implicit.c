@@ -145,8 +145,8 @@ static void assemble(void *ctx, sc_fem *f, float dt, float *r3)
     assemble_volume(c->s, f, dt, r3);
 }
 
-void sc_msds_implicit_step(const sc_msds *s, sc_fem *f, const sc_mesh *m, sc_nodes *n,
-                           float dt_s, uint32_t cg_iterations, const uint8_t *kinematic)
+void sc_msds_implicit_step(const sc_msds *s, sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
+                           uint32_t cg_iterations, const uint8_t *kinematic)
 {
     SC_ASSERT(s != NULL && f != NULL && m != NULL && n != NULL);
     SC_ASSERT(s->node_count == m->node_count && s->vol_count <= m->tet_count);

@@ -29,9 +29,9 @@ static sc_storage_linux storage;
 #define MAX_ROWS 256u
 static sc_emu_row rows[MAX_ROWS];
 
-#define STEP_MM 2.0f
-#define RAMP_S 0.25
-#define HOLD_S 0.5
+#define STEP_MM  2.0f
+#define RAMP_S   0.25
+#define HOLD_S   0.5
 #define HOVER_MM 3.0f
 
 typedef struct sweep_point {
@@ -50,8 +50,8 @@ static void rig_up(const char *case_file, sc_tissue_method m)
     rig.hal.storage = sc_storage_linux_dev(&storage);
     const int rc = sc_engine_load_case(&rig.engine, case_file);
     if (rc != SC_OK) {
-        print_message("case %s/cases/%s: %s (build the `cases` target)\n", SC_BINARY_DIR,
-                      case_file, sc_err_str(rc));
+        print_message("case %s/cases/%s: %s (build the `cases` target)\n", SC_BINARY_DIR, case_file,
+                      sc_err_str(rc));
     }
     assert_int_equal(rc, SC_OK);
     assert_int_equal(rig.engine.tissue.method, m);
@@ -82,8 +82,8 @@ static int state_finite(void)
 {
     const sc_nodes *n = &rig.engine.tissue.nodes;
     for (uint32_t i = 0; i < rig.engine.tissue.mesh.node_count; i++) {
-        if (!isfinite(n->x[i]) || !isfinite(n->y[i]) || !isfinite(n->z[i]) ||
-            !isfinite(n->vx[i]) || !isfinite(n->vy[i]) || !isfinite(n->vz[i])) {
+        if (!isfinite(n->x[i]) || !isfinite(n->y[i]) || !isfinite(n->z[i]) || !isfinite(n->vx[i]) ||
+            !isfinite(n->vy[i]) || !isfinite(n->vz[i])) {
             return 0;
         }
     }

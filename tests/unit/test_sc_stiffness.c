@@ -29,9 +29,9 @@ static sc_msds g_msds;
 static sc_fem g_fem;
 
 #define BLOCK_MM 16.0f
-#define E_PA 10000.0f
-#define NU 0.45f
-#define STRAIN 0.01f
+#define E_PA     10000.0f
+#define NU       0.45f
+#define STRAIN   0.01f
 
 typedef enum { USE_FEM, USE_MSDS, USE_MSDS_PAPER } solver;
 
@@ -136,8 +136,8 @@ static void fem_uniaxial_block_gives_e_a_over_l_at_three_resolutions(void **stat
     }
 }
 
-static void msds_derived_springs_give_e_a_over_l_within_20_percent_at_three_resolutions(
-    void **state)
+static void
+msds_derived_springs_give_e_a_over_l_within_20_percent_at_three_resolutions(void **state)
 {
     (void)state;
     for (uint32_t r = 0; r < 3u; r++) {
@@ -154,7 +154,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(fem_uniaxial_block_gives_e_a_over_l_at_three_resolutions),
-        cmocka_unit_test(msds_derived_springs_give_e_a_over_l_within_20_percent_at_three_resolutions),
+        cmocka_unit_test(
+            msds_derived_springs_give_e_a_over_l_within_20_percent_at_three_resolutions),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
