@@ -2,3 +2,6 @@
 if(TARGET test_press_sweep AND TARGET cases)
   add_dependencies(test_press_sweep cases)
 endif()
+if(TARGET test_physics_robust AND TARGET cases)
+  add_dependencies(test_physics_robust cases)
+endif()
