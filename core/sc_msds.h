@@ -118,7 +118,13 @@ typedef enum sc_msds_integrator {
  *   mu), van Gelder 1998's form (k ~ E V / L^2, dimensionally E x length, so a finer mesh
  *   keeps the material), and the volume term supplies the rest of lambda: k_vol =
  *   volume_stiffness_ratio * max(0, lambda - mu) / V0. With the ratio 1 the sum is the FEM's
- *   (lambda, mu). The factor is measured on the uniaxial block (tests/unit/test_sc_stiffness.c).
+ *   (lambda, mu). The factor is measured on the uniaxial block (tests/unit/test_sc_stiffness.c):
+ *   cubic cells of 4, 2 and 1.07 mm give E A / L within 0.1% (Poisson 0.45; 0.96-0.97 at 0.3).
+ *   Limitation: k ~ V / L^2 favours short edges, so cells far from cubic are too stiff along
+ *   their long axis (the default 40 x 20 x 30 mm box, cells 1 : 1 : 1.5: 1.44 x the FEM along
+ *   z at 20x10x10 and at 32x16x16); a per-tet fit of the 6 edge constants to the tet's
+ *   stiffness (Lloyd et al. 2007) would remove it (tried: projecting each off-diagonal block
+ *   onto its edge gives 1.37 on cubes, worse).
  * SC_MSDS_SPRINGS_PAPER: Algorithm 1's k = 0.002 E per tet edge (sc_springs.h) and the
  *   volume term on lambda (the former calibration: ratio 6), for the paper's tables. */
 typedef enum sc_msds_springs {

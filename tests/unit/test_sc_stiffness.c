@@ -36,22 +36,33 @@ static sc_fem g_fem;
 typedef enum { USE_FEM, USE_MSDS, USE_MSDS_PAPER } solver;
 
 /* Ratio of the measured stiffness F / (mean top displacement) to E A / L. */
+static double uniaxial_box_ratio(uint32_t nx, uint32_t ny, uint32_t nz, const float size[3],
+                                 solver which);
+
 static double uniaxial_ratio(uint32_t n, solver which)
 {
-    const sc_mesh_def md = {n, n, n, {0.0f, 0.0f, 0.0f}, {BLOCK_MM, BLOCK_MM, BLOCK_MM}};
+    const float size[3] = {BLOCK_MM, BLOCK_MM, BLOCK_MM};
+    return uniaxial_box_ratio(n, n, n, size, which);
+}
+
+/* The block test on a box of size[] with nx x ny x nz nodes, loaded along z. */
+static double uniaxial_box_ratio(uint32_t nx, uint32_t ny, uint32_t nz, const float size[3],
+                                 solver which)
+{
+    const sc_mesh_def md = {nx, ny, nz, {0.0f, 0.0f, 0.0f}, {size[0], size[1], size[2]}};
     assert_int_equal(sc_mesh_build(&g_mesh, &md), SC_OK);
     sc_material_table mat;
     sc_material_table_default(&mat);
     mat.row[SC_LABEL_FAT].e_pa = E_PA;
     mat.row[SC_LABEL_FAT].poisson = NU;
     assert_int_equal(sc_material_assign(&g_mesh, NULL, &mat, SC_LABEL_FAT), SC_OK);
-    const uint32_t nxy = n * n;
+    const uint32_t nxy = nx * ny;
     for (uint32_t i = 0; i < g_mesh.node_count; i++) {
-        g_mesh.node_fixed[i] = (i / nxy == n - 1u) ? (uint8_t)SC_MESH_ROLLER_Z : 0u;
+        g_mesh.node_fixed[i] = (i / nxy == nz - 1u) ? (uint8_t)SC_MESH_ROLLER_Z : 0u;
     }
-    const uint32_t bottom = (n - 1u) * nxy;
+    const uint32_t bottom = (nz - 1u) * nxy;
     g_mesh.node_fixed[bottom] = (uint8_t)(SC_MESH_ROLLER_X | SC_MESH_ROLLER_Y | SC_MESH_ROLLER_Z);
-    g_mesh.node_fixed[bottom + n - 1u] = (uint8_t)(SC_MESH_ROLLER_Y | SC_MESH_ROLLER_Z);
+    g_mesh.node_fixed[bottom + nx - 1u] = (uint8_t)(SC_MESH_ROLLER_Y | SC_MESH_ROLLER_Z);
     assert_int_equal(sc_springs_from_tets(&g_springs, (const uint32_t(*)[4])g_mesh.tet,
                                           g_mesh.tet_label, g_mesh.tet_count, &mat),
                      SC_OK);
@@ -69,7 +80,7 @@ static double uniaxial_ratio(uint32_t n, solver which)
     assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &mat, &fd), SC_OK);
     sc_nodes_reset_to_rest(&g_nodes, &g_mesh);
     /* top face (k = 0): consistent nodal loads of a uniform pressure, +z (into the body) */
-    const float area = BLOCK_MM * BLOCK_MM;
+    const float area = size[0] * size[1];
     const float e_nmm2 = E_PA * 1e-6f;
     const float force_n = e_nmm2 * area * STRAIN;
     /* consistent loads of the top face's triangles (the tets' hull faces at z = 0): a third
@@ -119,7 +130,7 @@ static double uniaxial_ratio(uint32_t n, solver which)
     }
     assert_int_equal(sc_fem_status(&g_fem), SC_OK);
     const double k_measured = (double)force_n / mean;
-    const double k_exact = (double)e_nmm2 * (double)area / (double)BLOCK_MM;
+    const double k_exact = (double)e_nmm2 * (double)area / (double)size[2];
     return k_measured / k_exact;
 }
 
@@ -150,9 +161,31 @@ msds_derived_springs_give_e_a_over_l_within_20_percent_at_three_resolutions(void
     }
 }
 
+/* The default mesh box (40 x 20 x 30 mm: cells 2.1 x 2.2 x 3.2 mm at 20x10x10, 1.3 x 1.3 x
+ * 2.0 mm at 32x16x16) at the smallest and the largest mesh of the paper's Table I. The FEM is
+ * exact; the MSDS's k ~ V / L^2 favours the short edges, so on cells this far from cubic it
+ * is stiffer along the long axis than the +-20% of the cubic cells: printed and bounded here
+ * (a known limitation, see sc_msds.h), not the cubes' 20%. */
+static void default_box_fem_exact_and_msds_within_60_percent_on_non_cubic_cells(void **state)
+{
+    (void)state;
+    static const uint32_t res[2][3] = {{20u, 10u, 10u}, {32u, 16u, 16u}};
+    const float size[3] = {40.0f, 20.0f, 30.0f};
+    for (uint32_t r = 0; r < 2u; r++) {
+        const double f = uniaxial_box_ratio(res[r][0], res[r][1], res[r][2], size, USE_FEM);
+        const double q = uniaxial_box_ratio(res[r][0], res[r][1], res[r][2], size, USE_MSDS);
+        print_message("40x20x30 mm box, %ux%ux%u nodes: stiffness / (E A / L) FEM %.3f, MSDS "
+                      "derived %.3f (ratio MSDS / FEM %.3f)\n",
+                      res[r][0], res[r][1], res[r][2], f, q, q / f);
+        assert_true(f >= 0.98 && f <= 1.02);
+        assert_true(q >= 0.8 && q <= 1.6);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(default_box_fem_exact_and_msds_within_60_percent_on_non_cubic_cells),
         cmocka_unit_test(fem_uniaxial_block_gives_e_a_over_l_at_three_resolutions),
         cmocka_unit_test(
             msds_derived_springs_give_e_a_over_l_within_20_percent_at_three_resolutions),
