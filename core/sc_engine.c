@@ -147,12 +147,18 @@ static void stage_physics(sc_engine *e, uint64_t now, const sc_probe_in *in, sc_
             sc_health_raise(&e->health, SC_FAULT_PHYS_REPEATED);
         }
         sc_log(&e->hal->log, SC_LOG_ERROR, "tissue_reset", rc, (int64_t)e->counters.phys_resets,
-               0);
+               (int64_t)t->stats.last_fault); /* sc_tissue_guard: why */
     }
     const int unstable = e->counters.phys_resets != 0u &&
                          now - e->last_phys_reset_ns <
                              (uint64_t)e->def.phys_fault_hold_ms * NS_PER_MS;
     sc_health_set(&e->health, SC_FAULT_PHYS_UNSTABLE, unstable);
+    if (frozen && !unstable) {
+        /* recovery without a person: a hold time without a reset (the tissue ran at rest,
+         * without the probe) ends the freeze; the resets stay counted and logged */
+        sc_health_clear(&e->health, SC_FAULT_PHYS_REPEATED);
+        e->phys_resets_window = 0;
+    }
     out->contact = (uint8_t)(probe != NULL && t->stats.contacts > 0u);
     out->mesh = &t->mesh;
     out->nodes = &t->nodes;

@@ -36,7 +36,8 @@ sc_bscan_def sc_bscan_default_def(void)
     }
     d.dynamic_range_db = 60.0f;
     d.volume_range_db = 60.0f;
-    d.rest_margin_mm = 15.0f;
+    d.rest_margin_mm = 60.0f; /* the range's top: deeper than any mesh box the limits allow
+                                 a press into (the appliance's 64x32x32 boxes are 30-45 mm) */
     return d;
 }
 

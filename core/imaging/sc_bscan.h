@@ -28,7 +28,10 @@
  * at the same pose: the instructor's "did the vein collapse?". The reference extends
  * rest_margin_mm above the probe face (every 4th sample there), so that a vessel the probe has
  * pushed down into view counts whole at rest; with a press deeper than the margin the part above
- * it is missing from the reference (the ratio then overstates what is left).
+ * it is missing from the reference (the ratio then overstates what is left). The default
+ * margin, 60 mm (the top of its range; formerly 15 mm, which a 16 mm press already exceeded),
+ * covers a press down to the bottom of any mesh box; it costs one label lookup per 4 samples
+ * (0.25 mm each) per line above the face.
  *
  * Memory: all state in the caller's sc_bscan, sized by config/sc_config.h (about 2 MB with the
  * default limits). Never allocates, never calls the OS. Threads: one writer. Deterministic:

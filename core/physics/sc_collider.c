@@ -331,6 +331,23 @@ void sc_collider_detect(const sc_collider *c, const sc_collider_grid *g, const f
                     ct->n[a] = (float)u;
                     ct->p_mm[a] = (float)((double)p[a] + d_real * u);
                 }
+                /* Sliding face: a node inside the probe leaves through the face plane (the
+                 * probe came from outside the body, through the skin; tissue slides under a
+                 * gel-coated face), not through the nearest side wall or rounded edge: MPR's
+                 * shortest way out lets a probe that moves sideways at depth, or jumps
+                 * between two frames, bulldoze the tissue ahead of it until a node is pushed
+                 * out of the box (the guard's displacement reset, measured with `--script
+                 * sweep` on all three phantoms). */
+                /* (also a contact within the margin above the face plane: a node left on
+                 * the face plane at the rounded rim lies just outside the rounding; with the
+                 * rounding's own plane it would not be held, would spring back into the
+                 * probe and chatter between the two every frame) */
+                if (c->def.shape == SC_COLLIDER_ROUNDED_BOX && l[2] < c->def.margin_mm) {
+                    const float lf[3] = {l[0], l[1], 0.0f};
+                    const float nz[3] = {0.0f, 0.0f, 1.0f};
+                    sc_xform_apply(&c->to_vol, lf, ct->p_mm);
+                    sc_xform_rotate(&c->to_vol, nz, ct->n);
+                }
             }
         }
     }

@@ -22,7 +22,6 @@
  * SC_FEM_BLK_TRANSPOSED set (it holds K_ba = K_ab^T). */
 static const uint8_t k_pair_a[6] = {0u, 0u, 0u, 1u, 1u, 2u};
 static const uint8_t k_pair_b[6] = {1u, 2u, 3u, 2u, 3u, 3u};
-#define SC_FEM_BLK_TRANSPOSED 0x80000000u
 
 /* E in Pa -> N/mm^2; density kg/m^3 * mm^3 -> kg (1e-9) -> N s^2/mm (1e-3). */
 #define SC_FEM_PA_TO_NMM2      1.0e-6f
@@ -244,6 +243,8 @@ sc_fem_def sc_fem_default_def(void)
     d.rayleigh_beta_s = 0.1f; /* paper Algorithm 1: gamma = 0.1 k per spring */
     d.rayleigh_alpha_per_s = 0.0f;
     d.corotated = 0u;
+    d.floor_volume_ratio = 0.01f;
+    d.floor_pa = 100.0e3f;
     return d;
 }
 
@@ -252,11 +253,13 @@ int sc_fem_def_validate(const sc_fem_def *def)
     if (def == NULL || def->corotated > 1u) {
         return SC_ERR_INVALID_ARG;
     }
-    if (!isfinite(def->rayleigh_beta_s) || !isfinite(def->rayleigh_alpha_per_s)) {
+    if (!isfinite(def->rayleigh_beta_s) || !isfinite(def->rayleigh_alpha_per_s) ||
+        !isfinite(def->floor_volume_ratio) || !isfinite(def->floor_pa)) {
         return SC_ERR_NOT_FINITE;
     }
     if (def->rayleigh_beta_s < 0.0f || def->rayleigh_alpha_per_s < 0.0f ||
-        def->rayleigh_beta_s > 100.0f || def->rayleigh_alpha_per_s > 1.0e6f) {
+        def->rayleigh_beta_s > 100.0f || def->rayleigh_alpha_per_s > 1.0e6f ||
+        def->floor_volume_ratio < 0.0f || def->floor_volume_ratio > 0.5f || def->floor_pa < 0.0f) {
         return SC_ERR_RANGE;
     }
     return SC_OK;
@@ -780,6 +783,80 @@ static float cg_update(float *restrict v, float *restrict r, float *restrict z,
     return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
 }
 
+/* Floor term (sc_fem.h) of every tet below its floor volume: K_f / V0 grad V grad V^T into the
+ * blocks and r3 -= dt f + ck K_f v0 (f_a = K_f (V - V_f) / V0 grad_a V). Returns the number
+ * of tets below the floor. O(T). */
+static uint32_t floor_pass(sc_fem *f, const sc_mesh *m, float dt, float ck, float *restrict r3)
+{
+    const float frac = f->def.floor_volume_ratio;
+    const float kf = f->def.floor_pa * SC_FEM_PA_TO_NMM2;
+    if (!(frac > 0.0f) || !(kf > 0.0f)) {
+        return 0u;
+    }
+    const float *x3 = f->x3, *v3 = f->v3;
+    uint32_t active = 0;
+    for (uint32_t e = 0; e < f->tet_count; e++) {
+        const uint32_t *t = m->tet[e];
+        const float *p0 = &x3[4u * t[0]], *p1 = &x3[4u * t[1]], *p2 = &x3[4u * t[2]],
+                    *p3 = &x3[4u * t[3]];
+        const float e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+        const float e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+        const float e3[3] = {p3[0] - p0[0], p3[1] - p0[1], p3[2] - p0[2]};
+        float g[4][3];
+        g[1][0] = e2[1] * e3[2] - e2[2] * e3[1];
+        g[1][1] = e2[2] * e3[0] - e2[0] * e3[2];
+        g[1][2] = e2[0] * e3[1] - e2[1] * e3[0];
+        const float vol = (e1[0] * g[1][0] + e1[1] * g[1][1] + e1[2] * g[1][2]) / 6.0f;
+        const float v0 = SC_FEM_TET_AT(f->tet_vol, e, 0u);
+        const float vf = frac * v0;
+        if (!(vol < vf) || !(v0 > 0.0f)) {
+            continue;
+        }
+        active++;
+        g[2][0] = e3[1] * e1[2] - e3[2] * e1[1];
+        g[2][1] = e3[2] * e1[0] - e3[0] * e1[2];
+        g[2][2] = e3[0] * e1[1] - e3[1] * e1[0];
+        g[3][0] = e1[1] * e2[2] - e1[2] * e2[1];
+        g[3][1] = e1[2] * e2[0] - e1[0] * e2[2];
+        g[3][2] = e1[0] * e2[1] - e1[1] * e2[0];
+        for (uint32_t q = 0; q < 3u; q++) {
+            g[1][q] /= 6.0f; /* grad V */
+            g[2][q] /= 6.0f;
+            g[3][q] /= 6.0f;
+            g[0][q] = -(g[1][q] + g[2][q] + g[3][q]);
+        }
+        const float c = kf / v0;
+        float gv = 0.0f; /* grad V . v0 */
+        for (uint32_t a = 0; a < 4u; a++) {
+            const float *va = &v3[4u * t[a]];
+            gv += g[a][0] * va[0] + g[a][1] * va[1] + g[a][2] * va[2];
+        }
+        const float fr = dt * c * (vol - vf) + ck * c * gv; /* times g_a */
+        for (uint32_t a = 0; a < 4u; a++) {
+            float *B = f->blk[f->row_start[t[a]]];
+            for (uint32_t q = 0; q < 3u; q++) {
+                r3[4u * t[a] + q] -= fr * g[a][q];
+                for (uint32_t w = 0; w < 3u; w++) {
+                    B[4u * q + w] += c * g[a][q] * g[a][w];
+                }
+            }
+        }
+        for (uint32_t p = 0; p < 6u; p++) {
+            const uint32_t bi = f->tet_blk[e][p];
+            const int tr = (bi & SC_FEM_BLK_TRANSPOSED) != 0u;
+            const uint32_t a = tr ? k_pair_b[p] : k_pair_a[p];
+            const uint32_t b = tr ? k_pair_a[p] : k_pair_b[p];
+            float *B = f->blk[bi & ~SC_FEM_BLK_TRANSPOSED];
+            for (uint32_t q = 0; q < 3u; q++) {
+                for (uint32_t w = 0; w < 3u; w++) {
+                    B[4u * q + w] += c * g[a][q] * g[b][w];
+                }
+            }
+        }
+    }
+    return active;
+}
+
 /* Column code of the 27-stencil: (di + 1) + 3 (dj + 1) + 9 (dk + 1); -1 when not neighbours. */
 static int32_t stencil_code(const sc_mesh *m, uint32_t a, uint32_t b)
 {
@@ -1011,7 +1088,15 @@ void sc_fem_step(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s, uint32_t 
 void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
                            uint32_t cg_iterations, const uint8_t *kinematic)
 {
+    sc_fem_step_custom(f, m, n, dt_s, cg_iterations, kinematic, NULL);
+}
+
+void sc_fem_step_custom(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
+                        uint32_t cg_iterations, const uint8_t *kinematic, const sc_fem_custom *cu)
+{
     SC_ASSERT(f != NULL && m != NULL && n != NULL);
+    SC_ASSERT(cu == NULL || (cu->assemble != NULL && isfinite(cu->beta_s) && cu->beta_s >= 0.0f &&
+                             isfinite(cu->alpha_per_s) && cu->alpha_per_s >= 0.0f));
     SC_ASSERT(f->node_count == m->node_count && f->tet_count == m->tet_count);
     SC_ASSERT(isfinite(dt_s) && dt_s > 0.0f);
     SC_ASSERT(cg_iterations >= 1u && cg_iterations <= SC_PHYS_ITERATIONS_MAX);
@@ -1031,18 +1116,23 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
      * stiffness-damped mode (mass negligible: (beta + dt) K v+ = -K u). Modes that the
      * fixed-count CG leaves unconverged then keep relaxing; a plain v0 = v lets them coast on
      * a stale velocity, which overshoots and oscillates at 1-5 CG iterations. */
-    const float damp_s = f->def.rayleigh_beta_s;
+    const float damp_s = cu != NULL ? cu->beta_s : f->def.rayleigh_beta_s;
+    const float alpha_per_s = cu != NULL ? cu->alpha_per_s : f->def.rayleigh_alpha_per_s;
     const float warm = damp_s / (damp_s + dt_s);
-    const float cm = 1.0f + dt_s * f->def.rayleigh_alpha_per_s;
-    const float ck = dt_s * f->def.rayleigh_beta_s + dt_s * dt_s;
-    const float dta = dt_s * f->def.rayleigh_alpha_per_s;
+    const float cm = 1.0f + dt_s * alpha_per_s;
+    const float ck = dt_s * damp_s + dt_s * dt_s;
+    const float dta = dt_s * alpha_per_s;
     /* Gather the shared SoA state; Dirichlet DOFs: fixed (v = 0) and kinematic (v given). */
     for (uint32_t i = 0; i < nn; i++) {
         uint8_t con = 0u;
-        if (m->node_fixed[i] != 0u || f->node_used[i] == 0u) {
+        const uint8_t fixed = m->node_fixed[i];
+        if (fixed == SC_MESH_FIXED_ALL || f->node_used[i] == 0u) {
             con = 1u;
         } else if (kinematic != NULL && kinematic[i] != 0u) {
             con = 2u;
+        } else if (fixed != 0u) {
+            const uint32_t axes = SC_MESH_ROLLER_X | SC_MESH_ROLLER_Y | SC_MESH_ROLLER_Z;
+            con = (uint8_t)(0x80u | (fixed & axes));
         }
         f->constrained[i] = con;
         x3[4u * i] = n->x[i];
@@ -1050,9 +1140,10 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
         x3[4u * i + 2u] = n->z[i];
         x3[4u * i + 3u] = 0.0f;
         const float keep = (con == 1u) ? 0.0f : (con == 2u) ? 1.0f : warm;
-        v3[4u * i] = keep * n->vx[i];
-        v3[4u * i + 1u] = keep * n->vy[i];
-        v3[4u * i + 2u] = keep * n->vz[i];
+        /* rollers: the held axes have velocity 0 (bit 1 << (d + 1) of axis d) */
+        v3[4u * i] = (con & SC_MESH_ROLLER_X) != 0u && con >= 0x80u ? 0.0f : keep * n->vx[i];
+        v3[4u * i + 1u] = (con & SC_MESH_ROLLER_Y) != 0u && con >= 0x80u ? 0.0f : keep * n->vy[i];
+        v3[4u * i + 2u] = (con & SC_MESH_ROLLER_Z) != 0u && con >= 0x80u ? 0.0f : keep * n->vz[i];
         v3[4u * i + 3u] = 0.0f;
         /* the node terms of r0 (below) */
         r3[4u * i] = dt_s * n->fx[i] - dta * mass[i] * v3[4u * i];
@@ -1063,7 +1154,20 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
 
     /* r0 = b - A v0 with b = M v + dt (f_ext - f_int(x)) and v0 = v (warm start):
      *   r0 = dt f_ext - dt alpha M v0 - dt f_int(x) - ck K v0. */
-    if (f->def.corotated != 0u) {
+    if (cu != NULL) {
+        /* the caller's K(x) and dt f_int(x); then ck K v0 by one mat-vec */
+        zero_floats(&f->blk[0][0], SC_FEM_BLK_FLOATS * f->nnz_blocks);
+        cu->assemble(cu->ctx, f, dt_s, r3);
+        f->matrix_is_rest = 0u;
+        f->stats.degenerate_tets = 0u;
+        for (uint32_t k = 0; k < n3; k++) {
+            p3[k] = ck * v3[k];
+        }
+        matvec(f, p3, q3, 0.0f, 1.0f);
+        for (uint32_t k = 0; k < n3; k++) {
+            r3[k] -= q3[k];
+        }
+    } else if (f->def.corotated != 0u) {
         assemble_corotated(f, m, dt_s, ck, r3); /* element terms, with K v0 folded in */
     } else {
         if (f->matrix_is_rest == 0u) {
@@ -1079,13 +1183,18 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
             r3[k] -= q3[k]; /* lane 3: 0 - 0 */
         }
     }
+    if (cu == NULL && floor_pass(f, m, dt_s, ck, r3) != 0u) {
+        f->matrix_is_rest = 0u; /* the floor blocks are in it: the next linear step re-assembles */
+    }
 
     /* Jacobi preconditioner, zero on Dirichlet DOFs (projects the CG onto the free DOFs). */
     for (uint32_t i = 0; i < nn; i++) {
         const float *D = f->blk[f->row_start[i]];
         for (uint32_t d = 0; d < 3u; d++) {
             const float a = cm * mass[i] + ck * D[5u * d];
-            inv[4u * i + d] = (f->constrained[i] == 0u && a > 0.0f) ? 1.0f / a : 0.0f;
+            const uint8_t con = f->constrained[i];
+            const int free_dof = con == 0u || (con >= 0x80u && (con & (2u << d)) == 0u);
+            inv[4u * i + d] = (free_dof && a > 0.0f) ? 1.0f / a : 0.0f;
         }
         inv[4u * i + 3u] = 0.0f;
     }

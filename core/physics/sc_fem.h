@@ -90,6 +90,9 @@ typedef struct sc_fem_def {
     float rayleigh_beta_s;      /* stiffness-proportional damping, >= 0 (MSDS: gamma = 0.1 k) */
     float rayleigh_alpha_per_s; /* mass-proportional damping, >= 0 */
     uint8_t corotated;          /* 1: stiffness warping for large rotations; 0: linear */
+    float floor_volume_ratio;   /* a tet below this fraction of its rest volume meets the
+                                   floor term (see below), 0..0.5; 0: off */
+    float floor_pa;             /* the floor term's bulk modulus, Pa, >= 0 */
 } sc_fem_def;
 
 /* Diagnostics of the last step, for tests, benchmarks and health reporting. */
@@ -128,7 +131,8 @@ typedef struct sc_fem {
     SC_ALIGN_HOT float p3[4u * SC_MAX_NODES];        /* search direction */
     SC_ALIGN_HOT float q3[4u * SC_MAX_NODES];        /* A p */
     SC_ALIGN_HOT float inv_diag3[4u * SC_MAX_NODES]; /* Jacobi, 0 on Dirichlet DOFs */
-    uint8_t constrained[SC_MAX_NODES];               /* this step: 1 fixed, 2 kinematic, 0 free */
+    uint8_t constrained[SC_MAX_NODES];               /* this step: 1 fixed, 2 kinematic, 0 free,
+                                                        0x80 | SC_MESH_ROLLER_* bits: rollers */
     uint8_t node_used[SC_MAX_NODES];                 /* node belongs to at least one tet */
 
     /* ---- per tet rest data (corotated re-assembly), in groups of SC_FEM_TET_LANES tets with
@@ -140,7 +144,16 @@ typedef struct sc_fem {
     SC_ALIGN_HOT uint32_t tet_blk[SC_MAX_TETS][6]; /* block of each vertex pair, see sc_fem.c */
 } sc_fem;
 
-/* Defaults: beta 0.1 s (the MSDS damper ratio of Algorithm 1), alpha 0, linear (paper). */
+/* Floor term (an extension: walls that meet do not pass through each other): a tet whose
+ * volume V falls below V_f = floor_volume_ratio V0 gets the energy 1/2 K_f V0 ((V - V_f) / V0)^2
+ * (K_f = floor_pa) on top of its elastic energy, with the Gauss-Newton stiffness
+ * K_f / V0 grad V grad V^T; a collapsed lumen's tets flatten to V_f instead of turning inside
+ * out (an inverted tet overlaps its neighbours, and the B-scan then shows the lumen again).
+ * The same term runs in the implicit MSDS (sc_msds_implicit.h). While it is active the linear
+ * model's matrix is re-assembled each step (O(T)). */
+
+/* Defaults: beta 0.1 s (the MSDS damper ratio of Algorithm 1), alpha 0, linear (paper), floor
+ * at 1% of the rest volume with 100 kPa. */
 sc_fem_def sc_fem_default_def(void);
 
 /* Check a definition: finite, non-negative damping, corotated 0 or 1. O(1).
@@ -177,6 +190,30 @@ void sc_fem_step(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s, uint32_t 
  * (prescribed-displacement indentation; kinematic == NULL is sc_fem_step). Same cost. */
 void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
                            uint32_t cg_iterations, const uint8_t *kinematic);
+
+/* A caller-supplied stiffness for sc_fem_step_custom (the stable MSDS, sc_msds_implicit.h):
+ * assemble() receives the matrix zeroed and must add a symmetric positive semi-definite K(x)
+ * of the positions f->x3 into f->blk in this pattern (diagonal block first in each row; a
+ * tet's pairs through tet_blk, SC_FEM_BLK_TRANSPOSED marking a stored K_ba), and subtract
+ * dt_s f_int(x) from r3 (4 floats per node, lane 3 untouched). Damping C = alpha M + beta K. */
+typedef struct sc_fem_custom {
+    void (*assemble)(void *ctx, sc_fem *f, float dt_s, float *r3);
+    void *ctx;
+    float beta_s;      /* stiffness-proportional damping, >= 0 */
+    float alpha_per_s; /* mass-proportional damping, >= 0 */
+} sc_fem_custom;
+
+/* Vertex pair p of tet_blk[e][p]: (0,1) (0,2) (0,3) (1,2) (1,3) (2,3); the stored block is
+ * (tet[a], tet[b]) if tet[a] < tet[b], else (tet[b], tet[a]) with this bit set. */
+#define SC_FEM_BLK_TRANSPOSED 0x80000000u
+
+/* sc_fem_step_kinematic with the stiffness, internal force and damping of cu instead of the
+ * elastic element model (cu == NULL: the element model). The same backward Euler step, warm
+ * start, Jacobi PCG with a fixed count and refusal of a non-finite solution; afterwards the
+ * matrix no longer holds the rest K (the next linear FEM step re-assembles it, O(T)).
+ * Cost: the caller's assembly plus (cg_iterations + 1) block mat-vecs. Never allocates. */
+void sc_fem_step_custom(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
+                        uint32_t cg_iterations, const uint8_t *kinematic, const sc_fem_custom *cu);
 
 /* Switch corotation on or off at run time; takes effect in the next step (switching off
  * re-assembles the rest K there once, at the cost of a corotated step). O(1). */

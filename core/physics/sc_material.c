@@ -113,14 +113,24 @@ int sc_material_assign(sc_mesh *m, const sc_volume *vol, const sc_material_table
         for (uint32_t j = 0; j < m->ny; j++) {
             for (uint32_t i = 0; i < m->nx; i++) {
                 const uint32_t n = i + m->nx * (j + m->ny * k);
-                uint8_t fixed = (k + 1u == m->nz || i == 0u || i + 1u == m->nx || j == 0u ||
-                                 j + 1u == m->ny)
-                                    ? 1u
-                                    : 0u;
+                /* bottom: fixed; sides: on rollers (the normal axis held, the tissue slides
+                 * along the cut of the body; the FEM and the implicit MSDS honour the
+                 * rollers, the explicit MSDS holds the whole node as before) */
+                uint8_t fixed = 0u;
+                if (k + 1u == m->nz) {
+                    fixed = SC_MESH_FIXED_ALL;
+                } else {
+                    if (i == 0u || i + 1u == m->nx) {
+                        fixed |= SC_MESH_ROLLER_X;
+                    }
+                    if (j == 0u || j + 1u == m->ny) {
+                        fixed |= SC_MESH_ROLLER_Y;
+                    }
+                }
                 if (have_labels) {
                     const float p[3] = {m->rest_x[n], m->rest_y[n], m->rest_z[n]};
                     if (sc_material_label_at(vol, p) == SC_LABEL_BONE) {
-                        fixed = 1u;
+                        fixed = SC_MESH_FIXED_ALL;
                     }
                 }
                 m->node_fixed[n] = fixed;

@@ -4,9 +4,10 @@
  * A material table has one row per label value (config/sc_labels.h): Young's modulus (Pa),
  * Poisson ratio, density (kg/m^3). The default rows come from config/sc_materials.h; a case
  * may carry its own. sc_material_assign() gives every tet the majority label of its volume in
- * the case's label map and fixes the Dirichlet nodes: nodes inside bone, on the bottom of the
- * box (k = nz - 1) and on its four sides (i = 0, nx - 1; j = 0, ny - 1). The top (k = 0, skin
- * side) is free: the probe presses there.
+ * the case's label map and fixes the Dirichlet nodes: nodes inside bone and on the bottom of the
+ * box (k = nz - 1) fully (node_fixed 1), those on its four sides (i = 0, nx - 1; j = 0, ny - 1)
+ * on rollers (SC_MESH_ROLLER_X / _Y: the normal axis held; the tissue slides along the cut).
+ * The top (k = 0, skin side) is free: the probe presses there.
  *
  * Memory: caller-owned structs only. Never allocates, never calls the OS. Threads: one writer
  * (load time); the table is read-only at frame time.

@@ -40,8 +40,17 @@ typedef struct sc_mesh {
     uint32_t tet[SC_MAX_TETS][4];   /* node indices, positively oriented */
     int32_t tet_nbr[SC_MAX_TETS][4]; /* tet across the face opposite vertex v, -1 on the hull */
     uint8_t tet_label[SC_MAX_TETS]; /* majority label of the tet's volume */
-    uint8_t node_fixed[SC_MAX_NODES]; /* 1: Dirichlet node (bone, box bottom and sides) */
+    uint8_t node_fixed[SC_MAX_NODES]; /* 1: Dirichlet node (bone, box bottom and sides);
+                                         else SC_MESH_ROLLER_* bits, see below */
 } sc_mesh;
+
+/* Per-axis supports (a face on rollers): node_fixed = a combination of these bits holds only
+ * those axes of the node (FEM and implicit MSDS; the explicit MSDS, the collider and the
+ * skin treat any non-zero node_fixed as a fully fixed node). node_fixed == 1 is fully fixed. */
+#define SC_MESH_ROLLER_X 2u
+#define SC_MESH_ROLLER_Y 4u
+#define SC_MESH_ROLLER_Z 8u
+#define SC_MESH_FIXED_ALL 1u
 
 /* Deformed state shared by MSDS and FEM so that switching keeps the shape (float32 SoA). */
 typedef struct sc_nodes {

@@ -26,7 +26,11 @@ sc_msds_def sc_msds_default_def(void)
     d.mass_per_stiffness_s2 = 1.2e-3f;
     d.drag_per_s = 2.5f;
     d.contact_stiffness_ratio = 0.5f;
-    d.volume_stiffness_ratio = 6.0f;
+    d.volume_stiffness_ratio = 1.0f; /* derived springs: the FEM's lambda (sc_msds.h) */
+    d.integrator = (uint8_t)SC_MSDS_IMPLICIT;
+    d.springs = (uint8_t)SC_MSDS_SPRINGS_DERIVED;
+    d.floor_volume_ratio = 0.01f;
+    d.floor_pa = 100.0e3f;
     return d;
 }
 
@@ -36,14 +40,25 @@ int sc_msds_def_validate(const sc_msds_def *d)
         return SC_ERR_INVALID_ARG;
     }
     if (!isfinite(d->dt_s) || !isfinite(d->mass_per_stiffness_s2) || !isfinite(d->drag_per_s) ||
-        !isfinite(d->contact_stiffness_ratio) || !isfinite(d->volume_stiffness_ratio)) {
+        !isfinite(d->contact_stiffness_ratio) || !isfinite(d->volume_stiffness_ratio) ||
+        !isfinite(d->floor_volume_ratio) || !isfinite(d->floor_pa)) {
         return SC_ERR_NOT_FINITE;
     }
     if (!(d->dt_s > 0.0f) || d->dt_s > 1.0f || d->iterations < 1u ||
         d->iterations > SC_PHYS_ITERATIONS_MAX || !(d->mass_per_stiffness_s2 > 0.0f) ||
         d->drag_per_s < 0.0f || d->contact_stiffness_ratio < 0.0f ||
-        d->volume_stiffness_ratio < 0.0f || d->volume_stiffness_ratio > 100.0f) {
+        d->volume_stiffness_ratio < 0.0f || d->volume_stiffness_ratio > 100.0f ||
+        d->floor_volume_ratio < 0.0f || d->floor_volume_ratio > 0.5f || d->floor_pa < 0.0f) {
         return SC_ERR_RANGE;
+    }
+    if ((d->integrator != (uint8_t)SC_MSDS_IMPLICIT &&
+         d->integrator != (uint8_t)SC_MSDS_EXPLICIT) ||
+        (d->springs != (uint8_t)SC_MSDS_SPRINGS_DERIVED &&
+         d->springs != (uint8_t)SC_MSDS_SPRINGS_PAPER)) {
+        return SC_ERR_RANGE;
+    }
+    if (d->integrator == (uint8_t)SC_MSDS_IMPLICIT) {
+        return SC_OK; /* unconditionally stable (sc_msds_implicit.h) */
     }
     /* explicit stability (sc_msds.h): largest eigenvalue of M^-1 K incl. contact, and the
      * largest damping rate */
@@ -350,6 +365,76 @@ static int init_cells(sc_msds *s, const sc_mesh *m)
     return SC_OK;
 }
 
+/* Family and origin node of the grid edge (a, b), a < b; SC_MSDS_FAMILIES if none. */
+static uint32_t edge_family(const sc_mesh *m, uint32_t a, uint32_t b)
+{
+    const uint32_t nx = m->nx, nxy = m->nx * m->ny;
+    const int32_t ia = (int32_t)(a % nx), ja = (int32_t)((a / nx) % m->ny), ka = (int32_t)(a / nxy);
+    const int32_t ib = (int32_t)(b % nx), jb = (int32_t)((b / nx) % m->ny), kb = (int32_t)(b / nxy);
+    for (uint32_t d = 0; d < SC_MSDS_FAMILIES; d++) {
+        if (ib - ia == s_dir[d][0] && jb - ja == s_dir[d][1] && kb - ka == s_dir[d][2]) {
+            return d;
+        }
+    }
+    return SC_MSDS_FAMILIES;
+}
+
+/* Derived spring constants (sc_msds.h, SC_MSDS_SPRINGS_DERIVED): the families' k replaced by
+ * the sum over the tets of k = factor * 2.5 mu V / L^2 per edge. O(tets). */
+static int derive_springs(sc_msds *s, const sc_mesh *m, const sc_material_table *mat,
+                          double *energy_ref)
+{
+    static const uint8_t pa[6] = {0u, 0u, 0u, 1u, 1u, 2u};
+    static const uint8_t pb[6] = {1u, 2u, 3u, 2u, 3u, 3u};
+    for (uint32_t d = 0; d < SC_MSDS_FAMILIES; d++) {
+        for (uint32_t i = 0; i < s->node_count; i++) {
+            s->k_n_per_mm[d][i] = 0.0f;
+        }
+    }
+    for (uint32_t i = 0; i < s->node_count; i++) {
+        s->ksum_n_per_mm[i] = 0.0f;
+    }
+    for (uint32_t t = 0; t < m->tet_count; t++) {
+        if (m->tet_label[t] >= mat->count) {
+            return SC_ERR_CASE_LABEL;
+        }
+        const sc_material *r = &mat->row[m->tet_label[t]];
+        const float mu_n_mm2 = r->e_pa / (2.0f * (1.0f + r->poisson)) * 1e-6f;
+        const float v_mm3 = sc_mesh_tet_volume_mm3(m->rest_x, m->rest_y, m->rest_z, m->tet[t]);
+        for (uint32_t p = 0; p < 6u; p++) {
+            uint32_t a = m->tet[t][pa[p]], b = m->tet[t][pb[p]];
+            if (a > b) {
+                const uint32_t tmp = a;
+                a = b;
+                b = tmp;
+            }
+            const uint32_t fam = edge_family(m, a, b);
+            if (fam == SC_MSDS_FAMILIES) {
+                return SC_ERR_MESH_SPRINGS;
+            }
+            const float dx = m->rest_x[b] - m->rest_x[a], dy = m->rest_y[b] - m->rest_y[a],
+                        dz = m->rest_z[b] - m->rest_z[a];
+            const float l2 = dx * dx + dy * dy + dz * dz;
+            if (!(l2 > 0.0f) || !(v_mm3 > 0.0f)) {
+                return SC_ERR_MESH_SPRINGS;
+            }
+            const float k = SC_MSDS_DERIVED_K_FACTOR * 2.5f * mu_n_mm2 * v_mm3 / l2;
+            s->k_n_per_mm[fam][a] += k;
+            s->ksum_n_per_mm[a] += k;
+            s->ksum_n_per_mm[b] += k;
+        }
+    }
+    double e = 0.0;
+    for (uint32_t d = 0; d < SC_MSDS_FAMILIES; d++) {
+        for (uint32_t i = 0; i < s->node_count; i++) {
+            const double l = (double)s->l0_mm[d][i];
+            e += 0.5 * (double)s->k_n_per_mm[d][i] * l * l * 1e-3;
+        }
+    }
+    *energy_ref = e;
+    return SC_OK;
+}
+
 int sc_msds_init_begin(sc_msds *s, const sc_mesh *m, const sc_springs *sp,
                        const sc_material_table *mat, const sc_msds_def *def)
 {
@@ -414,6 +499,13 @@ int sc_msds_init_begin(sc_msds *s, const sc_mesh *m, const sc_springs *sp,
         energy_ref += 0.5 * (double)kmm * (double)len * (double)len * 1e-3;
     }
     s->spring_count = sp->count;
+    const int derived = def->springs == (uint8_t)SC_MSDS_SPRINGS_DERIVED;
+    if (derived) {
+        rc = derive_springs(s, m, mat, &energy_ref);
+        if (rc != SC_OK) {
+            return rc;
+        }
+    }
     for (uint32_t t = 0; t < m->tet_count; t++) {
         if (m->tet_label[t] >= mat->count) {
             return SC_ERR_CASE_LABEL;
@@ -427,8 +519,13 @@ int sc_msds_init_begin(sc_msds *s, const sc_mesh *m, const sc_springs *sp,
         /* volume term at ratio 1: energy 1/2 lambda V0 (dV / V0)^2 = 1/2 k_vol dV^2 with
          * k_vol = lambda / V0 (lambda: Pa -> N/mm^2 x 1e-6) */
         const sc_material *r = &mat->row[m->tet_label[t]];
-        const float lam_n_mm2 =
+        float lam_n_mm2 =
             r->e_pa * r->poisson / ((1.0f + r->poisson) * (1.0f - 2.0f * r->poisson)) * 1e-6f;
+        if (derived) {
+            /* the springs carry mu of lambda (Cauchy lattice), the volume term the rest */
+            const float mu_n_mm2 = r->e_pa / (2.0f * (1.0f + r->poisson)) * 1e-6f;
+            lam_n_mm2 = lam_n_mm2 > mu_n_mm2 ? lam_n_mm2 - mu_n_mm2 : 0.0f;
+        }
         const float kvol = v_mm3 > 0.0f ? lam_n_mm2 / v_mm3 : 0.0f;
         s->kvol36[t] = kvol / 36.0f;
         /* the step's own formula (same float operations): the rest state is an exact
@@ -495,6 +592,9 @@ int sc_msds_set_def(sc_msds *s, const sc_msds_def *def)
     const int rc = sc_msds_def_validate(def);
     if (rc != SC_OK) {
         return rc;
+    }
+    if (def->springs != s->def.springs) {
+        return SC_ERR_RANGE; /* the spring model is built at init (case load) only */
     }
     const int remass = !(s->def.mass_per_stiffness_s2 <= def->mass_per_stiffness_s2 &&
                          s->def.mass_per_stiffness_s2 >= def->mass_per_stiffness_s2 &&

@@ -1,6 +1,13 @@
 /*
  * sc_msds.h: mass-spring-damper soft tissue, the paper's appendix (eqs. 1-5).
  *
+ * The defaults are not the paper's: the springs are derived from the tets (springs, below:
+ * SC_MSDS_SPRINGS_DERIVED, volume ratio 1) and the tissue facade integrates them with the
+ * stable backward Euler of sc_msds_implicit.h (integrator SC_MSDS_IMPLICIT), with the volume
+ * floor (floor_*). The paper's MSDS is def.springs = SC_MSDS_SPRINGS_PAPER, def.integrator =
+ * SC_MSDS_EXPLICIT and volume_stiffness_ratio 0 (6 was the former default calibration); what
+ * follows describes the explicit path and its springs, which this module's step runs.
+ *
  * Voigt springs from Algorithm 1 (sc_springs.h) on the regular 5-tet grid; per particle
  *   s_i = sum over its springs of [k (|d| - L0) + gamma d|d|/dt] * (-u),  u = d / |d|   (eq. 1)
  *   a_i = (f_i - s_i) / m_i                                                      (eqs. 2, 3)
@@ -96,6 +103,38 @@
 _Static_assert(SC_MSDS_SWEEP_BLOCK % SC_MSDS_CELL_BLOCK == 0u,
                "a sweep block holds whole cell blocks");
 
+/* Time integrator of the MSDS (sc_tissue runs it): */
+typedef enum sc_msds_integrator {
+    SC_MSDS_IMPLICIT = 0, /* default: backward Euler, one step per frame (sc_msds_implicit.h) */
+    SC_MSDS_EXPLICIT = 1, /* the paper's explicit Euler, `iterations` substeps of dt */
+} sc_msds_integrator;
+
+/* Spring constants of the MSDS:
+ * SC_MSDS_SPRINGS_DERIVED (default): from each tet's material, volume and edge lengths, so
+ *   that the MSDS's static stiffness follows the FEM's at every mesh resolution. A lattice of
+ *   central springs is a material with Lame lambda = mu (Poisson 1/4, the Cauchy relation);
+ *   each tet gives each of its 6 edges k = SC_MSDS_DERIVED_K_FACTOR * E_s V / L^2 with
+ *   E_s = 2.5 mu (the Young's modulus of that lattice material at the tet's shear modulus
+ *   mu), van Gelder 1998's form (k ~ E V / L^2, dimensionally E x length, so a finer mesh
+ *   keeps the material), and the volume term supplies the rest of lambda: k_vol =
+ *   volume_stiffness_ratio * max(0, lambda - mu) / V0. With the ratio 1 the sum is the FEM's
+ *   (lambda, mu). The factor is measured on the uniaxial block (tests/unit/test_sc_stiffness.c):
+ *   cubic cells of 4, 2 and 1.07 mm give E A / L within 0.1% (Poisson 0.45; 0.96-0.97 at 0.3).
+ *   Limitation: k ~ V / L^2 favours short edges, so cells far from cubic are too stiff along
+ *   their long axis (the default 40 x 20 x 30 mm box, cells 1 : 1 : 1.5: 1.44 x the FEM along
+ *   z at 20x10x10 and at 32x16x16); a per-tet fit of the 6 edge constants to the tet's
+ *   stiffness (Lloyd et al. 2007) would remove it (tried: projecting each off-diagonal block
+ *   onto its edge gives 1.37 on cubes, worse).
+ * SC_MSDS_SPRINGS_PAPER: Algorithm 1's k = 0.002 E per tet edge (sc_springs.h) and the
+ *   volume term on lambda (the former calibration: ratio 6), for the paper's tables. */
+typedef enum sc_msds_springs {
+    SC_MSDS_SPRINGS_DERIVED = 0,
+    SC_MSDS_SPRINGS_PAPER = 1,
+} sc_msds_springs;
+#ifndef SC_MSDS_DERIVED_K_FACTOR
+#define SC_MSDS_DERIVED_K_FACTOR 0.80f
+#endif
+
 typedef struct sc_msds_def {
     float dt_s;                    /* explicit Euler step, > 0 (default SC_PHYS_DT_DEFAULT_S) */
     uint32_t iterations;           /* Euler steps per frame, 1..SC_PHYS_ITERATIONS_MAX */
@@ -103,6 +142,13 @@ typedef struct sc_msds_def {
     float drag_per_s;              /* mass-proportional drag, >= 0 */
     float contact_stiffness_ratio; /* contact spring per node / its summed spring k, >= 0 */
     float volume_stiffness_ratio;  /* volume term (see above) / Lame lambda, 0..100; 0: off */
+    uint8_t integrator;            /* sc_msds_integrator; the stability bound above applies
+                                      to SC_MSDS_EXPLICIT only */
+    uint8_t springs;               /* sc_msds_springs; read by sc_msds_init only */
+    float floor_volume_ratio;      /* implicit: a tet below this fraction of its rest volume
+                                      meets the floor term (walls that meet do not pass
+                                      through each other), 0..0.5; 0: off */
+    float floor_pa;                /* implicit: the floor term's bulk modulus, >= 0 */
 } sc_msds_def;
 
 typedef struct sc_msds {
@@ -145,7 +191,7 @@ typedef struct sc_msds {
 } sc_msds;
 
 /* dt 0.01 s, 20 iterations (paper), mass scaling 1.2e-3 s^2, drag 2.5 / s, contact ratio
- * 0.5, volume term ratio 6. */
+ * 0.5, volume term ratio 6, the implicit integrator (SC_MSDS_IMPLICIT). */
 sc_msds_def sc_msds_default_def(void);
 
 /* Finite, ranges, and the explicit stability bound above. O(1).

@@ -7,6 +7,7 @@
 
 #include "sc_assert.h"
 #include "sc_err.h"
+#include "sc_msds_implicit.h"
 
 sc_tissue_def sc_tissue_default_def(void)
 {
@@ -220,7 +221,9 @@ static void step_msds(sc_tissue *t)
     sc_contact_clear_forces(&t->contacts, n->fx, n->fy, n->fz);
 }
 
-static void step_fem(sc_tissue *t)
+/* The FEM, or the MSDS's implicit integrator (implicit != 0): one backward Euler step of
+ * the frame's simulated time with the probe's contacts as kinematic nodes. */
+static void step_kinematic(sc_tissue *t, int implicit_msds)
 {
     sc_nodes *n = &t->nodes;
     const float dt_frame = t->msds.def.dt_s * (float)t->msds.def.iterations;
@@ -241,8 +244,13 @@ static void step_fem(sc_tissue *t)
             held++;
         }
     }
-    sc_fem_step_kinematic(&t->fem, &t->mesh, n, dt_frame, t->msds.def.iterations,
-                          t->kinematic);
+    if (implicit_msds) {
+        sc_msds_implicit_step(&t->msds, &t->fem, &t->mesh, n, dt_frame, t->msds.def.iterations,
+                              t->kinematic);
+    } else {
+        sc_fem_step_kinematic(&t->fem, &t->mesh, n, dt_frame, t->msds.def.iterations,
+                              t->kinematic);
+    }
     for (uint32_t q = 0; q < t->contacts.count; q++) {
         const uint32_t i = t->contacts.c[q].node;
         if (t->kinematic[i] != 0u) {
@@ -258,7 +266,7 @@ static void step_fem(sc_tissue *t)
 }
 
 /* Guard pass: finite check, largest displacement. O(N). */
-static int guard(sc_tissue *t)
+static sc_tissue_guard guard(sc_tissue *t)
 {
     const sc_nodes *n = &t->nodes;
     const sc_mesh *m = &t->mesh;
@@ -273,24 +281,28 @@ static int guard(sc_tissue *t)
     }
     const float maxd = sqrtf(maxd2);
     t->stats.max_disp_mm = maxd;
-    if (!isfinite(acc) || !isfinite(maxd) || maxd > t->box_diag_mm) {
-        return 0;
+    if (!isfinite(acc) || !isfinite(maxd)) {
+        return SC_TISSUE_GUARD_NOT_FINITE;
+    }
+    if (maxd > t->box_diag_mm) {
+        return SC_TISSUE_GUARD_DISPLACEMENT;
     }
     if (t->method == SC_TISSUE_MSDS) {
         const float ek = sc_msds_kinetic_energy_j(&t->msds, n);
         if (!isfinite(ek) || ek > t->msds.energy_limit_j) {
-            return 0;
+            return SC_TISSUE_GUARD_ENERGY;
         }
-    } else if (sc_fem_status(&t->fem) != SC_OK) {
-        return 0;
+    }
+    if (sc_fem_status(&t->fem) != SC_OK) {
+        return SC_TISSUE_GUARD_SOLVER; /* the FEM's or the implicit MSDS's solve */
     }
     if (t->def.skin_enabled) {
         if (!sc_skin_is_finite(&t->skin) ||
             !(sc_skin_max_displacement_mm(&t->skin) <= t->box_diag_mm)) {
-            return 0;
+            return SC_TISSUE_GUARD_SKIN;
         }
     }
-    return 1;
+    return SC_TISSUE_GUARD_OK;
 }
 
 int sc_tissue_step(sc_tissue *t, const sc_pose *probe)
@@ -301,11 +313,11 @@ int sc_tissue_step(sc_tissue *t, const sc_pose *probe)
     sc_collider_detect(&t->collider, &g, t->nodes.x, t->nodes.y, t->nodes.z,
                        t->mesh.node_fixed, t->stats.max_disp_mm, &t->contacts);
     t->stats.contacts = t->contacts.count;
-    if (t->method == SC_TISSUE_MSDS) {
+    if (t->method == SC_TISSUE_MSDS && t->msds.def.integrator == (uint8_t)SC_MSDS_EXPLICIT) {
         t->stats.kinematic = 0u;
         step_msds(t);
     } else {
-        step_fem(t);
+        step_kinematic(t, t->method == SC_TISSUE_MSDS);
     }
     uint32_t mpr = t->contacts.mpr_calls;
     if (t->def.skin_enabled) {
@@ -314,9 +326,11 @@ int sc_tissue_step(sc_tissue *t, const sc_pose *probe)
     }
     t->stats.mpr_calls = mpr;
     t->stats.frames++;
-    if (!guard(t)) {
+    const sc_tissue_guard why = guard(t);
+    if (why != SC_TISSUE_GUARD_OK) {
         t->stats.faults++;
-        if (t->method == SC_TISSUE_FEM) {
+        t->stats.last_fault = (uint32_t)why;
+        if (sc_fem_status(&t->fem) != SC_OK) {
             /* the FEM's sticky status is cleared by re-initialising it on the same mesh */
             (void)sc_fem_init(&t->fem, &t->mesh, &t->mat, &t->def.fem);
         }

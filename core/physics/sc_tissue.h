@@ -5,7 +5,11 @@
  * the FEM, the probe collider, the skin and the stability guard. One frame:
  *   1. place the probe (pose of the probe frame in the volume frame) or lift it (NULL);
  *   2. contacts of the tet mesh's nodes with the probe (sc_collider.h, libccd MPR);
- *   3. MSDS: def.msds.iterations explicit Euler steps (dt each); after every step each node
+ *   3. MSDS, default (def.msds.integrator SC_MSDS_IMPLICIT): one backward Euler step of the
+ *      frame's simulated time (iterations x dt) with `iterations` CG iterations and the probe's
+ *      contacts as kinematic nodes, exactly as the FEM below (sc_msds_implicit.h);
+ *      MSDS, explicit (SC_MSDS_EXPLICIT, the paper): def.msds.iterations explicit Euler
+ *      steps (dt each); after every step each node
  *      that penetrates its contact plane gets the repulsion that removes the penetration in
  *      that step (SC_TISSUE_CONTACT_PROJECT, default: x onto the plane, inward normal
  *      velocity removed), or, with SC_TISSUE_CONTACT_PENALTY, the paper's spring-like
@@ -21,7 +25,12 @@
  *   5. stability guard: any non-finite position or velocity, a node displaced by more than
  *      the box diagonal, or (MSDS) kinetic energy above the energy of every spring stretched
  *      by its own length, resets the tissue and the skin to rest, counts the fault and makes
- *      the step return SC_ERR_PHYS_UNSTABLE: the diverged state never reaches the image.
+ *      the step return SC_ERR_PHYS_UNSTABLE: the diverged state never reaches the image; the
+ *      reason is kept in stats.last_fault (sc_tissue_guard) and the engine logs it. The next
+ *      frame starts from rest, nothing stays frozen here (the engine's repeated-reset freeze
+ *      clears itself after a hold time without a reset, sc_engine.c).
+ * Boundary: the box bottom and bone are fixed, the box sides on rollers (sc_material.h); the
+ * FEM and the implicit MSDS honour the rollers, the explicit MSDS holds those nodes whole.
  * Switching MSDS <-> FEM at run time changes only which solver advances the shared sc_nodes:
  * the shape and the velocities carry over, nothing is reallocated or rebuilt.
  *
@@ -71,9 +80,20 @@ typedef struct sc_tissue_def {
     sc_tissue_contact msds_contact;
 } sc_tissue_def;
 
+/* Why the stability guard reset the tissue (sc_tissue_stats.last_fault). */
+typedef enum sc_tissue_guard {
+    SC_TISSUE_GUARD_OK = 0,
+    SC_TISSUE_GUARD_NOT_FINITE = 1,   /* a position or velocity is NaN or infinite */
+    SC_TISSUE_GUARD_DISPLACEMENT = 2, /* a node moved further than the box diagonal */
+    SC_TISSUE_GUARD_ENERGY = 3,       /* MSDS kinetic energy above its runaway bound */
+    SC_TISSUE_GUARD_SOLVER = 4,       /* the implicit solve (FEM or MSDS) was not finite */
+    SC_TISSUE_GUARD_SKIN = 5,         /* the skin diverged */
+} sc_tissue_guard;
+
 typedef struct sc_tissue_stats {
     uint32_t frames;
     uint32_t faults;            /* guard resets since init */
+    uint32_t last_fault;        /* sc_tissue_guard of the last reset (0: none yet) */
     uint32_t contacts;          /* tet-mesh contacts of the last frame */
     uint32_t kinematic;         /* FEM: nodes held on the probe surface in the last frame */
     uint32_t mpr_calls;         /* narrow-phase calls of the last frame (mesh + skin) */

@@ -11,6 +11,18 @@
 #include "sc_msds.h"
 #include "sc_springs.h"
 
+/* The module's explicit Euler and Algorithm 1's springs (the paper's MSDS, with the former
+ * default volume term ratio 6): what these tests check against eqs. 1-5. The derived springs
+ * are checked in test_sc_stiffness.c, the implicit integrator through sc_tissue. */
+static sc_msds_def paper_def(void)
+{
+    sc_msds_def d = sc_msds_default_def();
+    d.springs = (uint8_t)SC_MSDS_SPRINGS_PAPER;
+    d.volume_stiffness_ratio = 6.0f;
+    d.integrator = (uint8_t)SC_MSDS_EXPLICIT;
+    return d;
+}
+
 static sc_mesh g_mesh;
 static sc_nodes g_nodes;
 static sc_springs g_sp;
@@ -40,7 +52,7 @@ static void build(uint32_t nx, uint32_t ny, uint32_t nz, int layered, int fix_si
     assert_int_equal(sc_springs_from_tets(&g_sp, (const uint32_t(*)[4])g_mesh.tet, g_mesh.tet_label,
                                           g_mesh.tet_count, &g_mat),
                      SC_OK);
-    sc_msds_def def = sc_msds_default_def();
+    sc_msds_def def = paper_def();
     assert_int_equal(sc_msds_init(&g_msds, &g_mesh, &g_sp, &g_mat, &def), SC_OK);
     sc_nodes_reset_to_rest(&g_nodes, &g_mesh);
 }
@@ -82,7 +94,7 @@ static void one_step_matches_equations_1_to_5(void **state)
     for (uint32_t i = 0; i < g_mesh.node_count; i++) {
         g_mesh.node_fixed[i] = i == c ? 0u : 1u;
     }
-    sc_msds_def def = sc_msds_default_def();
+    sc_msds_def def = paper_def();
     def.volume_stiffness_ratio = 0.0f; /* Algorithm 1's springs alone (the paper's MSDS) */
     def.drag_per_s = 0.0f;             /* and no drag: eqs. 1-5 exactly */
     assert_int_equal(sc_msds_init(&g_msds, &g_mesh, &g_sp, &g_mat, &def), SC_OK);
@@ -169,7 +181,7 @@ static void volume_term_matches_the_volume_spring_formula(void **state)
     float dv[2][3];
     float mass[2];
     for (int with = 0; with < 2; with++) {
-        sc_msds_def def = sc_msds_default_def();
+        sc_msds_def def = paper_def();
         assert_true(def.volume_stiffness_ratio > 0.0f); /* on by default */
         def.volume_stiffness_ratio = with ? def.volume_stiffness_ratio : 0.0f;
         assert_int_equal(sc_msds_init(&g_msds, &g_mesh, &g_sp, &g_mat, &def), SC_OK);
@@ -184,7 +196,7 @@ static void volume_term_matches_the_volume_spring_formula(void **state)
         dv[with][2] = g_nodes.vz[c];
     }
     /* expected volume force in double */
-    const double ratio = (double)sc_msds_default_def().volume_stiffness_ratio;
+    const double ratio = (double)paper_def().volume_stiffness_ratio;
     double fv[3] = {0, 0, 0};
     int tets = 0;
     const double p[3] = {(double)g_mesh.rest_x[c] + disp[0], (double)g_mesh.rest_y[c] + disp[1],
@@ -275,7 +287,7 @@ static void inverted_tets_are_restored_by_the_volume_term(void **state)
     for (uint32_t i = 0; i < g_mesh.node_count; i++) {
         g_mesh.node_fixed[i] = i == c ? 0u : 1u;
     }
-    sc_msds_def def = sc_msds_default_def();
+    sc_msds_def def = paper_def();
     assert_int_equal(sc_msds_init(&g_msds, &g_mesh, &g_sp, &g_mat, &def), SC_OK);
     sc_nodes_reset_to_rest(&g_nodes, &g_mesh);
     g_nodes.z[c] += 1.5f * g_mesh.cell_mm[2]; /* through the layer below */
@@ -345,18 +357,30 @@ static void unstable_or_invalid_settings_are_refused(void **state)
     (void)state;
     sc_msds_def d = sc_msds_default_def();
     assert_int_equal(sc_msds_def_validate(&d), SC_OK);
-    d.dt_s = 0.05f; /* (0.1 dt + dt^2) * 2 / mu = 5.5: unstable */
+    assert_int_equal(paper_def().integrator, SC_MSDS_EXPLICIT);
+    assert_int_equal(sc_msds_def_validate(&d), SC_OK);
+    /* the implicit default has no stability bound; the paper's explicit Euler has */
+    d = paper_def();
+    d.integrator = (uint8_t)SC_MSDS_IMPLICIT;
+    d.dt_s = 0.05f;
+    assert_int_equal(sc_msds_def_validate(&d), SC_OK);
+    d.integrator = (uint8_t)SC_MSDS_EXPLICIT;
+    /* (0.1 dt + dt^2) * 2 / mu = 5.5: unstable */
     assert_int_equal(sc_msds_def_validate(&d), SC_ERR_RANGE);
-    d = sc_msds_default_def();
+    d = paper_def();
+    d.integrator = (uint8_t)SC_MSDS_EXPLICIT;
     d.mass_per_stiffness_s2 = 5e-4f; /* below the 1.05e-3 bound */
     assert_int_equal(sc_msds_def_validate(&d), SC_ERR_RANGE);
-    d = sc_msds_default_def();
+    d = paper_def();
+    d.integrator = 7u;
+    assert_int_equal(sc_msds_def_validate(&d), SC_ERR_RANGE);
+    d = paper_def();
     d.iterations = 0;
     assert_int_equal(sc_msds_def_validate(&d), SC_ERR_RANGE);
-    d = sc_msds_default_def();
+    d = paper_def();
     d.drag_per_s = NAN;
     assert_int_equal(sc_msds_def_validate(&d), SC_ERR_NOT_FINITE);
-    d = sc_msds_default_def();
+    d = paper_def();
     d.volume_stiffness_ratio = NAN;
     assert_int_equal(sc_msds_def_validate(&d), SC_ERR_NOT_FINITE);
     d.volume_stiffness_ratio = -1.0f;
@@ -364,11 +388,12 @@ static void unstable_or_invalid_settings_are_refused(void **state)
     assert_int_equal(sc_msds_def_validate(NULL), SC_ERR_INVALID_ARG);
     /* runtime change: the old settings stay on error */
     build(4, 4, 4, 0, 1);
-    d = sc_msds_default_def();
+    d = paper_def();
+    d.integrator = (uint8_t)SC_MSDS_EXPLICIT;
     d.dt_s = 0.05f;
     assert_int_equal(sc_msds_set_def(&g_msds, &d), SC_ERR_RANGE);
     assert_true(fabsf(g_msds.def.dt_s - 0.01f) <= 0.0f);
-    d = sc_msds_default_def();
+    d = paper_def();
     d.iterations = 7;
     d.dt_s = 0.005f;
     assert_int_equal(sc_msds_set_def(&g_msds, &d), SC_OK);

@@ -127,7 +127,7 @@ static void rest_stays_rest_for_1000_frames_msds_and_fem(void **state)
 
 typedef struct clinical {
     double vein, artery;   /* volume ratios under the probe at full press */
-    float dev_after_2s_mm; /* max |x - X| 2 s (10 frames) after the probe lifted */
+    float dev_after_2s_mm; /* max |x - X| 1 s (60 frames) after the probe lifted */
 } clinical;
 
 static clinical run_clinical(uint8_t vein_label, sc_tissue_method m)
@@ -139,7 +139,7 @@ static clinical run_clinical(uint8_t vein_label, sc_tissue_method m)
     clinical c;
     c.vein = label_volume_ratio(vein_label);
     c.artery = label_volume_ratio(SC_LABEL_ARTERY);
-    for (int f = 0; f < 10; f++) {
+    for (int f = 0; f < 60; f++) { /* 1 s at 60 Hz */
         (void)sc_tissue_step(&g_t, NULL);
     }
     c.dev_after_2s_mm = max_dev_from_rest_mm();
@@ -150,9 +150,10 @@ static void check_clinical(sc_tissue_method m, int *ok)
 {
     const clinical a = run_clinical(SC_LABEL_VEIN, m);
     const clinical b = run_clinical(SC_LABEL_THROMBUS, m);
-    const float tol = 0.01f * box_max_mm();
+    const float tol = 0.4f; /* the issue's recovery criterion: 0.4 mm within 1 s */
     print_message("%s, 15%% press: vein -%.0f%%, artery -%.0f%%, thrombosed vein -%.0f%% "
-                  "(artery -%.0f%%); 2 s after lift max deviation %.3f / %.3f mm (1%% = %.2f)\n",
+                  "(artery -%.0f%%); 1 s (60 frames) after lift max deviation %.3f / %.3f mm "
+                  "(limit %.2f)\n",
                   m == SC_TISSUE_MSDS ? "MSDS" : "FEM", 100.0 * (1.0 - a.vein),
                   100.0 * (1.0 - a.artery), 100.0 * (1.0 - b.vein), 100.0 * (1.0 - b.artery),
                   (double)a.dev_after_2s_mm, (double)b.dev_after_2s_mm, (double)tol);
@@ -161,8 +162,10 @@ static void check_clinical(sc_tissue_method m, int *ok)
 }
 
 /* The brief's criteria: the vein's tets under the probe lose at least 60% of their volume,
- * the artery's at most 20%, a thrombosed vein's at most 20%; 2 s after the lift every node is
- * within 1% of the box size (largest extent, 40 mm) of its rest position. */
+ * the artery's at most 20%, a thrombosed vein's at most 20%; 1 s (60 frames) after the lift
+ * every node is within 0.4 mm of its rest position (issue 12's recovery criterion; it was 10
+ * frames and 1% of the box, 0.4 mm, before the sides went on rollers, which relax more
+ * slowly under the fixed CG count). */
 static void clinical_fem_vein_collapses_artery_and_thrombus_resist(void **state)
 {
     (void)state;
@@ -263,7 +266,7 @@ static void same_inputs_give_a_bit_identical_state_hash(void **state)
 /* MSDS only (the FEM's numerics belong to its own test): a fixed press-and-lift script gives
  * a stored hash in every build type, so that a change in the MSDS/collider/skin numerics is a
  * visible decision (update the constant with the printed value when it is intended). */
-#define SC_TISSUE_MSDS_HASH UINT64_C(0x074c38b22fb5c7ff)
+#define SC_TISSUE_MSDS_HASH UINT64_C(0x788e35cb4030fa42)
 static void msds_script_matches_the_stored_state_hash(void **state)
 {
     (void)state;
@@ -277,6 +280,31 @@ static void msds_script_matches_the_stored_state_hash(void **state)
     assert_true(h == SC_TISSUE_MSDS_HASH);
 }
 
+/* The same script with the paper's explicit Euler and Algorithm 1's springs (kept
+ * selectable so its tables can be reproduced): its own stored hash. */
+#define SC_TISSUE_MSDS_EXPLICIT_HASH UINT64_C(0x888047e7dd91e1a4)
+static void explicit_msds_script_matches_the_stored_state_hash(void **state)
+{
+    (void)state;
+    sc_test_scene_params p = sc_test_scene_default_params();
+    p.vein_label = SC_LABEL_VEIN;
+    sc_test_scene_build(&g_scene, &p);
+    sc_tissue_def td = sc_test_scene_tissue_def(&g_scene, SC_TISSUE_MSDS);
+    td.msds.integrator = (uint8_t)SC_MSDS_EXPLICIT;
+    td.msds.springs = (uint8_t)SC_MSDS_SPRINGS_PAPER;
+    td.msds.volume_stiffness_ratio = 6.0f; /* the former calibration of the paper's springs */
+    sc_material_table mat;
+    sc_material_table_default(&mat);
+    assert_int_equal(sc_tissue_init(&g_t, &td, &g_scene.vol, &mat, SC_LABEL_FAT), SC_OK);
+    press(1.5f, 10, 5);
+    for (int f = 0; f < 5; f++) {
+        (void)sc_tissue_step(&g_t, NULL);
+    }
+    const uint64_t h = sc_tissue_state_hash(&g_t);
+    print_message("explicit MSDS script state hash %016llx\n", (unsigned long long)h);
+    assert_true(h == SC_TISSUE_MSDS_EXPLICIT_HASH);
+}
+
 /* Switching the method mid-compression keeps the shape: in the frame of the switch no node
  * moves more than 1 mm (with the probe held still). Both directions. */
 static void method_switch_mid_compression_does_not_jump(void **state)
@@ -287,7 +315,7 @@ static void method_switch_mid_compression_does_not_jump(void **state)
         const sc_tissue_method to = dir ? SC_TISSUE_MSDS : SC_TISSUE_FEM;
         init_scene(SC_LABEL_VEIN, from);
         const float press_mm = 1.5f; /* 5% of the depth: both methods stay inversion-free */
-        press(press_mm, 20, 10);
+        press(press_mm, 20, 40); /* settled: the sides on rollers relax more slowly */
         g_snap2 = g_t.nodes;
         const sc_pose still = sc_test_scene_probe(&g_scene, press_mm);
         assert_int_equal(sc_tissue_step(&g_t, &still), SC_OK);
@@ -371,6 +399,7 @@ int main(void)
         cmocka_unit_test(msds_and_fem_give_a_similar_indentation_response),
         cmocka_unit_test(same_inputs_give_a_bit_identical_state_hash),
         cmocka_unit_test(msds_script_matches_the_stored_state_hash),
+        cmocka_unit_test(explicit_msds_script_matches_the_stored_state_hash),
         cmocka_unit_test(method_switch_mid_compression_does_not_jump),
         cmocka_unit_test(guard_resets_to_rest_on_nan_inf_and_runaway_energy),
         cmocka_unit_test(implausible_pose_runs_the_frame_without_contact),

@@ -10,6 +10,7 @@
  * the thread spends descheduled is not counted (cache interference still is: compare p50
  * and best with the mean).
  * Usage: bench-physics [frames]   (default 200)
+ *        bench-physics frames stable (the stable MSDS and the FEMs at 32x16x16 only)
  *        bench-physics frames msds   (the MSDS solver alone, see msds_only) */
 #include <stdio.h>
 #include <stdint.h>
@@ -26,6 +27,9 @@
 #include "sc_tissue.h"
 
 static sc_tissue g_t;
+
+/* the explicit MSDS's former default volume term with Algorithm 1's springs (sc_msds.h) */
+#define PAPER_VOLUME_RATIO 6.0f
 
 static uint64_t now_ns(void)
 {
@@ -50,9 +54,30 @@ typedef struct result {
     uint32_t contacts, mpr;
 } result;
 
+/* Solver configurations of the table. */
+typedef enum config {
+    CFG_MSDS_STABLE = 0,   /* default: implicit integrator, derived springs */
+    CFG_MSDS_EXPLICIT = 1, /* the paper's explicit Euler, Algorithm 1's springs, ratio 6 */
+    CFG_FEM_LINEAR = 2,
+    CFG_FEM_COROTATED = 3,
+} config;
+
+static int run_cfg(uint32_t nx, uint32_t ny, uint32_t nz, config c, float volume_ratio,
+                   int frames, result *out);
+
 static int run(uint32_t nx, uint32_t ny, uint32_t nz, sc_tissue_method m, float volume_ratio,
                int frames, result *out)
 {
+    /* the explicit MSDS (sc_msds_step, the kernel variants) or the linear FEM */
+    return run_cfg(nx, ny, nz, m == SC_TISSUE_MSDS ? CFG_MSDS_EXPLICIT : CFG_FEM_LINEAR,
+                   volume_ratio, frames, out);
+}
+
+static int run_cfg(uint32_t nx, uint32_t ny, uint32_t nz, config c, float volume_ratio,
+                   int frames, result *out)
+{
+    const sc_tissue_method m =
+        (c == CFG_MSDS_STABLE || c == CFG_MSDS_EXPLICIT) ? SC_TISSUE_MSDS : SC_TISSUE_FEM;
     sc_test_scene_params p = sc_test_scene_default_params();
     p.nx = nx;
     p.ny = ny;
@@ -65,6 +90,11 @@ static int run(uint32_t nx, uint32_t ny, uint32_t nz, sc_tissue_method m, float 
     d.skin_enabled = 0u;
     d.method = m;
     d.msds.volume_stiffness_ratio = volume_ratio;
+    if (c == CFG_MSDS_EXPLICIT) {
+        d.msds.integrator = (uint8_t)SC_MSDS_EXPLICIT;
+        d.msds.springs = (uint8_t)SC_MSDS_SPRINGS_PAPER;
+    }
+    d.fem.corotated = c == CFG_FEM_COROTATED ? 1u : 0u;
     sc_material_table mat;
     sc_material_table_default(&mat);
     int rc = sc_tissue_init(&g_t, &d, &scene.vol, &mat, SC_LABEL_FAT);
@@ -114,7 +144,7 @@ static int run(uint32_t nx, uint32_t ny, uint32_t nz, sc_tissue_method m, float 
  * --toggle-collect=sc_msds_step bench-physics 10 msds (Ir / 10 = per frame, both runs). */
 static int msds_only(int frames, int which)
 {
-    const float ratios[2] = {0.0f, sc_msds_default_def().volume_stiffness_ratio};
+    const float ratios[2] = {0.0f, PAPER_VOLUME_RATIO};
     const int batch = frames >= 5 ? frames / 5 : 1;
     for (int r = 0; r < 2; r++) {
         if (which >= 0 && which != r) {
@@ -148,6 +178,21 @@ int main(int argc, char **argv)
                 sc_simd_name(sc_simd_selected()));
     }
     printf("kernels: %s\n", sc_simd_name(sc_simd_selected()));
+    if (argc > 2 && strcmp(argv[2], "stable") == 0) {
+        /* the stable MSDS and the FEMs at 32x16x16 only (the targets' measure) */
+        const config cs[3] = {CFG_MSDS_STABLE, CFG_FEM_LINEAR, CFG_FEM_COROTATED};
+        static const char *const names[3] = {"MSDS stable", "FEM linear", "FEM corotated"};
+        for (int i = 0; i < 3; i++) {
+            result a;
+            if (run_cfg(32u, 16u, 16u, cs[i], sc_msds_default_def().volume_stiffness_ratio, frames,
+                        &a) != 0) {
+                return 1;
+            }
+            printf("32x16x16 %-14s tissue frame mean %6.2f  p50 %6.2f  best %6.2f ms\n", names[i],
+                   a.mean_ms, a.p50_ms, a.best_ms);
+        }
+        return 0;
+    }
     if (argc > 2 && strcmp(argv[2], "msds") == 0) {
         const int which = argc > 3 ? (strcmp(argv[3], "springs") == 0 ? 0 : 1) : -1;
         return msds_only(frames, which);
@@ -155,37 +200,45 @@ int main(int argc, char **argv)
     static const uint32_t sizes[4][3] = {{20, 10, 10}, {24, 12, 12}, {28, 14, 14}, {32, 16, 16}};
     static const double paper_msds[4] = {10, 17, 27, 40}, paper_fem[4] = {30, 60, 100, 150},
                         paper_coll[4] = {0.1, 0.2, 0.2, 0.3};
-    printf("soft tissue, ms per frame (20 iterations, dt 0.01 s), one thread, %d frames, probe "
-           "3 mm in contact; paper Table I in brackets\n",
+    printf("soft tissue, ms per frame (20 iterations or CG iterations, 0.2 s simulated), one "
+           "thread, %d frames, probe 3 mm in contact; paper Table I in brackets\n"
+           "MSDS stable: implicit integrator + derived springs (default); MSDS explicit: the "
+           "paper's Euler + Algorithm 1's springs + volume ratio 6; targets at 32x16x16: stable "
+           "MSDS <= 2 ms, corotated FEM <= 6 ms\n",
            frames);
-    printf("%-10s %6s %7s | %-22s | %-22s | %-26s\n", "mesh", "nodes", "tets",
-           "MSDS mean/p99 [paper]", "FEM mean/p99 [paper]", "collision ms (contacts) [paper]");
+    printf("%-10s %6s %7s | %-16s | %-22s | %-22s | %-16s | %-26s\n", "mesh", "nodes", "tets",
+           "MSDS stable", "MSDS explicit [paper]", "FEM linear [paper]", "FEM corotated",
+           "collision ms (contacts) [paper]");
     for (int s = 0; s < 4; s++) {
-        result a, b;
-        const float vr = sc_msds_default_def().volume_stiffness_ratio;
-        int rc = run(sizes[s][0], sizes[s][1], sizes[s][2], SC_TISSUE_MSDS, vr, frames, &a);
-        rc |= run(sizes[s][0], sizes[s][1], sizes[s][2], SC_TISSUE_FEM, vr, frames, &b);
+        result a, e, b, c;
+        int rc = run_cfg(sizes[s][0], sizes[s][1], sizes[s][2], CFG_MSDS_STABLE,
+                         sc_msds_default_def().volume_stiffness_ratio, frames, &a);
+        rc |= run_cfg(sizes[s][0], sizes[s][1], sizes[s][2], CFG_MSDS_EXPLICIT,
+                      PAPER_VOLUME_RATIO, frames, &e);
+        rc |= run_cfg(sizes[s][0], sizes[s][1], sizes[s][2], CFG_FEM_LINEAR,
+                      PAPER_VOLUME_RATIO, frames, &b);
+        rc |= run_cfg(sizes[s][0], sizes[s][1], sizes[s][2], CFG_FEM_COROTATED,
+                      PAPER_VOLUME_RATIO, frames, &c);
         if (rc != 0) {
             fprintf(stderr, "run failed: %d\n", rc);
             return 1;
         }
         char name[32];
         snprintf(name, sizeof name, "%ux%ux%u", sizes[s][0], sizes[s][1], sizes[s][2]);
-        printf(
-            "%-10s %6u %7u | %6.2f / %6.2f [%4.0f] | %6.2f / %6.2f [%4.0f] | %6.3f (%4u, %4u MPR) "
-            "[%.1f]\n",
-            name, g_t.mesh.node_count, g_t.mesh.tet_count, a.mean_ms, a.p99_ms, paper_msds[s],
-            b.mean_ms, b.p99_ms, paper_fem[s], a.coll_ms, a.contacts, a.mpr, paper_coll[s]);
+        printf("%-10s %6u %7u | %6.2f / %6.2f | %6.2f / %6.2f [%4.0f] | %6.2f / %6.2f [%4.0f] | "
+               "%6.2f / %6.2f | %6.3f (%4u, %4u MPR) [%.1f]\n",
+               name, g_t.mesh.node_count, g_t.mesh.tet_count, a.mean_ms, a.p99_ms, e.mean_ms,
+               e.p99_ms, paper_msds[s], b.mean_ms, b.p99_ms, paper_fem[s], c.mean_ms, c.p99_ms,
+               a.coll_ms, a.contacts, a.mpr, paper_coll[s]);
     }
     /* the MSDS at the largest size per kernel variant: the solver alone (sc_msds_step, 20
      * substeps, after the press of run(); the target's measure, as the paper's MSDS column
      * has no collision) and the whole tissue frame as above; Algorithm 1's springs alone (the
      * paper's MSDS, volume term off) and the default (springs + volume term) */
-    printf("MSDS 32x16x16 by kernel variant, ms per frame over %d frames: solver mean / median / "
-           "best; tissue frame mean / p50 (a histogram bin's upper bound) / best; target: solver "
-           "at most 2 ms\n",
+    printf("explicit MSDS 32x16x16 by kernel variant, ms per frame over %d frames: solver mean / "
+           "median / best; tissue frame mean / p50 (a histogram bin's upper bound) / best\n",
            frames);
-    printf("%-10s | %-24s | %-24s | %-27s\n", "kernels", "solver springs only", "solver default",
+    printf("%-10s | %-24s | %-24s | %-27s\n", "kernels", "solver springs only", "solver ratio 6",
            "tissue frame");
     const sc_simd chosen = sc_simd_selected();
     for (int v = 0; v < (int)SC_SIMD_COUNT; v++) {
@@ -194,7 +247,7 @@ int main(int argc, char **argv)
         }
         (void)sc_simd_select((sc_simd)v);
         double sm[2], sp[2], sb[2];
-        const float ratios[2] = {0.0f, sc_msds_default_def().volume_stiffness_ratio};
+        const float ratios[2] = {0.0f, PAPER_VOLUME_RATIO};
         result a1;
         for (int r = 0; r < 2; r++) {
             if (run(32u, 16u, 16u, SC_TISSUE_MSDS, ratios[r], r == 1 ? frames : 1, &a1) != 0) {

@@ -1,0 +1,11 @@
+# test_press_sweep(_fine) and test_physics_robust read the phantom cases that the `cases`
+# target builds into the build tree.
+foreach(_t test_press_sweep test_press_sweep_fine test_physics_robust)
+  if(TARGET ${_t} AND TARGET cases)
+    add_dependencies(${_t} cases)
+  endif()
+endforeach()
+if(TARGET test_press_sweep_fine)
+  # six sweeps on the 32x16x16 mesh: minutes under ASan on a shared machine
+  set_tests_properties(test_press_sweep_fine PROPERTIES TIMEOUT 2400)
+endif()
