@@ -44,14 +44,14 @@ static void rig_up(const char *case_file, sc_tissue_method m)
                       case_file, sc_err_str(rc));
     }
     assert_int_equal(rc, SC_OK);
-    assert_int_equal(rig.engine.tissue.method, m);
+    assert_int_equal(rig.engine.tissue[rig.engine.active].method, m);
 }
 
 static void frame(uint64_t t0, uint64_t *next_ns, int *more)
 {
     sc_can_frame f[SC_EMU_MAX_FRAMES];
     const uint64_t release =
-        rig.engine.sched.started ? rig.engine.sched.next_release_ns : rig.clock.now_ns;
+        sc_engine_next_release_ns(&rig.engine);
     while (*more && t0 + *next_ns <= release) {
         uint64_t t_ns;
         const int k = sc_emu_next(&emu, f, SC_EMU_MAX_FRAMES, &t_ns);
@@ -69,8 +69,8 @@ static void frame(uint64_t t0, uint64_t *next_ns, int *more)
 
 static int state_finite(void)
 {
-    const sc_nodes *n = &rig.engine.tissue.nodes;
-    for (uint32_t i = 0; i < rig.engine.tissue.mesh.node_count; i++) {
+    const sc_nodes *n = &rig.engine.tissue[rig.engine.active].nodes;
+    for (uint32_t i = 0; i < rig.engine.tissue[rig.engine.active].mesh.node_count; i++) {
         if (!isfinite(n->x[i]) || !isfinite(n->y[i]) || !isfinite(n->z[i]) ||
             !isfinite(n->vx[i]) || !isfinite(n->vy[i]) || !isfinite(n->vz[i])) {
             return 0;
@@ -81,7 +81,7 @@ static int state_finite(void)
 
 static float max_dev_from_rest_mm(void)
 {
-    const sc_tissue *t = &rig.engine.tissue;
+    const sc_tissue *t = &rig.engine.tissue[rig.engine.active];
     float m = 0.0f;
     for (uint32_t i = 0; i < t->mesh.node_count; i++) {
         const float dx = t->nodes.x[i] - t->mesh.rest_x[i];
@@ -178,8 +178,8 @@ static void abuse(const char *case_name, sc_tissue_method m)
     for (uint32_t f = 0; f < lift_frame + hz; f++) {
         frame(t0, &next_ns, &more);
         assert_true(state_finite());
-        contact += rig.engine.probe_contact;
-        max_disp = fmaxf(max_disp, rig.engine.tissue.stats.max_disp_mm);
+        contact += rig.engine.tissue_out.contact;
+        max_disp = fmaxf(max_disp, rig.engine.tissue[rig.engine.active].stats.max_disp_mm);
     }
     const float dev = max_dev_from_rest_mm();
     sc_engine_status st;
@@ -235,7 +235,7 @@ static void repeated_guard_resets_clear_by_themselves_within_a_second_or_so(void
     }
     const uint32_t fatal = rig.engine.def.phys_resets_fatal;
     for (uint32_t k = 0; k < fatal; k++) {
-        rig.engine.tissue.nodes.x[7] = NAN;
+        rig.engine.tissue[rig.engine.active].nodes.x[7] = NAN;
         frame(t0, &next_ns, &more);
     }
     sc_engine_status st;
@@ -260,7 +260,7 @@ static void repeated_guard_resets_clear_by_themselves_within_a_second_or_so(void
     uint32_t contact = 0;
     for (uint32_t f = 0; f < 2u * hz; f++) {
         frame(t0, &next_ns, &more);
-        contact += rig.engine.probe_contact;
+        contact += rig.engine.tissue_out.contact;
     }
     assert_true(contact > 0u);
     assert_true(rig.engine.counters.phys_resets == fatal);

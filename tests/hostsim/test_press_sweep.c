@@ -56,7 +56,7 @@ static void rig_up(const char *case_file, sc_tissue_method m)
                       sc_err_str(rc));
     }
     assert_int_equal(rc, SC_OK);
-    assert_int_equal(rig.engine.tissue.method, m);
+    assert_int_equal(rig.engine.tissue[rig.engine.active].method, m);
 }
 
 /* Feed the emulator's samples due before the next frame, run it. */
@@ -64,7 +64,7 @@ static void frame(uint64_t t0, uint64_t *next_ns, int *more)
 {
     sc_can_frame f[SC_EMU_MAX_FRAMES];
     const uint64_t release =
-        rig.engine.sched.started ? rig.engine.sched.next_release_ns : rig.clock.now_ns;
+        sc_engine_next_release_ns(&rig.engine);
     while (*more && t0 + *next_ns <= release) {
         uint64_t t_ns;
         const int k = sc_emu_next(&emu, f, SC_EMU_MAX_FRAMES, &t_ns);
@@ -82,8 +82,8 @@ static void frame(uint64_t t0, uint64_t *next_ns, int *more)
 
 static int state_finite(void)
 {
-    const sc_nodes *n = &rig.engine.tissue.nodes;
-    for (uint32_t i = 0; i < rig.engine.tissue.mesh.node_count; i++) {
+    const sc_nodes *n = &rig.engine.tissue[rig.engine.active].nodes;
+    for (uint32_t i = 0; i < rig.engine.tissue[rig.engine.active].mesh.node_count; i++) {
         if (!isfinite(n->x[i]) || !isfinite(n->y[i]) || !isfinite(n->z[i]) || !isfinite(n->vx[i]) ||
             !isfinite(n->vy[i]) || !isfinite(n->vz[i])) {
             return 0;
@@ -94,7 +94,7 @@ static int state_finite(void)
 
 static float max_dev_from_rest_mm(void)
 {
-    const sc_tissue *t = &rig.engine.tissue;
+    const sc_tissue *t = &rig.engine.tissue[rig.engine.active];
     float m = 0.0f;
     for (uint32_t i = 0; i < t->mesh.node_count; i++) {
         const float dx = t->nodes.x[i] - t->mesh.rest_x[i];
@@ -114,15 +114,15 @@ static float ratio(const sc_bscan_status *b, uint32_t label)
  * engine builds it at case load. */
 static void remesh(uint32_t nx, uint32_t ny, uint32_t nz)
 {
-    sc_tissue_def td = rig.engine.tissue.def;
+    sc_tissue_def td = rig.engine.tissue[rig.engine.active].def;
     td.mesh.nx = nx;
     td.mesh.ny = ny;
     td.mesh.nz = nz;
-    const sc_material_table mat = rig.engine.tissue.mat;
-    assert_int_equal(sc_tissue_init(&rig.engine.tissue, &td, &rig.engine.slot.c.volume, &mat,
+    const sc_material_table mat = rig.engine.tissue[rig.engine.active].mat;
+    assert_int_equal(sc_tissue_init(&rig.engine.tissue[rig.engine.active], &td, &rig.engine.slot.c.volume, &mat,
                                     (uint8_t)SC_LABEL_FAT),
                      SC_OK);
-    assert_int_equal(sc_bscan_attach_mesh(&rig.engine.bscan, &rig.engine.tissue.mesh), SC_OK);
+    assert_int_equal(sc_bscan_attach_mesh(&rig.engine.bscan, &rig.engine.tissue[rig.engine.active].mesh), SC_OK);
 }
 
 static void sweep_mesh(const char *case_name, sc_tissue_method m, uint32_t fine)
@@ -197,8 +197,8 @@ static void sweep_mesh(const char *case_name, sc_tissue_method m, uint32_t fine)
     sc_engine_get_status(&rig.engine, &st);
     print_message("%s %s, mesh %ux%ux%u: press mm / vein / artery / thrombus image-area ratio "
                   "(-1: not in view)\n",
-                  case_name, m == SC_TISSUE_MSDS ? "msds" : "fem", rig.engine.tissue.mesh.nx,
-                  rig.engine.tissue.mesh.ny, rig.engine.tissue.mesh.nz);
+                  case_name, m == SC_TISSUE_MSDS ? "msds" : "fem", rig.engine.tissue[rig.engine.active].mesh.nx,
+                  rig.engine.tissue[rig.engine.active].mesh.ny, rig.engine.tissue[rig.engine.active].mesh.nz);
     for (uint32_t i = 0; i < np; i++) {
         print_message("  %5.1f  %6.3f  %6.3f  %6.3f\n", (double)pts[i].depth_mm,
                       (double)pts[i].vein, (double)pts[i].artery, (double)pts[i].thrombus);
@@ -229,7 +229,7 @@ static void sweep_mesh(const char *case_name, sc_tissue_method m, uint32_t fine)
     }
     assert_true(at16);
     assert_true(rig.engine.counters.phys_resets == 0u);
-    assert_true(rig.engine.tissue.stats.faults == 0u);
+    assert_true(rig.engine.tissue[rig.engine.active].stats.faults == 0u);
     assert_true((st.faults & ((1u << SC_FAULT_PHYS_UNSTABLE) | (1u << SC_FAULT_PHYS_REPEATED))) ==
                 0u);
     /* back to rest within 1 s on the cases' meshes; on the 32x16x16 mesh the fixed CG count
