@@ -47,22 +47,16 @@ static void rig_up(const char *case_file, sc_tissue_method m)
     assert_int_equal(rig.engine.tissue[rig.engine.active].method, m);
 }
 
-static void frame(uint64_t t0, uint64_t *next_ns, int *more)
+static int send_peer(void *ctx, const sc_can_frame *f)
 {
-    sc_can_frame f[SC_EMU_MAX_FRAMES];
-    const uint64_t release =
-        sc_engine_next_release_ns(&rig.engine);
-    while (*more && t0 + *next_ns <= release) {
-        uint64_t t_ns;
-        const int k = sc_emu_next(&emu, f, SC_EMU_MAX_FRAMES, &t_ns);
-        if (k < 0) {
-            *more = 0;
-            break;
-        }
-        for (int j = 0; j < k; j++) {
-            (void)sc_can_send(&rig.peer, &f[j]);
-        }
-        *next_ns = t_ns + (uint64_t)(1e9 / emu.def.rate_hz);
+    return sc_can_send((const sc_can_dev *)ctx, f);
+}
+
+static void frame(uint64_t t0, int *more)
+{
+    if (*more && sc_emu_feed(&emu, sc_engine_next_release_ns(&rig.engine) - t0, send_peer,
+                             &rig.peer) == SC_ERR_NOT_FOUND) {
+        *more = 0;
     }
     sc_engine_step(&rig.engine, NULL);
 }
@@ -169,14 +163,13 @@ static void abuse(const char *case_name, sc_tissue_method m)
     assert_int_equal(sc_emu_init(&emu, &ed), SC_OK);
 
     const uint64_t t0 = rig.clock.now_ns;
-    uint64_t next_ns = 0;
     int more = 1;
     const uint32_t hz = rig.engine.def.sched.rate_hz;
     const uint32_t lift_frame = (uint32_t)((t - 2.0) * (double)hz);
     uint32_t contact = 0;
     float max_disp = 0.0f;
     for (uint32_t f = 0; f < lift_frame + hz; f++) {
-        frame(t0, &next_ns, &more);
+        frame(t0, &more);
         assert_true(state_finite());
         contact += rig.engine.tissue_out.contact;
         max_disp = fmaxf(max_disp, rig.engine.tissue[rig.engine.active].stats.max_disp_mm);
@@ -227,16 +220,15 @@ static void repeated_guard_resets_clear_by_themselves_within_a_second_or_so(void
     ed.duration_s = 8.0;
     assert_int_equal(sc_emu_init(&emu, &ed), SC_OK);
     const uint64_t t0 = rig.clock.now_ns;
-    uint64_t next_ns = 0;
     int more = 1;
     const uint32_t hz = rig.engine.def.sched.rate_hz;
     for (uint32_t f = 0; f < hz; f++) {
-        frame(t0, &next_ns, &more);
+        frame(t0, &more);
     }
     const uint32_t fatal = rig.engine.def.phys_resets_fatal;
     for (uint32_t k = 0; k < fatal; k++) {
         rig.engine.tissue[rig.engine.active].nodes.x[7] = NAN;
-        frame(t0, &next_ns, &more);
+        frame(t0, &more);
     }
     sc_engine_status st;
     sc_engine_get_status(&rig.engine, &st);
@@ -244,7 +236,7 @@ static void repeated_guard_resets_clear_by_themselves_within_a_second_or_so(void
     assert_true((st.faults & (1u << SC_FAULT_PHYS_REPEATED)) != 0u);
     uint32_t cleared_after = 0;
     for (uint32_t f = 0; f < 2u * hz; f++) {
-        frame(t0, &next_ns, &more);
+        frame(t0, &more);
         sc_engine_get_status(&rig.engine, &st);
         if ((st.faults & ((1u << SC_FAULT_PHYS_REPEATED) | (1u << SC_FAULT_PHYS_UNSTABLE))) ==
             0u) {
@@ -259,7 +251,7 @@ static void repeated_guard_resets_clear_by_themselves_within_a_second_or_so(void
     /* the probe acts again: contact within the next second of the press script */
     uint32_t contact = 0;
     for (uint32_t f = 0; f < 2u * hz; f++) {
-        frame(t0, &next_ns, &more);
+        frame(t0, &more);
         contact += rig.engine.tissue_out.contact;
     }
     assert_true(contact > 0u);

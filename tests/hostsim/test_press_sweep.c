@@ -60,22 +60,16 @@ static void rig_up(const char *case_file, sc_tissue_method m)
 }
 
 /* Feed the emulator's samples due before the next frame, run it. */
-static void frame(uint64_t t0, uint64_t *next_ns, int *more)
+static int send_peer(void *ctx, const sc_can_frame *f)
 {
-    sc_can_frame f[SC_EMU_MAX_FRAMES];
-    const uint64_t release =
-        sc_engine_next_release_ns(&rig.engine);
-    while (*more && t0 + *next_ns <= release) {
-        uint64_t t_ns;
-        const int k = sc_emu_next(&emu, f, SC_EMU_MAX_FRAMES, &t_ns);
-        if (k < 0) {
-            *more = 0;
-            break;
-        }
-        for (int j = 0; j < k; j++) {
-            (void)sc_can_send(&rig.peer, &f[j]);
-        }
-        *next_ns = t_ns + (uint64_t)(1e9 / emu.def.rate_hz);
+    return sc_can_send((const sc_can_dev *)ctx, f);
+}
+
+static void frame(uint64_t t0, int *more)
+{
+    if (*more && sc_emu_feed(&emu, sc_engine_next_release_ns(&rig.engine) - t0, send_peer,
+                             &rig.peer) == SC_ERR_NOT_FOUND) {
+        *more = 0;
     }
     sc_engine_step(&rig.engine, NULL);
 }
@@ -169,7 +163,6 @@ static void sweep_mesh(const char *case_name, sc_tissue_method m, uint32_t fine)
     assert_int_equal(sc_emu_init(&emu, &ed), SC_OK);
 
     const uint64_t t0 = rig.clock.now_ns;
-    uint64_t next_ns = 0;
     int more = 1;
     const uint32_t hz = rig.engine.def.sched.rate_hz;
     sweep_point pts[64];
@@ -177,7 +170,7 @@ static void sweep_mesh(const char *case_name, sc_tissue_method m, uint32_t fine)
     for (uint32_t s = 0; s <= steps && s < 64u; s++) {
         const uint32_t frames = (uint32_t)((s == 0u ? HOLD_S : RAMP_S + HOLD_S) * hz);
         for (uint32_t f = 0; f < frames; f++) {
-            frame(t0, &next_ns, &more);
+            frame(t0, &more);
             assert_true(state_finite());
         }
         const sc_bscan_status *b = sc_bscan_status_get(&rig.engine.bscan);
@@ -186,11 +179,11 @@ static void sweep_mesh(const char *case_name, sc_tissue_method m, uint32_t fine)
     }
     /* the lift (ramp) and 1 s without contact */
     for (uint32_t f = 0; f < (uint32_t)(RAMP_S * hz) + hz; f++) {
-        frame(t0, &next_ns, &more);
+        frame(t0, &more);
     }
     const float dev = max_dev_from_rest_mm();
     for (uint32_t f = 0; f < hz; f++) {
-        frame(t0, &next_ns, &more);
+        frame(t0, &more);
     }
     const float dev2 = max_dev_from_rest_mm();
     sc_engine_status st;
