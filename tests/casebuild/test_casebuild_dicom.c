@@ -137,6 +137,8 @@ static void enhanced_multiframe_rle_compressed_imports_into_a_valid_case(void **
     snprintf(f, sizeof f, "%s/mf8rle/volume.dcm", g_dir);
     sc_import_opts o = sc_import_default_opts();
     o.volume_path = f;
+    o.depth_axis = "+k"; /* source order (the default would be depth posterior, x right) */
+    o.lateral_axis = "+i";
     o.mesh_nodes[0] = o.mesh_nodes[1] = o.mesh_nodes[2] = 3;
     sc_import_result r;
     char err[256];

@@ -451,9 +451,9 @@ static void bad_inputs_are_refused_with_named_errors(void **state)
     assert_int_equal(read_named("nan.nrrd", hdr, data, N), SC_ERR_CASE_SPACING);
     snprintf(hdr, sizeof hdr,
              "NRRD0004\ntype: uchar\ndimension: 3\nsizes: %u %u %u\n"
-             "space directions: (1,0,0) (0,1,0) (0,0,-1)\nencoding: raw\n\n",
+             "space directions: (1,0,0) (1,1,0) (0,0,1)\nencoding: raw\n\n",
              DX, DY, DZ);
-    assert_int_equal(read_named("lefthanded.nrrd", hdr, data, N), SC_ERR_CASE_TRANSFORM);
+    assert_int_equal(read_named("sheared.nrrd", hdr, data, N), SC_ERR_CASE_TRANSFORM);
     snprintf(hdr, sizeof hdr,
              "NDims = 3\nDimSize = %u %u %u\nElementType = MET_LONG_LONG\n"
              "ElementDataFile = LOCAL\n",

@@ -5,6 +5,7 @@
  * OUT.scase
  *                [--name NAME] [--description TEXT] [--spacing MM] [--window LO:HI]
  *                [--mesh-nodes NX,NY,NZ] [--mesh-box X0,Y0,Z0,SX,SY,SZ]
+ *                [--depth-axis AX] [--lateral-axis AX] [--label-map V=NAME,...]
  *                [--calibration 12 numbers] [--registration 12 numbers] (row-major R, then t)
  *   sc-casebuild info CASE.scase
  *   sc-casebuild verify CASE.scase...
@@ -15,6 +16,7 @@
  * Exit status: 0 success, 1 a case refused / an input unreadable, 2 usage.
  */
 #include <errno.h>
+#include <math.h>
 #include <inttypes.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -44,8 +46,11 @@ static int usage(void)
             "  sc-casebuild import --volume FILE [--labels FILE] -o OUT.scase [--name NAME]\n"
             "               [--description TEXT] [--spacing MM] [--window LO:HI]\n"
             "               [--mesh-nodes NX,NY,NZ] [--mesh-box X0,Y0,Z0,SX,SY,SZ]\n"
+            "               [--depth-axis AX] [--lateral-axis AX]  (AX: +i -i +j -j +k -k of the\n"
+            "                source grid, or L R A P S I when the file states a patient frame)\n"
+            "               [--label-map V=NAME,...[,*=NAME]]  (source label -> vein, artery, ...)\n"
             "               [--calibration R00,..,R22,TX,TY,TZ]  (image -> probe, mm)\n"
-            "               [--registration R00,..,R22,TX,TY,TZ] (tracker -> mannequin, mm)\n"
+            "               [--registration R00,..,R22,TX,TY,TZ] (tracker -> patient, mm)\n"
             "               (FILE: .mha, .mhd, .nrrd, .nhdr, raw or compressed; .dcm or a DICOM\n"
             "                series folder when built with DCMTK)\n"
             "  sc-casebuild info CASE\n"
@@ -188,6 +193,28 @@ static int cmd_info(int argc, char **argv)
                100.0 * (double)hist[l] / (double)c.voxel_count, (double)c.materials[l].e_pa,
                (double)c.materials[l].poisson, (double)c.materials[l].density_kg_m3);
     }
+    /* labels present and absent (an absent vein or artery means no compression measure) */
+    printf("\nlabels found          ");
+    for (uint32_t l = 0; l < c.material_count && l < SC_LABEL_COUNT; l++) {
+        if (hist[l] != 0u) {
+            printf(" %s", label_names[l]);
+        }
+    }
+    printf("\nlabels absent         ");
+    int absent = 0;
+    for (uint32_t l = 0; l < SC_LABEL_COUNT; l++) {
+        if (l >= c.material_count || hist[l] == 0u) {
+            printf(" %s", label_names[l]);
+            absent = 1;
+        }
+    }
+    printf("%s\n", absent ? "" : " none");
+    if (hist[SC_LABEL_VEIN] == 0u || hist[SC_LABEL_ARTERY] == 0u) {
+        printf("note                   no %s label: the engine reports no %s area ratio for "
+               "this case\n",
+               hist[SC_LABEL_VEIN] == 0u ? "vein" : "artery",
+               hist[SC_LABEL_VEIN] == 0u ? "vein" : "artery");
+    }
     uint64_t acc = 0;
     int p5 = -1, p50 = -1, p95 = -1;
     for (int g = 0; g < 256; g++) {
@@ -230,6 +257,45 @@ static int cmd_verify(int argc, char **argv)
     return bad;
 }
 
+/* Strict command-line numbers: the whole string, finite, inside [lo, hi]; else a message
+ * naming the option and exit status 2. */
+static int num_f32(const char *opt, const char *s, double lo, double hi, float *out)
+{
+    char *end;
+    errno = 0;
+    const double v = strtod(s, &end);
+    if (errno || end == s || *end || !isfinite(v) || v < lo || v > hi) {
+        fprintf(stderr, "sc-casebuild: %s '%s': a number in [%g, %g]\n", opt, s, lo, hi);
+        return -1;
+    }
+    *out = (float)v;
+    return 0;
+}
+
+static int num_u64(const char *opt, const char *s, uint64_t lo, uint64_t hi, uint64_t *out)
+{
+    char *end;
+    errno = 0;
+    const unsigned long long v = strtoull(s, &end, 0);
+    if (errno || end == s || *end || s[0] == '-' || s[0] == '+' || v < lo || v > hi) {
+        fprintf(stderr, "sc-casebuild: %s '%s': an integer in [%" PRIu64 ", %" PRIu64 "]\n", opt,
+                s, lo, hi);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+static int num_u32(const char *opt, const char *s, uint32_t lo, uint32_t hi, uint32_t *out)
+{
+    uint64_t v;
+    if (num_u64(opt, s, lo, hi, &v) != 0) {
+        return -1;
+    }
+    *out = (uint32_t)v;
+    return 0;
+}
+
 static int cmd_phantom(int argc, char **argv)
 {
     sc_phantom_def pd = sc_phantom_default_def();
@@ -247,9 +313,13 @@ static int cmd_phantom(int argc, char **argv)
         if (strcmp(argv[i], "-o") == 0 && i + 1 < argc) {
             out = argv[++i];
         } else if (strcmp(argv[i], "--seed") == 0 && i + 1 < argc) {
-            pd.seed = strtoull(argv[++i], NULL, 0);
+            if (num_u64("--seed", argv[++i], 0u, UINT64_MAX, &pd.seed) != 0) {
+                return 2;
+            }
         } else if (strcmp(argv[i], "--spacing") == 0 && i + 1 < argc) {
-            pd.spacing_mm = strtof(argv[++i], NULL);
+            if (num_f32("--spacing", argv[++i], 0.1, 2.0, &pd.spacing_mm) != 0) {
+                return 2;
+            }
         } else {
             return usage();
         }
@@ -272,10 +342,12 @@ static int parse_floats(const char *s, float *v, int n)
 {
     for (int i = 0; i < n; i++) {
         char *end;
-        v[i] = strtof(s, &end);
-        if (end == s) {
+        errno = 0;
+        const double d = strtod(s, &end);
+        if (end == s || errno || !isfinite(d) || fabs(d) > 1e6) {
             return -1;
         }
+        v[i] = (float)d;
         s = end;
         if (i + 1 < n) {
             if (*s != ',') {
@@ -309,37 +381,63 @@ static int cmd_import(int argc, char **argv)
         } else if (strcmp(a, "--description") == 0) {
             o.description = val;
         } else if (strcmp(a, "--spacing") == 0) {
-            o.spacing_mm = strtof(val, NULL);
-        } else if (strcmp(a, "--window") == 0) {
-            float w[2];
-            const char *colon = strchr(val, ':');
-            if (colon == NULL) {
-                return usage();
+            if (num_f32("--spacing", val, 0.01, 50.0, &o.spacing_mm) != 0) {
+                return 2;
             }
-            w[0] = strtof(val, NULL);
-            w[1] = strtof(colon + 1, NULL);
-            o.window_lo = w[0];
-            o.window_hi = w[1];
+        } else if (strcmp(a, "--window") == 0) {
+            const char *colon = strchr(val, ':');
+            char lo_s[64];
+            if (colon == NULL || (size_t)(colon - val) >= sizeof lo_s) {
+                fprintf(stderr, "sc-casebuild: --window '%s': LO:HI\n", val);
+                return 2;
+            }
+            memcpy(lo_s, val, (size_t)(colon - val));
+            lo_s[colon - val] = 0;
+            if (num_f32("--window LO", lo_s, -1e30, 1e30, &o.window_lo) != 0 ||
+                num_f32("--window HI", colon + 1, -1e30, 1e30, &o.window_hi) != 0) {
+                return 2;
+            }
+            if (!(o.window_hi > o.window_lo)) {
+                fprintf(stderr, "sc-casebuild: --window '%s': HI must be above LO\n", val);
+                return 2;
+            }
             o.has_window = 1;
         } else if (strcmp(a, "--mesh-nodes") == 0) {
-            float v[3];
-            if (parse_floats(val, v, 3) != 0) {
-                return usage();
+            char buf[64];
+            const uint32_t maxn[3] = {SC_MAX_MESH_NX, SC_MAX_MESH_NY, SC_MAX_MESH_NZ};
+            snprintf(buf, sizeof buf, "%s", val);
+            char *save = NULL, *tok = strtok_r(buf, ",", &save);
+            for (int k = 0; k < 3; k++) {
+                if (tok == NULL || num_u32("--mesh-nodes", tok, 2u, maxn[k], &o.mesh_nodes[k])) {
+                    fprintf(stderr, "sc-casebuild: --mesh-nodes '%s': NX,NY,NZ, each 2..%u,%u,%u\n",
+                            val, maxn[0], maxn[1], maxn[2]);
+                    return 2;
+                }
+                tok = strtok_r(NULL, ",", &save);
             }
-            o.mesh_nodes[0] = (uint32_t)v[0];
-            o.mesh_nodes[1] = (uint32_t)v[1];
-            o.mesh_nodes[2] = (uint32_t)v[2];
+            if (tok != NULL) {
+                fprintf(stderr, "sc-casebuild: --mesh-nodes '%s': three counts\n", val);
+                return 2;
+            }
+        } else if (strcmp(a, "--depth-axis") == 0) {
+            o.depth_axis = val;
+        } else if (strcmp(a, "--lateral-axis") == 0) {
+            o.lateral_axis = val;
+        } else if (strcmp(a, "--label-map") == 0) {
+            o.label_map = val;
         } else if (strcmp(a, "--calibration") == 0 || strcmp(a, "--registration") == 0) {
             float v[12];
             if (parse_floats(val, v, 12) != 0) {
                 return usage();
             }
             sc_xform *x = a[2] == 'c' ? &o.image_to_probe : &o.tracker_to_patient;
+            o.has_registration |= a[2] == 'r';
             memcpy(x->r, v, sizeof x->r);
             memcpy(x->t_mm, v + 9, sizeof x->t_mm);
         } else if (strcmp(a, "--mesh-box") == 0) {
             if (parse_floats(val, o.mesh_box_mm, 6) != 0) {
-                return usage();
+                fprintf(stderr, "sc-casebuild: --mesh-box '%s': six finite numbers (mm)\n", val);
+                return 2;
             }
             o.has_mesh_box = 1;
         } else {
@@ -356,6 +454,16 @@ static int cmd_import(int argc, char **argv)
         fprintf(stderr, "sc-casebuild: import: %s: %s\n", sc_err_name(rc), err);
         return 1;
     }
+    static const char axis_names[] = "ijk";
+    printf("%s: case frame x = %c%c, y = %c%c, z (depth) = %c%c of the source grid; mesh box %s "
+           "[%.2f %.2f %.2f] + [%.2f %.2f %.2f] mm\n",
+           out, r.frame_sign[0] > 0 ? '+' : '-', axis_names[r.frame_axis[0]],
+           r.frame_sign[1] > 0 ? '+' : '-', axis_names[r.frame_axis[1]],
+           r.frame_sign[2] > 0 ? '+' : '-', axis_names[r.frame_axis[2]],
+           r.mesh_box_derived ? "(from the labels)" : "(given)", (double)r.def.mesh.origin_mm[0],
+           (double)r.def.mesh.origin_mm[1], (double)r.def.mesh.origin_mm[2],
+           (double)r.def.mesh.size_mm[0], (double)r.def.mesh.size_mm[1],
+           (double)r.def.mesh.size_mm[2]);
     rc = write_case_file(&r.def, out);
     sc_import_result_free(&r);
     return rc;
@@ -372,9 +480,17 @@ static int cmd_slice(int argc, char **argv)
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--axis") == 0 && i + 1 < argc) {
             const char *ax = argv[++i];
-            axis = ax[0] == 'x' ? 0 : ax[0] == 'y' ? 1 : 2;
+            if ((ax[0] != 'x' && ax[0] != 'y' && ax[0] != 'z') || ax[1] != 0) {
+                fprintf(stderr, "sc-casebuild: --axis '%s': x, y or z\n", ax);
+                return 2;
+            }
+            axis = ax[0] - 'x';
         } else if (strcmp(argv[i], "--index") == 0 && i + 1 < argc) {
-            index = strtol(argv[++i], NULL, 10);
+            uint32_t ix;
+            if (num_u32("--index", argv[++i], 0u, SC_MAX_VOLUME_DIM - 1u, &ix) != 0) {
+                return 2;
+            }
+            index = (long)ix;
         } else if (strcmp(argv[i], "-o") == 0 && i + 1 < argc) {
             out = argv[++i];
         } else if (strcmp(argv[i], "--labels") == 0) {
@@ -455,9 +571,12 @@ static int cmd_bench(int argc, char **argv)
     int repeat = 11;
     int first = 0;
     if (argc >= 2 && strcmp(argv[0], "--repeat") == 0) {
-        repeat = atoi(argv[1]);
+        uint32_t rp;
+        if (num_u32("--repeat", argv[1], 1u, 1000u, &rp) != 0) {
+            return 2;
+        }
+        repeat = (int)rp;
         first = 2;
-        repeat = repeat < 1 ? 1 : (repeat > 1000 ? 1000 : repeat);
     }
     if (argc <= first) {
         return usage();
@@ -518,12 +637,20 @@ static int cmd_isosurface(int argc, char **argv)
                 }
             }
             if (o.label < 0) {
-                o.label = (int)strtol(l, NULL, 10);
+                uint32_t lv;
+                if (num_u32("--label", l, 0u, SC_MAX_LABELS - 1u, &lv) != 0) {
+                    return 2;
+                }
+                o.label = (int)lv;
             }
         } else if (strcmp(argv[i], "--sigma") == 0 && i + 1 < argc) {
-            o.sigma_mm = strtof(argv[++i], NULL);
+            if (num_f32("--sigma", argv[++i], 0.0, 20.0, &o.sigma_mm) != 0) {
+                return 2;
+            }
         } else if (strcmp(argv[i], "--iterations") == 0 && i + 1 < argc) {
-            o.iterations = (uint32_t)strtoul(argv[++i], NULL, 10);
+            if (num_u32("--iterations", argv[++i], 0u, 1000u, &o.iterations) != 0) {
+                return 2;
+            }
         } else if (strcmp(argv[i], "-o") == 0 && i + 1 < argc) {
             out = argv[++i];
         } else {

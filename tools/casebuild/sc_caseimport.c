@@ -214,7 +214,62 @@ static void image_init(sc_image *img)
     for (int a = 0; a < 3; a++) {
         img->spacing[a] = 1.0;
         img->dir[a * 3 + a] = 1.0;
+        img->lps[a * 3 + a] = 1.0;
     }
+}
+
+/* NRRD "space": the patient frame of an anatomical world (columns L, P, S in world
+ * coordinates); 0 for the non-anatomical spaces; -1 unknown or not a 3D space. */
+static int nrrd_space(const char *v, sc_image *img)
+{
+    static const struct {
+        const char *name, *abbr;
+        double l, p; /* signs of world x, y along Left, Posterior; S is +z in all three */
+    } m[] = {{"right-anterior-superior", "RAS", -1.0, -1.0},
+             {"left-anterior-superior", "LAS", 1.0, -1.0},
+             {"left-posterior-superior", "LPS", 1.0, 1.0}};
+    for (size_t i = 0; i < sizeof m / sizeof m[0]; i++) {
+        if (strcasecmp(v, m[i].name) == 0 || strcasecmp(v, m[i].abbr) == 0) {
+            memset(img->lps, 0, sizeof img->lps);
+            img->lps[0] = m[i].l;
+            img->lps[4] = m[i].p;
+            img->lps[8] = 1.0;
+            img->anatomical = 1;
+            return 1;
+        }
+    }
+    if (strcasecmp(v, "scanner-xyz") == 0 || strcasecmp(v, "3D-right-handed") == 0 ||
+        strcasecmp(v, "3D-left-handed") == 0) {
+        return 0;
+    }
+    return -1;
+}
+
+/* MetaImage AnatomicalOrientation (ITK's convention: each letter names the side grid axis a
+ * comes from, "RAI" = x toward Left, y toward Posterior, z toward Superior, the identity in
+ * ITK's LPS world). Fills dir (columns) from it; 0 ok, -1 malformed. */
+static int met_orientation(const char *v, double dir[9])
+{
+    if (strlen(v) != 3u) {
+        return -1;
+    }
+    int used = 0;
+    for (int a = 0; a < 3; a++) {
+        static const char from[] = "RLAPIS"; /* from R: toward +x (L), from L: toward -x ... */
+        const char *hit = strchr(from, toupper((unsigned char)v[a]));
+        if (hit == NULL || v[a] == 0) {
+            return -1;
+        }
+        int k = (int)(hit - from), world = k / 2;
+        if (used & (1 << world)) {
+            return -1;
+        }
+        used |= 1 << world;
+        for (int r = 0; r < 3; r++) {
+            dir[r * 3 + a] = r == world ? (k % 2 == 0 ? 1.0 : -1.0) : 0.0;
+        }
+    }
+    return 0;
 }
 
 static size_t image_count(const sc_image *img)
@@ -291,6 +346,8 @@ static int read_metaimage(const char *path, sc_image *img, char *err, size_t err
         return rc;
     }
     int ndims = 0, have_type = 0, compressed = 0, big = 0, channels = 1, have_spacing = 0;
+    int have_matrix = 0, have_anat = 0;
+    double anat_dir[9];
     long long dsz[3] = {1, 1, 1};
     long long header_size = 0, comp_size = -1;
     char datafile[1024] = "";
@@ -352,6 +409,7 @@ static int read_metaimage(const char *path, sc_image *img, char *err, size_t err
             /* MetaIO stores the matrix column by column: the first 3 values are the
              * direction of the first axis */
             int n = parse_numbers(val, v, 9);
+            have_matrix = 1;
             if (n == 9) {
                 for (int a = 0; a < 3; a++) {
                     for (int r = 0; r < 3; r++) {
@@ -390,12 +448,30 @@ static int read_metaimage(const char *path, sc_image *img, char *err, size_t err
             snprintf(datafile, sizeof datafile, "%s", val);
             data_off = pos;
             found_data = 1;
-        } /* other keys (ObjectType, AnatomicalOrientation, patient fields...): ignored */
+        } else if (strcasecmp(key, "AnatomicalOrientation") == 0) {
+            /* "???" (unknown) is what ITK writes for a non-anatomical image */
+            if (strcmp(val, "???") != 0) {
+                if (met_orientation(val, anat_dir) != 0) {
+                    free(file);
+                    return fail(err, errlen, SC_ERR_PARSE,
+                                "%s: AnatomicalOrientation '%s' is not three of R/L, A/P, I/S",
+                                path, val);
+                }
+                have_anat = 1;
+            }
+        } /* other keys (ObjectType, patient fields...): ignored */
     }
     if (!found_data || !have_type || (ndims != 2 && ndims != 3)) {
         free(file);
         return fail(err, errlen, SC_ERR_PARSE,
                     "%s: MetaImage needs NDims 2 or 3, ElementType, ElementDataFile", path);
+    }
+    if (have_anat) {
+        /* ITK's world is LPS; the matrix, when given, is the geometry (as ITK reads it) */
+        img->anatomical = 1;
+        if (!have_matrix && ndims == 3) {
+            memcpy(img->dir, anat_dir, sizeof anat_dir);
+        }
     }
     if (channels != 1) {
         free(file);
@@ -613,6 +689,14 @@ static int read_nrrd(const char *path, sc_image *img, char *err, size_t errlen)
                 }
             }
             have_dirs = 1;
+        } else if (strcasecmp(key, "space") == 0) {
+            if (nrrd_space(val, img) < 0) {
+                free(file);
+                return fail(err, errlen, SC_ERR_NOT_SUPPORTED,
+                            "%s: space '%s' (RAS, LAS, LPS, scanner-xyz, 3D-right-handed, "
+                            "3D-left-handed)",
+                            path, val);
+            }
         } else if (strcasecmp(key, "space origin") == 0) {
             int n = parse_numbers(val, v, 3);
             for (int a = 0; a < n; a++) {
@@ -820,13 +904,7 @@ int sc_image_read(const char *path, sc_image *img, char *err, size_t errlen)
             }
         }
     }
-    double det = d[0] * (d[4] * d[8] - d[5] * d[7]) - d[1] * (d[3] * d[8] - d[5] * d[6]) +
-                 d[2] * (d[3] * d[7] - d[4] * d[6]);
-    if (det < 0.0) {
-        sc_image_free(img);
-        return fail(err, errlen, SC_ERR_CASE_TRANSFORM,
-                    "%s: left-handed grid (det -1): flip an axis before import", path);
-    }
+    /* a left-handed grid is fine: the case frame is chosen right-handed (sc_import_case) */
     return SC_OK;
 }
 
@@ -923,12 +1001,262 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* ---- case frame ------------------------------------------------------------------------ */
+static const char *const k_label_names[] = {
+#define IM_LBL_NAME_(name, value, text) [value] = text,
+    SC_LABEL_LIST(IM_LBL_NAME_)
+#undef IM_LBL_NAME_
+};
+
+/* World direction named by an axis option (see sc_import_opts.depth_axis). */
+static int axis_spec_world(const sc_image *img, const char *path, const char *spec,
+                           const char *opt, double w[3], char *err, size_t errlen)
+{
+    if ((spec[0] == '+' || spec[0] == '-') && spec[1] >= 'i' && spec[1] <= 'k' && !spec[2]) {
+        const int a = spec[1] - 'i';
+        const double sg = spec[0] == '-' ? -1.0 : 1.0;
+        for (int r = 0; r < 3; r++) {
+            w[r] = sg * img->dir[r * 3 + a];
+        }
+        return SC_OK;
+    }
+    static const struct {
+        const char *letter, *word;
+        int col;
+        double sign;
+    } an[] = {{"L", "left", 0, 1.0},      {"R", "right", 0, -1.0},   {"P", "posterior", 1, 1.0},
+              {"A", "anterior", 1, -1.0}, {"S", "superior", 2, 1.0}, {"I", "inferior", 2, -1.0}};
+    for (size_t i = 0; i < sizeof an / sizeof an[0]; i++) {
+        if (strcmp(spec, an[i].letter) == 0 || strcasecmp(spec, an[i].word) == 0) {
+            if (!img->anatomical) {
+                return fail(err, errlen, SC_ERR_INVALID_ARG,
+                            "%s: %s %s: the file states no patient frame (NRRD space, MetaImage "
+                            "AnatomicalOrientation); name a grid axis (+i -i +j -j +k -k)",
+                            path, opt, spec);
+            }
+            for (int r = 0; r < 3; r++) {
+                w[r] = an[i].sign * img->lps[r * 3 + an[i].col];
+            }
+            return SC_OK;
+        }
+    }
+    return fail(err, errlen, SC_ERR_INVALID_ARG,
+                "%s '%s': a grid axis (+i -i +j -j +k -k) or a patient direction (L R A P S I)",
+                opt, spec);
+}
+
+/* The grid axis (not `exclude`) closest to world direction w, and the sign along it. */
+static void snap_axis(const sc_image *img, const double w[3], int exclude, int *axis, int *sign)
+{
+    double best = -1.0;
+    for (int a = 0; a < 3; a++) {
+        if (a == exclude) {
+            continue;
+        }
+        double d = img->dir[a] * w[0] + img->dir[3 + a] * w[1] + img->dir[6 + a] * w[2];
+        if (fabs(d) > best) {
+            best = fabs(d);
+            *axis = a;
+            *sign = d < 0.0 ? -1 : 1;
+        }
+    }
+}
+
+/* Case frame: case axis c is sign[c] * grid axis axis[c]; C (row-major, columns = world
+ * directions of the case axes) is right-handed whatever the grid's handedness. */
+static int choose_frame(const sc_image *img, const sc_import_opts *o, int axis[3], int sign[3],
+                        double C[9], char *err, size_t errlen)
+{
+    const char *path = o->volume_path;
+    const char *dspec = o->depth_axis ? o->depth_axis : (img->anatomical ? "P" : "+k");
+    double w[3];
+    int rc = axis_spec_world(img, path, dspec, "--depth-axis", w, err, errlen);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    snap_axis(img, w, -1, &axis[2], &sign[2]);
+    const char *lspec = o->lateral_axis;
+    if (lspec == NULL) {
+        lspec = img->anatomical ? "R" : (axis[2] == 0 ? "+j" : "+i");
+    }
+    rc = axis_spec_world(img, path, lspec, "--lateral-axis", w, err, errlen);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    int la, ls;
+    snap_axis(img, w, -1, &la, &ls);
+    if (la == axis[2]) {
+        if (o->lateral_axis != NULL) {
+            return fail(err, errlen, SC_ERR_INVALID_ARG,
+                        "--lateral-axis %s lies along the depth axis (%s)", o->lateral_axis,
+                        dspec);
+        }
+        snap_axis(img, w, axis[2], &la, &ls); /* oblique default: the next closest axis */
+    }
+    axis[0] = la;
+    sign[0] = ls;
+    axis[1] = 3 - axis[0] - axis[2];
+    /* y = z x x */
+    double zx[3], xx[3], cy[3];
+    for (int r = 0; r < 3; r++) {
+        zx[r] = sign[2] * img->dir[r * 3 + axis[2]];
+        xx[r] = sign[0] * img->dir[r * 3 + axis[0]];
+    }
+    cy[0] = zx[1] * xx[2] - zx[2] * xx[1];
+    cy[1] = zx[2] * xx[0] - zx[0] * xx[2];
+    cy[2] = zx[0] * xx[1] - zx[1] * xx[0];
+    double d = cy[0] * img->dir[axis[1]] + cy[1] * img->dir[3 + axis[1]] +
+               cy[2] * img->dir[6 + axis[1]];
+    sign[1] = d < 0.0 ? -1 : 1;
+    for (int c = 0; c < 3; c++) {
+        for (int r = 0; r < 3; r++) {
+            C[r * 3 + c] = sign[c] * img->dir[r * 3 + axis[c]];
+        }
+    }
+    return SC_OK;
+}
+
+/* ---- label map ---------------------------------------------------------------------------- */
+static int label_from_name(const char *s, size_t n)
+{
+    for (int l = 0; l < (int)SC_LABEL_COUNT; l++) {
+        if (strlen(k_label_names[l]) == n && strncasecmp(k_label_names[l], s, n) == 0) {
+            return l;
+        }
+    }
+    return -1;
+}
+
+/* map[v] = project label of source value v, -1 unmapped; map[256] = the "*" entry or -1 */
+static int parse_label_map(const char *spec, int map[257], char *err, size_t errlen)
+{
+    for (int v = 0; v < 257; v++) {
+        map[v] = -1;
+    }
+    const char *p = spec;
+    while (*p) {
+        const char *comma = strchr(p, ',');
+        size_t len = comma ? (size_t)(comma - p) : strlen(p);
+        const char *eq = memchr(p, '=', len);
+        if (eq == NULL || eq == p || eq + 1 == p + len) {
+            return fail(err, errlen, SC_ERR_INVALID_ARG,
+                        "--label-map: '%.*s' is not VALUE=NAME (e.g. 2=vein,3=artery,*=muscle)",
+                        (int)len, p);
+        }
+        int slot;
+        if (eq - p == 1 && p[0] == '*') {
+            slot = 256;
+        } else {
+            char num[16];
+            size_t nl = (size_t)(eq - p);
+            if (nl >= sizeof num) {
+                return fail(err, errlen, SC_ERR_INVALID_ARG, "--label-map: value '%.*s'",
+                            (int)nl, p);
+            }
+            memcpy(num, p, nl);
+            num[nl] = 0;
+            char *end;
+            errno = 0;
+            long v = strtol(num, &end, 10);
+            if (errno || *end || end == num || v < 0 || v > 255) {
+                return fail(err, errlen, SC_ERR_INVALID_ARG,
+                            "--label-map: value '%s' is not an integer 0..255", num);
+            }
+            slot = (int)v;
+        }
+        const char *nm = eq + 1;
+        size_t nn = (size_t)(p + len - nm);
+        int l = label_from_name(nm, nn);
+        if (l < 0) {
+            char known[160] = "";
+            for (int k = 0; k < (int)SC_LABEL_COUNT; k++) {
+                strncat(known, k_label_names[k], sizeof known - strlen(known) - 2u);
+                strncat(known, k + 1 < (int)SC_LABEL_COUNT ? " " : "",
+                        sizeof known - strlen(known) - 1u);
+            }
+            return fail(err, errlen, SC_ERR_INVALID_ARG,
+                        "--label-map: unknown label name '%.*s' (known: %s)", (int)nn, nm, known);
+        }
+        if (map[slot] >= 0) {
+            return fail(err, errlen, SC_ERR_INVALID_ARG, "--label-map: value %s given twice",
+                        slot == 256 ? "*" : "");
+        }
+        map[slot] = l;
+        p += len;
+        if (*p == ',') {
+            p++;
+            if (!*p) {
+                return fail(err, errlen, SC_ERR_INVALID_ARG, "--label-map: trailing comma");
+            }
+        }
+    }
+    return SC_OK;
+}
+
+/* ---- derived mesh box --------------------------------------------------------------------- */
+static int derive_mesh_box(const sc_import_result *r, const uint32_t dim[3], const double sp[3],
+                           const double org[3], float box[6], char *err, size_t errlen)
+{
+    const uint8_t *lab = r->labels;
+    uint32_t i0 = dim[0], i1 = 0, j0 = dim[1], j1 = 0, top = dim[2];
+    uint32_t bone_top = dim[2], vessel_bottom = 0;
+    int have_vessel = 0;
+    for (uint32_t k = 0; k < dim[2]; k++) {
+        for (uint32_t j = 0; j < dim[1]; j++) {
+            const uint8_t *row = lab + (size_t)dim[0] * (j + (size_t)dim[1] * k);
+            for (uint32_t i = 0; i < dim[0]; i++) {
+                const uint8_t l = row[i];
+                if (l == SC_LABEL_OUTSIDE) {
+                    continue;
+                }
+                i0 = i < i0 ? i : i0;
+                i1 = i > i1 ? i : i1;
+                j0 = j < j0 ? j : j0;
+                j1 = j > j1 ? j : j1;
+                top = k < top ? k : top;
+                if (l == SC_LABEL_BONE && k < bone_top) {
+                    bone_top = k;
+                }
+                if (l == SC_LABEL_VEIN || l == SC_LABEL_ARTERY || l == SC_LABEL_THROMBUS) {
+                    have_vessel = 1;
+                    vessel_bottom = k > vessel_bottom ? k : vessel_bottom;
+                }
+            }
+        }
+    }
+    uint32_t bottom = dim[2] - 1u;
+    if (bone_top < dim[2] && bone_top > top + 1u && (!have_vessel || bone_top > vessel_bottom)) {
+        bottom = bone_top;
+    }
+    if (top >= dim[2] || i1 <= i0 || j1 <= j0 || bottom <= top) {
+        return fail(err, errlen, SC_ERR_CASE_MESH_BOX,
+                    "cannot derive a mesh box from the labels (no tissue volume below a skin "
+                    "surface, at least 2 voxels on every axis): give --mesh-box");
+    }
+    const uint32_t lo[3] = {i0, j0, top}, hi[3] = {i1, j1, bottom};
+    for (int a = 0; a < 3; a++) {
+        box[a] = (float)(org[a] + sp[a] * (double)lo[a]);
+        box[3 + a] = (float)(sp[a] * (double)(hi[a] - lo[a]));
+    }
+    return SC_OK;
+}
+
 int sc_import_case(const sc_import_opts *o, sc_import_result *r, char *err, size_t errlen)
 {
     if (o == NULL || r == NULL || o->volume_path == NULL) {
         return fail(err, errlen, SC_ERR_INVALID_ARG, "no volume");
     }
     memset(r, 0, sizeof *r);
+    int lmap[257];
+    if (o->label_map != NULL) {
+        int rc = parse_label_map(o->label_map, lmap, err, errlen);
+        if (rc != SC_OK) {
+            return rc;
+        }
+        if (o->labels_path == NULL) {
+            return fail(err, errlen, SC_ERR_INVALID_ARG, "--label-map without --labels");
+        }
+    }
     sc_image vol, lab;
     int rc = sc_image_read(o->volume_path, &vol, err, errlen);
     if (rc != SC_OK) {
@@ -943,13 +1271,34 @@ int sc_import_case(const sc_import_opts *o, sc_import_result *r, char *err, size
         }
         have_lab = 1;
     }
-    /* the case grid: the volume's orientation and extent, source or requested spacing */
+    /* the case frame: axes of the source grid, permuted/flipped so that z is depth */
+    int axis[3], sign[3];
+    double C[9];
+    rc = choose_frame(&vol, o, axis, sign, C, err, errlen);
+    if (rc != SC_OK) {
+        goto out;
+    }
+    /* the case grid: the volume's extent along each case axis, source or requested spacing */
     uint32_t dim[3];
-    double sp[3];
-    for (int a = 0; a < 3; a++) {
-        sp[a] = o->spacing_mm > 0.0f ? (double)o->spacing_mm : vol.spacing[a];
-        double ext = vol.spacing[a] * (double)(vol.dim[a] - 1u);
-        dim[a] = (uint32_t)floor(ext / sp[a] + 1e-6) + 1u;
+    double sp[3], org[3];
+    for (int c = 0; c < 3; c++) {
+        const int a = axis[c];
+        const double sa = vol.spacing[a];
+        const double ext = sa * (double)(vol.dim[a] - 1u);
+        const double o_a = vol.dir[a] * vol.origin[0] + vol.dir[3 + a] * vol.origin[1] +
+                           vol.dir[6 + a] * vol.origin[2];
+        org[c] = sign[c] > 0 ? o_a : -o_a - ext;
+        sp[c] = o->spacing_mm > 0.0f ? (double)o->spacing_mm : sa;
+        const double nd = floor(ext / sp[c] + 1e-6) + 1.0;
+        if (!(nd >= 1.0 && nd <= (double)SC_MAX_VOLUME_DIM)) {
+            rc = fail(err, errlen, SC_ERR_CASE_DIMS,
+                      "case grid axis %c: %.4g mm at %.4g mm is %.4g voxels, above %u", "xyz"[c],
+                      ext, sp[c], nd, SC_MAX_VOLUME_DIM);
+            goto out;
+        }
+        dim[c] = (uint32_t)nd;
+        r->frame_axis[c] = a;
+        r->frame_sign[c] = sign[c];
     }
     long long dl[3] = {dim[0], dim[1], dim[2]};
     sc_image tmp;
@@ -987,17 +1336,16 @@ int sc_import_case(const sc_import_opts *o, sc_import_result *r, char *err, size
     if (!(hi > lo)) {
         hi = lo + 1.0;
     }
-    size_t outside_labels = 0;
     for (uint32_t k = 0; k < dim[2]; k++) {
         for (uint32_t j = 0; j < dim[1]; j++) {
             for (uint32_t i = 0; i < dim[0]; i++) {
                 size_t idx = i + (size_t)dim[0] * (j + (size_t)dim[1] * k);
-                /* world point: origin + D * (i, j, k) * sp */
-                double g[3] = {(double)i * sp[0], (double)j * sp[1], (double)k * sp[2]};
+                /* world point: C * (case origin + (i, j, k) * sp) */
+                double q[3] = {org[0] + (double)i * sp[0], org[1] + (double)j * sp[1],
+                               org[2] + (double)k * sp[2]};
                 double p[3];
                 for (int rr = 0; rr < 3; rr++) {
-                    p[rr] = vol.origin[rr] + vol.dir[rr * 3] * g[0] + vol.dir[rr * 3 + 1] * g[1] +
-                            vol.dir[rr * 3 + 2] * g[2];
+                    p[rr] = C[rr * 3] * q[0] + C[rr * 3 + 1] * q[1] + C[rr * 3 + 2] * q[2];
                 }
                 double si[3];
                 world_to_index(&vol, p, si);
@@ -1009,22 +1357,40 @@ int sc_import_case(const sc_import_opts *o, sc_import_result *r, char *err, size
                 if (have_lab) {
                     double li[3], lv = 0.0;
                     world_to_index(&lab, p, li);
-                    if (!sample_nearest(&lab, li, &lv)) {
-                        lv = SC_LABEL_OUTSIDE; /* label map smaller than the volume */
-                        outside_labels++;
-                    }
-                    if (!(lv >= 0.0 && lv <= 255.0) || lv > floor(lv)) {
+                    int inside = sample_nearest(&lab, li, &lv);
+                    if (inside && (!(lv >= 0.0 && lv <= 255.0) || lv > floor(lv))) {
                         rc = fail(err, errlen, SC_ERR_CASE_LABEL,
-                                  "label value %g is not an integer 0..255", lv);
+                                  "%s: label value %g is not an integer 0..255", o->labels_path,
+                                  lv);
                         goto out;
                     }
-                    l = (uint8_t)lv;
+                    if (!inside) {
+                        l = SC_LABEL_OUTSIDE; /* label map smaller than the volume */
+                    } else if (o->label_map != NULL) {
+                        const int m = lmap[(int)lv] >= 0 ? lmap[(int)lv] : lmap[256];
+                        if (m < 0) {
+                            rc = fail(err, errlen, SC_ERR_CASE_LABEL,
+                                      "%s: label value %g has no entry in --label-map (add "
+                                      "%g=NAME or *=NAME)",
+                                      o->labels_path, lv, lv);
+                            goto out;
+                        }
+                        l = (uint8_t)m;
+                    } else if (lv >= (double)SC_LABEL_COUNT) {
+                        rc = fail(err, errlen, SC_ERR_CASE_LABEL,
+                                  "%s: label value %g is not a project label (0..%d); name what "
+                                  "it is with --label-map %g=NAME",
+                                  o->labels_path, lv, (int)SC_LABEL_COUNT - 1, lv);
+                        goto out;
+                    } else {
+                        l = (uint8_t)lv;
+                    }
                 }
                 r->labels[idx] = l;
+                r->label_voxels[l]++;
             }
         }
     }
-    (void)outside_labels;
     /* the case definition */
     sc_case_def *d = &r->def;
     *d = sc_case_default_def();
@@ -1040,16 +1406,14 @@ int sc_import_case(const sc_import_opts *o, sc_import_result *r, char *err, size
     }
     d->name = r->name;
     d->description = r->description;
-    /* volume frame = grid axes: v = D^T (world); case origin = D^T world origin */
+    /* volume frame = case axes: v = C^T (world) */
     for (int a = 0; a < 3; a++) {
         d->volume.dim[a] = dim[a];
         d->volume.spacing_mm[a] = (float)sp[a];
-        d->volume.origin_mm[a] =
-            (float)(vol.dir[a] * vol.origin[0] + vol.dir[3 + a] * vol.origin[1] +
-                    vol.dir[6 + a] * vol.origin[2]);
+        d->volume.origin_mm[a] = (float)org[a];
     }
     for (int i = 0; i < 9; i++) {
-        d->orientation[i] = (float)vol.dir[i];
+        d->orientation[i] = (float)C[i];
     }
     d->volume.voxels = r->voxels;
     d->volume.labels = r->labels;
@@ -1061,18 +1425,39 @@ int sc_import_case(const sc_import_opts *o, sc_import_result *r, char *err, size
     d->material_count = (uint32_t)(sizeof mats / sizeof mats[0]);
     memcpy(d->materials, mats, sizeof mats);
     d->image_to_probe = o->image_to_probe;
-    d->tracker_to_patient = o->tracker_to_patient;
     d->mesh.nx = o->mesh_nodes[0];
     d->mesh.ny = o->mesh_nodes[1];
     d->mesh.nz = o->mesh_nodes[2];
-    for (int a = 0; a < 3; a++) {
-        if (o->has_mesh_box) {
-            d->mesh.origin_mm[a] = o->mesh_box_mm[a];
-            d->mesh.size_mm[a] = o->mesh_box_mm[3 + a];
-        } else {
-            d->mesh.origin_mm[a] = d->volume.origin_mm[a];
-            d->mesh.size_mm[a] = (float)(sp[a] * (double)(dim[a] - 1u));
+    float box[6];
+    if (o->has_mesh_box) {
+        memcpy(box, o->mesh_box_mm, sizeof box);
+    } else {
+        rc = derive_mesh_box(r, dim, sp, org, box, err, errlen);
+        if (rc != SC_OK) {
+            goto out;
         }
+        r->mesh_box_derived = 1;
+    }
+    for (int a = 0; a < 3; a++) {
+        d->mesh.origin_mm[a] = box[a];
+        d->mesh.size_mm[a] = box[3 + a];
+    }
+    if (o->has_registration) {
+        d->tracker_to_patient = o->tracker_to_patient;
+    } else {
+        /* the tracker emulator's frame: tracker -> volume is (x, y, z) -> (x, -y, -z) plus the
+         * top centre of the mesh box, so tracker -> patient = C diag(1, -1, -1), t = C top */
+        const double top[3] = {(double)box[0] + 0.5 * (double)box[3],
+                               (double)box[1] + 0.5 * (double)box[4], (double)box[2]};
+        sc_xform x;
+        for (int rr = 0; rr < 3; rr++) {
+            x.r[rr * 3 + 0] = (float)C[rr * 3 + 0];
+            x.r[rr * 3 + 1] = (float)-C[rr * 3 + 1];
+            x.r[rr * 3 + 2] = (float)-C[rr * 3 + 2];
+            x.t_mm[rr] =
+                (float)(C[rr * 3] * top[0] + C[rr * 3 + 1] * top[1] + C[rr * 3 + 2] * top[2]);
+        }
+        d->tracker_to_patient = x;
     }
     rc = SC_OK;
 out:

@@ -38,9 +38,27 @@ typedef struct sc_import_opts {
                                  * is, other types their 0.1 .. 99.9 percentiles */
     uint32_t mesh_nodes[3];     /* default 24 x 12 x 12 */
     int has_mesh_box;
-    float mesh_box_mm[6];        /* origin xyz, size xyz in the volume frame; default: the volume */
+    float mesh_box_mm[6]; /* origin xyz, size xyz in the case frame; default: derived from the
+                           * labels (sc_import_case) */
+    /* Case frame (x lateral, y along the body, z depth: the engine presses along z). Each a
+     * grid axis of the source, "+i" "-i" "+j" "-j" "+k" "-k", or a patient direction the
+     * axis points toward, "L" "R" "A" "P" "S" "I" (or the words left, right, anterior,
+     * posterior, superior, inferior; only for files that state a patient frame), snapped to
+     * the grid axis closest to it. NULL: depth "P" and lateral "R" when the file states a
+     * patient frame (a supine patient scanned from the front: neck, groin), else depth "+k"
+     * and lateral "+i" (or "+j" when depth lies along i). */
+    const char *depth_axis;
+    const char *lateral_axis;
+    /* "V=NAME,V=NAME,...[,*=NAME]": which label of the project each source label value is
+     * (names of config/sc_labels.h); "*" covers values not listed. NULL: the values are the
+     * project's own (0..SC_LABEL_COUNT-1). */
+    const char *label_map;
     sc_xform image_to_probe;     /* probe calibration; default identity */
-    sc_xform tracker_to_patient; /* mannequin registration; default identity */
+    int has_registration;        /* 0: the default registration below */
+    sc_xform tracker_to_patient; /* mannequin registration (tracker -> the file's world frame);
+                                  * default: the tracker emulator's frame (Z up out of the body,
+                                  * a half turn about x from the case frame, as the phantoms)
+                                  * with its origin at the top centre of the mesh box */
 } sc_import_opts;
 
 typedef struct sc_import_result {
@@ -49,13 +67,23 @@ typedef struct sc_import_result {
     uint8_t *labels;
     char name[SC_CASE_NAME_LEN];
     char description[SC_CASE_DESCRIPTION_LEN];
+    int frame_axis[3];      /* source grid axis of case x, y, z */
+    int frame_sign[3];      /* +1 / -1 */
+    uint64_t label_voxels[SC_MAX_LABELS]; /* voxels of each project label in the case */
+    int mesh_box_derived;   /* 1: the mesh box came from the labels */
 } sc_import_result;
 
 sc_import_opts sc_import_default_opts(void);
 
-/* Read, resample to the case grid (trilinear for intensities, nearest for labels, through
- * world coordinates so the label map may have its own grid), window to 8 bits, and fill a
- * case definition with the default material table. O(case voxels). */
+/* Read, choose the case frame (depth axis), resample to the case grid (trilinear for
+ * intensities, nearest for labels, through world coordinates so the label map may have its
+ * own grid), window to 8 bits, map labels, derive the mesh box when none is given, and fill a
+ * case definition with the default material table. O(case voxels).
+ *
+ * Derived mesh box: x and y span the columns holding tissue (any label but outside); its top
+ * is the highest skin/tissue voxel (the smallest z with a label other than outside); its
+ * bottom the top of the shallowest bone when that lies below every vessel (bone is the fixed
+ * structure the tissue rests on), else the volume's bottom. */
 int sc_import_case(const sc_import_opts *o, sc_import_result *r, char *err, size_t errlen);
 void sc_import_result_free(sc_import_result *r);
 

@@ -382,6 +382,9 @@ extern "C" int sc_dicom_read(const char *path, sc_image *img, char *err, size_t 
         return fail(err, errlen, SC_ERR_NOT_SUPPORTED, "%zu slices", sl.size());
     }
     std::memset(img, 0, sizeof *img);
+    // DICOM patient coordinates are LPS (PS3.3 C.7.6.2.1.1)
+    img->anatomical = 1;
+    img->lps[0] = img->lps[4] = img->lps[8] = 1.0;
     img->data = (double *)std::malloc(n * sizeof(double));
     if (img->data == nullptr) {
         cleanup();
