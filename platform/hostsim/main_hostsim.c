@@ -503,7 +503,8 @@ int main(int argc, char **argv)
     }
     static uint8_t deepest[SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES];
     sc_display_frame_info deepest_info = {0};
-    float min_vein = 2.0f, artery_at_min = -1.0f;
+    float min_vein = 2.0f, artery_at_min = -1.0f, deepest_z = -1e30f;
+    int have_vein = 0;
     uint32_t min_vein_frame = 0, contact_frames = 0, pngs = 0, png_errors = 0;
     sc_stats wall;
     sc_stats_reset(&wall);
@@ -548,8 +549,21 @@ int main(int argc, char **argv)
                 sc_health_state_name(st.state), st.faults, h);
         if (st.probe_contact) {
             contact_frames++;
-            if (st.vein_area_ratio >= 0.0f && st.vein_area_ratio < min_vein) {
-                min_vein = st.vein_area_ratio;
+            /* the deepest compression: the smallest vein ratio; a case without a vein label
+             * (no ratio) takes the deepest probe position instead, so the image is written */
+            const float probe_z = sc_engine_get_probe(&rig.engine)->pose_volume.pos_mm[2];
+            const int by_vein = st.vein_area_ratio >= 0.0f && st.vein_area_ratio < min_vein;
+            const int by_depth = !have_vein && st.vein_area_ratio < 0.0f && probe_z > deepest_z;
+            if (st.vein_area_ratio >= 0.0f) {
+                have_vein = 1;
+            }
+            if (by_depth) {
+                deepest_z = probe_z;
+            }
+            if (by_vein || by_depth) {
+                if (by_vein) {
+                    min_vein = st.vein_area_ratio;
+                }
                 artery_at_min = st.artery_area_ratio;
                 min_vein_frame = i;
                 deepest_info = rig.display.last_info;
@@ -619,10 +633,28 @@ int main(int argc, char **argv)
                    " incomplete, %" PRIu64 " protocol errors\n",
                 rig.display.frames_complete, rig.display.frames_incomplete,
                 rig.display.protocol_errors);
-        fprintf(f, "compression     min vein area ratio %.3f at frame %u (artery %.3f there); "
-                   "%u frames in contact\n",
-                (double)(min_vein > 1.5f ? -1.0f : min_vein), min_vein_frame,
-                (double)artery_at_min, contact_frames);
+        if (have_vein) {
+            char art[48];
+            if (artery_at_min >= 0.0f) {
+                snprintf(art, sizeof art, "artery %.3f there", (double)artery_at_min);
+            } else {
+                snprintf(art, sizeof art, "no artery label in the case");
+            }
+            fprintf(f, "compression     min vein area ratio %.3f at frame %u (%s); "
+                       "%u frames in contact\n",
+                    (double)min_vein, min_vein_frame, art, contact_frames);
+        } else if (contact_frames) {
+            /* no vein in this case (or never seen): say so instead of a -1 ratio */
+            fprintf(f, "compression     no vein label in the case; deepest press at frame %u "
+                       "(artery %s); %u frames in contact\n",
+                    min_vein_frame, artery_at_min >= 0.0f ? "measured" : "none in the case",
+                    contact_frames);
+            if (artery_at_min >= 0.0f) {
+                fprintf(f, "                artery area ratio %.3f there\n", (double)artery_at_min);
+            }
+        } else {
+            fprintf(f, "compression     no frame in contact\n");
+        }
         fprintf(f, "tracker         %u frames, %u poses accepted, %u E2E rejects, "
                    "%u implausible, %u lift events\n",
                 tc->frames, tc->outcome[SC_TRK_POSE_ACCEPTED],

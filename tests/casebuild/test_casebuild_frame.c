@@ -125,8 +125,14 @@ static void nrrd_ras_space_puts_posterior_depth_on_case_z(void **state)
     }
     /* depth P = -j, lateral R = +i, y = z x x = +k (superior) */
     check_permutation(&r, (const int[]){0, 2, 1}, (const int[]){1, 1, -1});
-    /* case z grows toward posterior: RAS y decreases with case z */
-    assert_true(fabsf(r.def.orientation[1 * 3 + 2] + 1.0f) < 1e-6f);
+    /* the world is converted to LPS: case z is +y (posterior), case x is -x (right); the
+     * origin (10, 20, 30) RAS is (-10, -20, 30) LPS */
+    assert_true(fabsf(r.def.orientation[1 * 3 + 2] - 1.0f) < 1e-6f);
+    assert_true(fabsf(r.def.orientation[0 * 3 + 0] + 1.0f) < 1e-6f);
+    /* case origin: x along R from 10, y along S from 30, z along P: LPS y of j = 4, -22 */
+    assert_true(fabsf(r.def.volume.origin_mm[0] - 10.0f) < 1e-5f);
+    assert_true(fabsf(r.def.volume.origin_mm[1] - 30.0f) < 1e-5f);
+    assert_true(fabsf(r.def.volume.origin_mm[2] + 22.0f) < 1e-5f);
     sc_import_result_free(&r);
 }
 

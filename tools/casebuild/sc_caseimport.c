@@ -218,22 +218,22 @@ static void image_init(sc_image *img)
     }
 }
 
-/* NRRD "space": the patient frame of an anatomical world (columns L, P, S in world
- * coordinates); 0 for the non-anatomical spaces; -1 unknown or not a 3D space. */
-static int nrrd_space(const char *v, sc_image *img)
+/* NRRD "space": anatomical worlds are converted to LPS (DICOM's and ITK's), so that a volume
+ * and a label map from different tools meet in one patient frame: to_lps holds the sign of
+ * each world axis. 1 anatomical, 0 a non-anatomical space, -1 unknown or not a 3D space. */
+static int nrrd_space(const char *v, sc_image *img, double to_lps[3])
 {
     static const struct {
         const char *name, *abbr;
-        double l, p; /* signs of world x, y along Left, Posterior; S is +z in all three */
+        double sx, sy;
     } m[] = {{"right-anterior-superior", "RAS", -1.0, -1.0},
              {"left-anterior-superior", "LAS", 1.0, -1.0},
              {"left-posterior-superior", "LPS", 1.0, 1.0}};
     for (size_t i = 0; i < sizeof m / sizeof m[0]; i++) {
         if (strcasecmp(v, m[i].name) == 0 || strcasecmp(v, m[i].abbr) == 0) {
-            memset(img->lps, 0, sizeof img->lps);
-            img->lps[0] = m[i].l;
-            img->lps[4] = m[i].p;
-            img->lps[8] = 1.0;
+            to_lps[0] = m[i].sx;
+            to_lps[1] = m[i].sy;
+            to_lps[2] = 1.0;
             img->anatomical = 1;
             return 1;
         }
@@ -606,6 +606,7 @@ static int read_nrrd(const char *path, sc_image *img, char *err, size_t errlen)
         return fail(err, errlen, SC_ERR_PARSE, "%s: no NRRD magic", path);
     }
     int ndims = 0, have_type = 0, enc = ENC_RAW, big = 0, have_dirs = 0;
+    double to_lps[3] = {1.0, 1.0, 1.0};
     long long dsz[3] = {1, 1, 1};
     long long byte_skip = 0, line_skip = 0;
     char datafile[1024] = "";
@@ -690,7 +691,7 @@ static int read_nrrd(const char *path, sc_image *img, char *err, size_t errlen)
             }
             have_dirs = 1;
         } else if (strcasecmp(key, "space") == 0) {
-            if (nrrd_space(val, img) < 0) {
+            if (nrrd_space(val, img, to_lps) < 0) {
                 free(file);
                 return fail(err, errlen, SC_ERR_NOT_SUPPORTED,
                             "%s: space '%s' (RAS, LAS, LPS, scanner-xyz, 3D-right-handed, "
@@ -731,6 +732,12 @@ static int read_nrrd(const char *path, sc_image *img, char *err, size_t errlen)
     if (!have_type || (ndims != 2 && ndims != 3)) {
         free(file);
         return fail(err, errlen, SC_ERR_PARSE, "%s: NRRD needs type and dimension 2 or 3", path);
+    }
+    for (int r = 0; r < 3; r++) {
+        img->origin[r] *= to_lps[r];
+        for (int a = 0; a < 3; a++) {
+            img->dir[r * 3 + a] *= to_lps[r];
+        }
     }
     rc = set_dims(img, dsz, ndims, err, errlen);
     if (rc != SC_OK) {

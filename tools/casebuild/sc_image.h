@@ -24,9 +24,10 @@ typedef struct sc_image {
     double origin[3];
     double dir[9];     /* row-major; column a = direction of grid axis a */
     int anatomical;    /* 1: the file states a patient frame (DICOM, NRRD space RAS/LAS/LPS,
-                        * MetaImage AnatomicalOrientation); lps holds its axes */
+                        * MetaImage AnatomicalOrientation); the world is then LPS (the readers
+                        * convert RAS and LAS) */
     double lps[9];     /* row-major; columns: world direction of patient Left, Posterior,
-                        * Superior (identity for LPS worlds) */
+                        * Superior (identity: every reader gives LPS) */
     sc_elem_type type; /* element type of the file */
     double *data;      /* dim[0]*dim[1]*dim[2] values, x fastest (malloc'd) */
 } sc_image;
