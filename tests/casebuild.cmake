@@ -17,3 +17,14 @@ add_test(NAME casebuild_cases_verify
          COMMAND sc-casebuild verify ${CMAKE_BINARY_DIR}/cases/neck-ijv.scase
                  ${CMAKE_BINARY_DIR}/cases/femoral.scase ${CMAKE_BINARY_DIR}/cases/femoral-dvt.scase)
 set_tests_properties(casebuild_cases_verify PROPERTIES LABELS casebuild TIMEOUT 120)
+
+# End to end: a volume in every format by an independent writer (teem's unu, Python, pydicom)
+# -> import -> the engine pressing on the host simulator: the vein collapses, the artery holds.
+if(TARGET sc-hostsim)
+  add_test(NAME casebuild_e2e_import_press
+           COMMAND ${CMAKE_CURRENT_SOURCE_DIR}/casebuild/e2e_import_press.sh
+                   $<TARGET_FILE:sc-casebuild> $<TARGET_FILE:sc-hostsim> ${PROJECT_SOURCE_DIR}
+                   ${CMAKE_CURRENT_BINARY_DIR}/casebuild_e2e)
+  set_tests_properties(casebuild_e2e_import_press PROPERTIES LABELS "casebuild;integration"
+                                                             TIMEOUT 300)
+endif()

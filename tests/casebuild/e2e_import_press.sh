@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# End-to-end import: one neck-like labelled volume written by independent tools in every
+# format (teem's unu: NRRD in RAS with depth along -j and a foreign label numbering; a
+# MetaImage header written by Python, LPS with AnatomicalOrientation, depth +j; pydicom: an
+# axial DICOM series, depth along the rows) -> sc-casebuild import with the defaults (depth
+# from the file's patient frame, mesh box from the labels, registration of the tracker
+# emulator) -> the engine on the host simulator pressing 8 mm at the mesh box's top centre.
+# Checks: the three cases have the same label map (the frame was found in each file), and in
+# each the vein collapses (min area ratio < 0.5) while the artery holds (> 0.8), running.
+#   e2e_import_press.sh SC_CASEBUILD SC_HOSTSIM SOURCE_DIR WORK_DIR
+set -euo pipefail
+cb=$1 hs=$2 src=$3 work=$4
+command -v teem-unu >/dev/null || { echo "e2e: teem-unu missing (tools/install-deps.sh: teem-apps)" >&2; exit 1; }
+rm -rf "$work" && mkdir -p "$work"
+map=$(/usr/bin/python3 "$src/tests/casebuild/write_e2e_volumes.py" "$work/in")
+"$cb" import --volume "$work/in/nrrd/vol.nrrd" --labels "$work/in/nrrd/lab.nrrd" --label-map "$map" -o "$work/nrrd.scase"
+"$cb" import --volume "$work/in/mha/vol.mhd" --labels "$work/in/mha/lab.mha" -o "$work/mha.scase"
+"$cb" import --volume "$work/in/dicom" --labels "$work/in/mha/lab.mha" -o "$work/dicom.scase"
+fail=0
+ref=""
+for f in nrrd mha dicom; do
+    "$cb" slice "$work/$f.scase" --axis y --labels -o "$work/$f-labels.pgm"
+    sum=$(md5sum < "$work/$f-labels.pgm")
+    if [ -z "$ref" ]; then ref=$sum; elif [ "$sum" != "$ref" ]; then
+        echo "e2e: $f: label map differs from the NRRD case's (frame or geometry wrong)" >&2; fail=1
+    fi
+    "$cb" info "$work/$f.scase" | grep -q "labels found.* vein artery" || { echo "e2e: $f: info lacks vein/artery" >&2; fail=1; }
+    mkdir -p "$work/out-$f"
+    "$hs" --case "$work/$f.scase" --out "$work/out-$f" --every 0 --quiet > "$work/out-$f/stdout.txt"
+    line=$(grep "^compression" "$work/out-$f/summary.txt")
+    state=$(grep "^final state" "$work/out-$f/summary.txt")
+    vein=$(sed -n 's/.*min vein area ratio \([0-9.]*\) .*/\1/p' <<< "$line")
+    artery=$(sed -n 's/.*(artery \([0-9.]*\) there).*/\1/p' <<< "$line")
+    echo "$f: vein $vein artery $artery; $state"
+    [ -f "$work/out-$f/deepest_compression.png" ] || { echo "e2e: $f: no deepest_compression.png" >&2; fail=1; }
+    if [ -z "$vein" ] || [ -z "$artery" ] || ! awk -v v="$vein" -v a="$artery" 'BEGIN { exit !(v < 0.5 && a > 0.8) }'; then
+        echo "e2e: $f: want vein < 0.5 and artery > 0.8: $line" >&2; fail=1
+    fi
+    grep -q "running" <<< "$state" || { echo "e2e: $f: $state" >&2; fail=1; }
+done
+exit $fail
