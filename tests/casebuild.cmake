@@ -28,3 +28,9 @@ if(TARGET sc-hostsim)
   set_tests_properties(casebuild_e2e_import_press PROPERTIES LABELS "casebuild;integration"
                                                              TIMEOUT 300)
 endif()
+
+# The command line: strict numbers, named refusals, exit status 2.
+add_test(NAME casebuild_cli
+         COMMAND ${CMAKE_CURRENT_SOURCE_DIR}/casebuild/casebuild_cli.sh $<TARGET_FILE:sc-casebuild>
+                 ${CMAKE_BINARY_DIR}/cases/neck-ijv.scase ${CMAKE_CURRENT_BINARY_DIR}/casebuild_cli)
+set_tests_properties(casebuild_cli PROPERTIES LABELS casebuild TIMEOUT 300)

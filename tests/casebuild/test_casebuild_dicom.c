@@ -223,6 +223,26 @@ static void series_and_multiframe_by_pydicom_with_and_without_rescale_import_exa
     check_pydicom("usmf.dcm", 8, 0, 1.0, 0.0);
     /* present: applied */
     check_pydicom("series16r", 16, 1, 0.5, -20.0);
+    /* enhanced: shared Pixel Value Transformation, per-frame positions out of order */
+    check_pydicom("enh.dcm", 8, 0, 2.0, -5.0);
+    /* refused by name, never a crash: a frame count that would size gigabytes, a single 2D
+     * frame, a slice missing from a series, two series in a folder */
+    static const struct {
+        const char *name, *needle;
+        int rc;
+    } bad[] = {{"hostile/frames.dcm", "Number of Frames", SC_ERR_NO_SPACE},
+               {"hostile/single.dcm", "single 2D frame", SC_ERR_NOT_SUPPORTED},
+               {"hostile/gap", "spacing not uniform", SC_ERR_NOT_SUPPORTED},
+               {"hostile/mixed", "several series", SC_ERR_NOT_SUPPORTED}};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        char path[300], err[256] = "";
+        snprintf(path, sizeof path, "%s/pyd/%s", g_dir, bad[i].name);
+        sc_image img;
+        const int rc = sc_image_read(path, &img, err, sizeof err);
+        if (rc != bad[i].rc || strstr(err, bad[i].needle) == NULL) {
+            fail_msg("%s: %s (%d), want %s", bad[i].name, err, rc, bad[i].needle);
+        }
+    }
 }
 
 static void missing_or_empty_dicom_inputs_are_refused(void **state)

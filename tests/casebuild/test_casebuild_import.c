@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
 
@@ -489,6 +490,176 @@ static void bad_inputs_are_refused_with_named_errors(void **state)
     assert_int_equal(sc_import_case(&o, &r, err, sizeof err), SC_ERR_CASE_LABEL);
 }
 
+/* read hdr (+ data) as NAME with the given limits: the return code, the message in err */
+static int read_lim(const char *name, const char *hdr, const void *data, size_t dn,
+                    const sc_read_limits *lim, char *err, size_t errlen)
+{
+    write_bytes(name, hdr, strlen(hdr), data, dn);
+    char p[512];
+    path_of(p, sizeof p, name);
+    sc_image img;
+    err[0] = 0;
+    int rc = sc_image_read_ex(p, lim, &img, err, errlen);
+    if (rc == SC_OK) {
+        sc_image_free(&img);
+    }
+    return rc;
+}
+
+#define EXPECT_REFUSED(name, hdr, data, dn, lim, want_rc, needle)                                \
+    do {                                                                                       \
+        char e_[512];                                                                          \
+        int rc_ = read_lim(name, hdr, data, dn, lim, e_, sizeof e_);                           \
+        if (rc_ != (want_rc) || strstr(e_, needle) == NULL || strstr(e_, name) == NULL) {      \
+            fail_msg("%s: rc %d '%s', want %d and '%s'", name, rc_, e_, want_rc, needle);      \
+        }                                                                                      \
+    } while (0)
+
+/* Issue 14: every header number range-checked before use, data files only beside the
+ * header, a ceiling before any allocation or inflation, non-finite voxels refused; each
+ * refusal names the file and the field. */
+static void hostile_headers_are_refused_naming_the_field(void **state)
+{
+    (void)state;
+    static uint8_t data[N * 8u];
+    memset(data, 0, sizeof data);
+    const sc_read_limits def = sc_read_default_limits();
+    char hdr[1024];
+    /* sizes that would overflow an integer cast (undefined behaviour before) */
+    EXPECT_REFUSED("huge.mha",
+                   "NDims = 3\nDimSize = 1e300 2 2\nElementType = MET_UCHAR\n"
+                   "ElementDataFile = LOCAL\n",
+                   data, N, &def, SC_ERR_CASE_DIMS, "DimSize");
+    EXPECT_REFUSED("huge.nrrd",
+                   "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 1e300 2 2\nencoding: raw\n\n",
+                   data, N, &def, SC_ERR_CASE_DIMS, "sizes");
+    EXPECT_REFUSED("frac.nrrd",
+                   "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2.5 2 2\nencoding: raw\n\n", data,
+                   N, &def, SC_ERR_CASE_DIMS, "sizes");
+    EXPECT_REFUSED("ndims.mha",
+                   "NDims = three\nDimSize = 2 2 2\nElementType = MET_UCHAR\n"
+                   "ElementDataFile = LOCAL\n",
+                   data, N, &def, SC_ERR_PARSE, "NDims");
+    EXPECT_REFUSED("dim.nrrd",
+                   "NRRD0004\ntype: uchar\ndimension: 99999999999\nsizes: 2 2 2\n"
+                   "encoding: raw\n\n",
+                   data, N, &def, SC_ERR_PARSE, "dimension");
+    /* spacing and origin outside any physical range */
+    snprintf(hdr, sizeof hdr,
+             "NDims = 3\nDimSize = %u %u %u\nElementSpacing = 1e308 1 1\nElementType = MET_UCHAR\n"
+             "ElementDataFile = LOCAL\n",
+             DX, DY, DZ);
+    EXPECT_REFUSED("sp308.mha", hdr, data, N, &def, SC_ERR_CASE_SPACING, "spacing");
+    snprintf(hdr, sizeof hdr,
+             "NRRD0004\ntype: uchar\ndimension: 3\nsizes: %u %u %u\nspacings: 1e-30 1 1\n"
+             "encoding: raw\n\n",
+             DX, DY, DZ);
+    EXPECT_REFUSED("sp30.nrrd", hdr, data, N, &def, SC_ERR_CASE_SPACING, "spacing");
+    snprintf(hdr, sizeof hdr,
+             "NDims = 3\nDimSize = %u %u %u\nOffset = 0 1e300 0\nElementType = MET_UCHAR\n"
+             "ElementDataFile = LOCAL\n",
+             DX, DY, DZ);
+    EXPECT_REFUSED("org.mha", hdr, data, N, &def, SC_ERR_CASE_TRANSFORM, "origin");
+    snprintf(hdr, sizeof hdr,
+             "NDims = 3\nDimSize = %u %u %u\nTransformMatrix = 1 0 0 0 1\nElementType = "
+             "MET_UCHAR\nElementDataFile = LOCAL\n",
+             DX, DY, DZ);
+    EXPECT_REFUSED("tm5.mha", hdr, data, N, &def, SC_ERR_PARSE, "TransformMatrix");
+    snprintf(hdr, sizeof hdr,
+             "NRRD0004\ntype: uchar\ndimension: 3\nsizes: %u %u %u\nbyte skip: 1e20\n"
+             "encoding: raw\n\n",
+             DX, DY, DZ);
+    EXPECT_REFUSED("skip.nrrd", hdr, data, N, &def, SC_ERR_PARSE, "byte skip");
+    snprintf(hdr, sizeof hdr,
+             "NDims = 3\nDimSize = %u %u %u\nHeaderSize = -7\nElementType = MET_UCHAR\n"
+             "ElementDataFile = vol.raw\n",
+             DX, DY, DZ);
+    EXPECT_REFUSED("hs.mhd", hdr, data, N, &def, SC_ERR_PARSE, "HeaderSize");
+    /* data files only beside the header: not ../, not absolute, unless allowed */
+    snprintf(hdr, sizeof hdr,
+             "NDims = 3\nDimSize = %u %u %u\nElementType = MET_UCHAR\n"
+             "ElementDataFile = ../../../../etc/passwd\n",
+             DX, DY, DZ);
+    EXPECT_REFUSED("up.mhd", hdr, NULL, 0, &def, SC_ERR_INVALID_ARG, "ElementDataFile");
+    snprintf(hdr, sizeof hdr,
+             "NRRD0004\ntype: uchar\ndimension: 3\nsizes: %u %u %u\ndata file: /etc/passwd\n"
+             "encoding: raw\n\n",
+             DX, DY, DZ);
+    EXPECT_REFUSED("abs.nhdr", hdr, NULL, 0, &def, SC_ERR_INVALID_ARG, "data file");
+    snprintf(hdr, sizeof hdr,
+             "NRRD0004\ntype: uchar\ndimension: 3\nsizes: %u %u %u\ndata file: sub/../x.raw\n"
+             "encoding: raw\n\n",
+             DX, DY, DZ);
+    EXPECT_REFUSED("mid.nhdr", hdr, NULL, 0, &def, SC_ERR_INVALID_ARG, "data file");
+    {
+        /* allowed by option: a data file one folder up is read */
+        char sub[512], p[600], err[256];
+        path_of(sub, sizeof sub, "sub");
+        mkdir(sub, 0700);
+        write_bytes("up.raw", NULL, 0, data, N);
+        snprintf(hdr, sizeof hdr,
+                 "NRRD0004\ntype: uchar\ndimension: 3\nsizes: %u %u %u\ndata file: ../up.raw\n"
+                 "encoding: raw\n\n",
+                 DX, DY, DZ);
+        write_bytes("sub/up.nhdr", hdr, strlen(hdr), NULL, 0);
+        snprintf(p, sizeof p, "%s/up.nhdr", sub);
+        sc_image img;
+        assert_int_equal(sc_image_read(p, &img, err, sizeof err), SC_ERR_INVALID_ARG);
+        sc_read_limits allow = def;
+        allow.allow_data_path = 1;
+        assert_int_equal(sc_image_read_ex(p, &allow, &img, err, sizeof err), SC_OK);
+        sc_image_free(&img);
+    }
+    /* the ceiling, checked before allocating or inflating: a gzip header that claims
+     * 1024 x 1024 x 64 voxels (a 512 MiB double buffer) over 20 bytes of data */
+    EXPECT_REFUSED("bomb.nrrd",
+                   "NRRD0004\ntype: double\ndimension: 3\nsizes: 1024 1024 128\n"
+                   "encoding: gzip\n\n",
+                   data, 20, &def, SC_ERR_CASE_DIMS, "ceiling");
+    sc_read_limits small = def;
+    small.max_voxels = 50; /* below DX*DY*DZ = 140 */
+    snprintf(hdr, sizeof hdr,
+             "NRRD0004\ntype: uchar\ndimension: 3\nsizes: %u %u %u\nencoding: raw\n\n", DX, DY,
+             DZ);
+    EXPECT_REFUSED("cap.nrrd", hdr, data, N, &small, SC_ERR_CASE_DIMS, "ceiling");
+    /* non-finite voxels: refused, the first one named */
+    float fl[N];
+    for (size_t i = 0; i < N; i++) {
+        fl[i] = (float)i;
+    }
+    fl[DX + 2] = NAN; /* voxel (2, 1, 0) */
+    snprintf(hdr, sizeof hdr,
+             "NRRD0004\ntype: float\ndimension: 3\nsizes: %u %u %u\nencoding: raw\n"
+             "endian: little\n\n",
+             DX, DY, DZ);
+    EXPECT_REFUSED("nanvox.nrrd", hdr, fl, sizeof fl, &def, SC_ERR_NOT_FINITE, "(2, 1, 0)");
+    fl[DX + 2] = INFINITY;
+    EXPECT_REFUSED("infvox.nrrd", hdr, fl, sizeof fl, &def, SC_ERR_NOT_FINITE, "inf");
+    /* options of the import itself */
+    fl[DX + 2] = 1.0f;
+    write_bytes("fine.nrrd", hdr, strlen(hdr), fl, sizeof fl);
+    sc_import_opts o = sc_import_default_opts();
+    char pv[512], err[256];
+    path_of(pv, sizeof pv, "fine.nrrd");
+    o.volume_path = pv;
+    sc_import_result r;
+    o.spacing_mm = 1e-30f;
+    assert_int_equal(sc_import_case(&o, &r, err, sizeof err), SC_ERR_CASE_SPACING);
+    o.spacing_mm = -3.0f;
+    assert_int_equal(sc_import_case(&o, &r, err, sizeof err), SC_ERR_CASE_SPACING);
+    o.spacing_mm = 0.0f;
+    o.has_window = 1;
+    o.window_lo = NAN;
+    o.window_hi = INFINITY;
+    assert_int_equal(sc_import_case(&o, &r, err, sizeof err), SC_ERR_INVALID_ARG);
+    assert_non_null(strstr(err, "--window"));
+    o.has_window = 0;
+    o.spacing_mm = 0.05f; /* 121 x 81 x 61 = 598 k case voxels: above a ceiling of 100 k */
+    o.limits.max_voxels = 100000u;
+    assert_int_equal(sc_import_case(&o, &r, err, sizeof err), SC_ERR_CASE_DIMS);
+    assert_non_null(strstr(err, "case grid"));
+}
+
 static int setup(void **state)
 {
     (void)state;
@@ -513,6 +684,7 @@ int main(void)
         cmocka_unit_test(import_keeps_u8_voxels_and_labels_exactly_at_source_spacing),
         cmocka_unit_test(import_resamples_linearly_and_keeps_orientation),
         cmocka_unit_test(bad_inputs_are_refused_with_named_errors),
+        cmocka_unit_test(hostile_headers_are_refused_naming_the_field),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

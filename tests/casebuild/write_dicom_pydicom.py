@@ -11,6 +11,14 @@ with z the index along the slice normal. Written, as scanners and tools write th
   series16r/     16-bit signed slices, Rescale Slope 0.5, Intercept -20
   usmf.dcm       one US Multi-frame image: frames stacked along the normal by
                  SpacingBetweenSlices from one ImagePositionPatient, no rescale tags
+  enh.dcm        an Enhanced US Volume: shared functional groups (Pixel Measures, Plane
+                 Orientation rotated 90 degrees about z, Pixel Value Transformation with slope 2,
+                 intercept -5) and per-frame Plane Position, frames stored in shuffled order
+and inputs that must be refused by name (hostile/):
+  frames.dcm     NumberOfFrames 2147483647 over one frame of pixels (must not size anything)
+  single.dcm     one 2D frame (not a volume)
+  gap/           a series with one slice missing (inconsistent spacing)
+  mixed/         two series in one folder
 """
 import os
 import random
@@ -96,13 +104,79 @@ def us_multiframe(outdir):
     ds.save_as(os.path.join(outdir, "usmf.dcm"), write_like_original=False)
 
 
+def enhanced(outdir):
+    vol = values(8, False)
+    ds = base("1.2.840.10008.5.1.4.1.1.6.2", generate_uid())  # Enhanced US Volume
+    del ds.PixelSpacing
+    del ds.ImageOrientationPatient
+    pixel_format(ds, 8, False)
+    ds.NumberOfFrames = DZ
+    shared = Dataset()
+    pm = Dataset()
+    pm.PixelSpacing = [SPACING[1], SPACING[0]]
+    pm.SliceThickness = SLICE
+    po = Dataset()
+    po.ImageOrientationPatient = [0, 1, 0, -1, 0, 0]  # rows along +y, columns along -x
+    pvt = Dataset()
+    pvt.RescaleSlope = 2
+    pvt.RescaleIntercept = -5
+    pvt.RescaleType = "US"
+    shared.PixelMeasuresSequence = [pm]
+    shared.PlaneOrientationSequence = [po]
+    shared.PixelValueTransformationSequence = [pvt]
+    ds.SharedFunctionalGroupsSequence = [shared]
+    order = list(range(DZ))
+    random.Random(11).shuffle(order)
+    frames = []
+    for z in order:
+        pp = Dataset()
+        pp.ImagePositionPatient = [ORIGIN[0], ORIGIN[1], ORIGIN[2] + z * SLICE]
+        fg = Dataset()
+        fg.PlanePositionSequence = [pp]
+        frames.append(fg)
+    ds.PerFrameFunctionalGroupsSequence = frames
+    ds.PixelData = np.ascontiguousarray(vol[order]).tobytes()
+    ds.save_as(os.path.join(outdir, "enh.dcm"), write_like_original=False)
+
+
+def hostile(outdir):
+    d = os.path.join(outdir, "hostile")
+    os.makedirs(d)
+    vol = values(8, False)
+    ds = base("1.2.840.10008.5.1.4.1.1.3.1", generate_uid())
+    pixel_format(ds, 8, False)
+    ds.NumberOfFrames = 2147483647
+    ds.ImagePositionPatient = list(ORIGIN)
+    ds.SpacingBetweenSlices = SLICE
+    ds.PixelData = vol[0].tobytes()
+    ds.save_as(os.path.join(d, "frames.dcm"), write_like_original=False)
+    ds = base("1.2.840.10008.5.1.4.1.1.7", generate_uid())
+    pixel_format(ds, 8, False)
+    ds.ImagePositionPatient = list(ORIGIN)
+    ds.PixelData = vol[0].tobytes()
+    ds.save_as(os.path.join(d, "single.dcm"), write_like_original=False)
+    for name, zs, uids in (("gap", [0, 1, 2, 4, 5], None), ("mixed", [0, 1, 2, 3], 2)):
+        sd = os.path.join(d, name)
+        os.makedirs(sd)
+        series_uids = [generate_uid() for _ in range(uids or 1)]
+        for k, z in enumerate(zs):
+            ds = base("1.2.840.10008.5.1.4.1.1.7", series_uids[k % len(series_uids)])
+            pixel_format(ds, 8, False)
+            ds.ImagePositionPatient = [ORIGIN[0], ORIGIN[1], ORIGIN[2] + z * SLICE]
+            ds.PixelData = vol[z].tobytes()
+            ds.save_as(os.path.join(sd, "img%03d.dcm" % k), write_like_original=False)
+
+
 def main():
     out = sys.argv[1]
+    enhanced(out)
+    hostile(out)
     series(out, "series8", 8, False, None)
     series(out, "series16", 16, False, None)
     series(out, "series16r", 16, True, (0.5, -20))
     us_multiframe(out)
-    print("pydicom %s wrote 3 series and 1 multi-frame image in %s" % (pydicom.__version__, out))
+    print("pydicom %s wrote 3 series, 2 multi-frame images and 4 hostile inputs in %s"
+          % (pydicom.__version__, out))
 
 
 if __name__ == "__main__":

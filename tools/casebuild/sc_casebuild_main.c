@@ -6,6 +6,7 @@
  *                [--name NAME] [--description TEXT] [--spacing MM] [--window LO:HI]
  *                [--mesh-nodes NX,NY,NZ] [--mesh-box X0,Y0,Z0,SX,SY,SZ]
  *                [--depth-axis AX] [--lateral-axis AX] [--label-map V=NAME,...]
+ *                [--max-voxels N] [--allow-data-path yes]
  *                [--calibration 12 numbers] [--registration 12 numbers] (row-major R, then t)
  *   sc-casebuild info CASE.scase
  *   sc-casebuild verify CASE.scase...
@@ -49,6 +50,8 @@ static int usage(void)
             "               [--depth-axis AX] [--lateral-axis AX]  (AX: +i -i +j -j +k -k of the\n"
             "                source grid, or L R A P S I when the file states a patient frame)\n"
             "               [--label-map V=NAME,...[,*=NAME]]  (source label -> vein, artery, ...)\n"
+            "               [--max-voxels N] (ceiling per image and case, default 67108864)\n"
+            "               [--allow-data-path yes] (data files outside the header's folder)\n"
             "               [--calibration R00,..,R22,TX,TY,TZ]  (image -> probe, mm)\n"
             "               [--registration R00,..,R22,TX,TY,TZ] (tracker -> patient, mm)\n"
             "               (FILE: .mha, .mhd, .nrrd, .nhdr, raw or compressed; .dcm or a DICOM\n"
@@ -419,6 +422,16 @@ static int cmd_import(int argc, char **argv)
                 fprintf(stderr, "sc-casebuild: --mesh-nodes '%s': three counts\n", val);
                 return 2;
             }
+        } else if (strcmp(a, "--max-voxels") == 0) {
+            if (num_u64("--max-voxels", val, 1u, SC_MAX_VOLUME_VOXELS, &o.limits.max_voxels)) {
+                return 2;
+            }
+        } else if (strcmp(a, "--allow-data-path") == 0) {
+            if (strcmp(val, "yes") != 0 && strcmp(val, "no") != 0) {
+                fprintf(stderr, "sc-casebuild: --allow-data-path '%s': yes or no\n", val);
+                return 2;
+            }
+            o.limits.allow_data_path = strcmp(val, "yes") == 0;
         } else if (strcmp(a, "--depth-axis") == 0) {
             o.depth_axis = val;
         } else if (strcmp(a, "--lateral-axis") == 0) {

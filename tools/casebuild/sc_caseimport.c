@@ -31,7 +31,8 @@ static int fail(char *err, size_t errlen, int rc, const char *fmt, ...)
 }
 
 /* ---- file helpers ----------------------------------------------------------------------- */
-static int read_file(const char *path, uint8_t **data, size_t *size, char *err, size_t errlen)
+static int read_file(const char *path, uint64_t max_bytes, uint8_t **data, size_t *size, char *err,
+                     size_t errlen)
 {
     FILE *f = fopen(path, "rb");
     if (f == NULL) {
@@ -45,7 +46,14 @@ static int read_file(const char *path, uint8_t **data, size_t *size, char *err, 
     long len = ftell(f);
     if (len < 0 || fseek(f, 0, SEEK_SET) != 0) {
         fclose(f);
-        return fail(err, errlen, SC_ERR_IO, "%s: cannot size", path);
+        return fail(err, errlen, SC_ERR_IO, "%s: cannot size (not a regular file?)", path);
+    }
+    if ((uint64_t)len > max_bytes) {
+        fclose(f);
+        return fail(err, errlen, SC_ERR_NO_SPACE,
+                    "%s: %ld bytes, above the ceiling of %llu bytes for the voxel limit "
+                    "(--max-voxels)",
+                    path, len, (unsigned long long)max_bytes);
     }
     uint8_t *buf = malloc((size_t)len + 1u);
     if (buf == NULL) {
@@ -64,15 +72,38 @@ static int read_file(const char *path, uint8_t **data, size_t *size, char *err, 
     return SC_OK;
 }
 
-/* path of a data file named in a header: relative to the header's directory */
-static void sibling_path(char *out, size_t n, const char *header_path, const char *name)
+/* Path of a data file named in a header: relative to the header's directory. Unless allowed,
+ * only beside the header (or below it): no absolute path, no ".." component, so a header
+ * cannot make the importer read an unrelated file as voxels. */
+static int sibling_path(char *out, size_t n, const char *header_path, const char *field,
+                        const char *name, int allow_any, char *err, size_t errlen)
 {
-    const char *slash = strrchr(header_path, '/');
-    if (name[0] == '/' || slash == NULL) {
-        snprintf(out, n, "%s", name);
-    } else {
-        snprintf(out, n, "%.*s/%s", (int)(slash - header_path), header_path, name);
+    if (!allow_any) {
+        int dotdot = 0;
+        for (const char *p = name; *p;) {
+            const char *e = strchr(p, '/');
+            size_t len = e ? (size_t)(e - p) : strlen(p);
+            dotdot |= len == 2u && p[0] == '.' && p[1] == '.';
+            p += len + (e ? 1u : 0u);
+        }
+        if (name[0] == '/' || dotdot || name[0] == 0) {
+            return fail(err, errlen, SC_ERR_INVALID_ARG,
+                        "%s: %s '%s': data files must lie beside the header (no absolute path, no "
+                        "'..'; --allow-data-path permits it)",
+                        header_path, field, name);
+        }
     }
+    const char *slash = strrchr(header_path, '/');
+    int w;
+    if (name[0] == '/' || slash == NULL) {
+        w = snprintf(out, n, "%s", name);
+    } else {
+        w = snprintf(out, n, "%.*s/%s", (int)(slash - header_path), header_path, name);
+    }
+    if (w < 0 || (size_t)w >= n) {
+        return fail(err, errlen, SC_ERR_INVALID_ARG, "%s: %s: path too long", header_path, field);
+    }
+    return SC_OK;
 }
 
 static size_t elem_size(sc_elem_type t)
@@ -190,21 +221,61 @@ static int inflate_exact(const uint8_t *src, size_t srclen, uint8_t *dst, size_t
     return SC_OK;
 }
 
-static int set_dims(sc_image *img, const long long d[3], int nd, char *err, size_t errlen)
+static int parse_numbers(const char *s, double *v, int max);
+
+static int set_dims(sc_image *img, const long long d[3], int nd, uint64_t max_voxels,
+                    const char *what, char *err, size_t errlen)
 {
     for (int a = 0; a < 3; a++) {
         long long v = a < nd ? d[a] : 1;
         if (v < 1 || v > (long long)SC_MAX_VOLUME_DIM) {
-            return fail(err, errlen, SC_ERR_CASE_DIMS, "dimension %d = %lld outside 1..%u", a, v,
-                        SC_MAX_VOLUME_DIM);
+            return fail(err, errlen, SC_ERR_CASE_DIMS, "%s: axis %d = %lld outside 1..%u", what, a,
+                        v, SC_MAX_VOLUME_DIM);
         }
         img->dim[a] = (uint32_t)v;
     }
-    uint64_t n = (uint64_t)img->dim[0] * img->dim[1] * img->dim[2];
-    if (n > SC_MAX_VOLUME_VOXELS) {
-        return fail(err, errlen, SC_ERR_CASE_DIMS, "%llu voxels above the limit %u",
-                    (unsigned long long)n, SC_MAX_VOLUME_VOXELS);
+    const uint64_t n = (uint64_t)img->dim[0] * img->dim[1] * img->dim[2]; /* < 2^30 */
+    const uint64_t cap = max_voxels < SC_MAX_VOLUME_VOXELS ? max_voxels : SC_MAX_VOLUME_VOXELS;
+    if (n > cap) {
+        return fail(err, errlen, SC_ERR_CASE_DIMS,
+                    "%s: %llu voxels, above the ceiling of %llu (--max-voxels, at most %u)", what,
+                    (unsigned long long)n, (unsigned long long)cap, SC_MAX_VOLUME_VOXELS);
     }
+    return SC_OK;
+}
+
+/* Dimensions from a header field: each a whole number 1..SC_MAX_VOLUME_DIM, checked as a
+ * double before any conversion (DimSize = 1e300 must not reach an integer cast). */
+static int parse_dims(const char *path, const char *field, const char *val, long long d[3],
+                      char *err, size_t errlen)
+{
+    double v[4];
+    const int n = parse_numbers(val, v, 4);
+    if (n < 1 || n > 3) {
+        return fail(err, errlen, SC_ERR_PARSE, "%s: %s '%s': 1 to 3 sizes", path, field, val);
+    }
+    for (int a = 0; a < n; a++) {
+        if (!(v[a] >= 1.0 && v[a] <= (double)SC_MAX_VOLUME_DIM) || v[a] > floor(v[a])) {
+            return fail(err, errlen, SC_ERR_CASE_DIMS, "%s: %s: size %.6g is not a whole number "
+                        "in 1..%u", path, field, v[a], SC_MAX_VOLUME_DIM);
+        }
+        d[a] = (long long)v[a];
+    }
+    return SC_OK;
+}
+
+/* A whole header number in [lo, hi]. */
+static int parse_int_field(const char *path, const char *field, const char *val, long long lo,
+                           long long hi, long long *out, char *err, size_t errlen)
+{
+    char *end;
+    errno = 0;
+    const long long v = strtoll(val, &end, 10);
+    if (errno || end == val || *end || v < lo || v > hi) {
+        return fail(err, errlen, SC_ERR_PARSE, "%s: %s '%s': a whole number in %lld..%lld", path,
+                    field, val, lo, hi);
+    }
+    *out = v;
     return SC_OK;
 }
 
@@ -337,11 +408,13 @@ static int is_true(const char *s)
     return strcasecmp(s, "true") == 0 || strcmp(s, "1") == 0;
 }
 
-static int read_metaimage(const char *path, sc_image *img, char *err, size_t errlen)
+static int read_metaimage(const char *path, const sc_read_limits *lim, sc_image *img, char *err,
+                          size_t errlen)
 {
     uint8_t *file;
     size_t fsize;
-    int rc = read_file(path, &file, &fsize, err, errlen);
+    const uint64_t max_bytes = lim->max_voxels * 8u + (1u << 20);
+    int rc = read_file(path, max_bytes, &file, &fsize, err, errlen);
     if (rc != SC_OK) {
         return rc;
     }
@@ -379,28 +452,29 @@ static int read_metaimage(const char *path, sc_image *img, char *err, size_t err
         *eq = 0;
         char *key = trim(line), *val = trim(eq + 1);
         double v[9];
+        long long iv = 0;
         if (strcasecmp(key, "NDims") == 0) {
-            ndims = atoi(val);
+            rc = parse_int_field(path, "NDims", val, 2, 3, &iv, err, errlen);
+            ndims = (int)iv;
         } else if (strcasecmp(key, "DimSize") == 0) {
-            int n = parse_numbers(val, v, 3);
-            if (n < 1) {
-                free(file);
-                return fail(err, errlen, SC_ERR_PARSE, "%s: bad DimSize", path);
-            }
-            for (int a = 0; a < n; a++) {
-                dsz[a] = (long long)v[a];
-            }
+            rc = parse_dims(path, "DimSize", val, dsz, err, errlen);
         } else if (strcasecmp(key, "ElementSpacing") == 0 ||
                    (strcasecmp(key, "ElementSize") == 0 && !have_spacing)) {
             /* ElementSpacing wins over ElementSize (voxel extent) when both are given */
             have_spacing = strcasecmp(key, "ElementSpacing") == 0;
             int n = parse_numbers(val, v, 3);
+            if (n < 1) {
+                rc = fail(err, errlen, SC_ERR_PARSE, "%s: %s '%s': 1 to 3 numbers", path, key, val);
+            }
             for (int a = 0; a < n; a++) {
                 img->spacing[a] = v[a];
             }
         } else if (strcasecmp(key, "Offset") == 0 || strcasecmp(key, "Origin") == 0 ||
                    strcasecmp(key, "Position") == 0) {
             int n = parse_numbers(val, v, 3);
+            if (n < 1) {
+                rc = fail(err, errlen, SC_ERR_PARSE, "%s: %s '%s': 1 to 3 numbers", path, key, val);
+            }
             for (int a = 0; a < n; a++) {
                 img->origin[a] = v[a];
             }
@@ -421,6 +495,9 @@ static int read_metaimage(const char *path, sc_image *img, char *err, size_t err
                 img->dir[3] = v[1];
                 img->dir[1] = v[2];
                 img->dir[4] = v[3];
+            } else {
+                rc = fail(err, errlen, SC_ERR_PARSE, "%s: %s: 9 numbers (4 for NDims = 2)", path,
+                          key);
             }
         } else if (strcasecmp(key, "ElementType") == 0) {
             if (met_type(val, &img->type) != 0) {
@@ -429,16 +506,18 @@ static int read_metaimage(const char *path, sc_image *img, char *err, size_t err
             }
             have_type = 1;
         } else if (strcasecmp(key, "ElementNumberOfChannels") == 0) {
-            channels = atoi(val);
+            rc = parse_int_field(path, "ElementNumberOfChannels", val, 1, 1, &iv, err, errlen);
+            channels = (int)iv;
         } else if (strcasecmp(key, "BinaryDataByteOrderMSB") == 0 ||
                    strcasecmp(key, "ElementByteOrderMSB") == 0) {
             big = is_true(val);
         } else if (strcasecmp(key, "CompressedData") == 0) {
             compressed = is_true(val);
         } else if (strcasecmp(key, "CompressedDataSize") == 0) {
-            comp_size = atoll(val);
+            rc = parse_int_field(path, "CompressedDataSize", val, 0, 1LL << 40, &comp_size, err,
+                                 errlen);
         } else if (strcasecmp(key, "HeaderSize") == 0) {
-            header_size = atoll(val);
+            rc = parse_int_field(path, "HeaderSize", val, -1, 1LL << 40, &header_size, err, errlen);
         } else if (strcasecmp(key, "BinaryData") == 0) {
             if (!is_true(val)) {
                 free(file);
@@ -460,6 +539,10 @@ static int read_metaimage(const char *path, sc_image *img, char *err, size_t err
                 have_anat = 1;
             }
         } /* other keys (ObjectType, patient fields...): ignored */
+        if (rc != SC_OK) {
+            free(file);
+            return rc;
+        }
     }
     if (!found_data || !have_type || (ndims != 2 && ndims != 3)) {
         free(file);
@@ -478,7 +561,9 @@ static int read_metaimage(const char *path, sc_image *img, char *err, size_t err
         return fail(err, errlen, SC_ERR_NOT_SUPPORTED, "%s: %d channels (1 supported)", path,
                     channels);
     }
-    rc = set_dims(img, dsz, ndims, err, errlen);
+    char what[1100];
+    snprintf(what, sizeof what, "%s: DimSize", path);
+    rc = set_dims(img, dsz, ndims, lim->max_voxels, what, err, errlen);
     if (rc != SC_OK) {
         free(file);
         return rc;
@@ -495,9 +580,12 @@ static int read_metaimage(const char *path, sc_image *img, char *err, size_t err
         return fail(err, errlen, SC_ERR_NOT_SUPPORTED, "%s: slice-list data files", path);
     } else {
         char dp[2048];
-        sibling_path(dp, sizeof dp, path, datafile);
         size_t olen;
-        rc = read_file(dp, &other, &olen, err, errlen);
+        rc = sibling_path(dp, sizeof dp, path, "ElementDataFile", datafile, lim->allow_data_path,
+                          err, errlen);
+        if (rc == SC_OK) {
+            rc = read_file(dp, max_bytes, &other, &olen, err, errlen);
+        }
         if (rc != SC_OK) {
             free(file);
             return rc;
@@ -593,11 +681,13 @@ static int nrrd_type(const char *s, sc_elem_type *t)
 
 enum { ENC_RAW, ENC_GZIP, ENC_ASCII };
 
-static int read_nrrd(const char *path, sc_image *img, char *err, size_t errlen)
+static int read_nrrd(const char *path, const sc_read_limits *lim, sc_image *img, char *err,
+                     size_t errlen)
 {
     uint8_t *file;
     size_t fsize;
-    int rc = read_file(path, &file, &fsize, err, errlen);
+    const uint64_t max_bytes = lim->max_voxels * 8u + (1u << 20);
+    int rc = read_file(path, max_bytes, &file, &fsize, err, errlen);
     if (rc != SC_OK) {
         return rc;
     }
@@ -648,6 +738,7 @@ static int read_nrrd(const char *path, sc_image *img, char *err, size_t errlen)
         *colon = 0;
         char *key = trim(line), *val = trim(colon + 2);
         double v[9];
+        long long iv = 0;
         if (strcasecmp(key, "type") == 0) {
             if (nrrd_type(val, &img->type) != 0) {
                 free(file);
@@ -655,18 +746,16 @@ static int read_nrrd(const char *path, sc_image *img, char *err, size_t errlen)
             }
             have_type = 1;
         } else if (strcasecmp(key, "dimension") == 0) {
-            ndims = atoi(val);
+            rc = parse_int_field(path, "dimension", val, 2, 3, &iv, err, errlen);
+            ndims = (int)iv;
         } else if (strcasecmp(key, "sizes") == 0) {
-            int n = parse_numbers(val, v, 3);
-            if (n < 1) {
-                free(file);
-                return fail(err, errlen, SC_ERR_PARSE, "%s: bad sizes", path);
-            }
-            for (int a = 0; a < n; a++) {
-                dsz[a] = (long long)v[a];
-            }
+            rc = parse_dims(path, "sizes", val, dsz, err, errlen);
         } else if (strcasecmp(key, "spacings") == 0 && !have_dirs) {
             int n = parse_numbers(val, v, 3);
+            if (n < 1) {
+                rc = fail(err, errlen, SC_ERR_PARSE, "%s: spacings '%s': 1 to 3 numbers", path,
+                          val);
+            }
             for (int a = 0; a < n; a++) {
                 img->spacing[a] = v[a];
             }
@@ -700,6 +789,10 @@ static int read_nrrd(const char *path, sc_image *img, char *err, size_t errlen)
             }
         } else if (strcasecmp(key, "space origin") == 0) {
             int n = parse_numbers(val, v, 3);
+            if (n != 3) {
+                rc = fail(err, errlen, SC_ERR_PARSE, "%s: space origin '%s': a 3-vector", path,
+                          val);
+            }
             for (int a = 0; a < n; a++) {
                 img->origin[a] = v[a];
             }
@@ -718,9 +811,9 @@ static int read_nrrd(const char *path, sc_image *img, char *err, size_t errlen)
         } else if (strcasecmp(key, "endian") == 0) {
             big = strcasecmp(val, "big") == 0;
         } else if (strcasecmp(key, "byte skip") == 0 || strcasecmp(key, "byteskip") == 0) {
-            byte_skip = atoll(val);
+            rc = parse_int_field(path, "byte skip", val, -1, 1LL << 40, &byte_skip, err, errlen);
         } else if (strcasecmp(key, "line skip") == 0 || strcasecmp(key, "lineskip") == 0) {
-            line_skip = atoll(val);
+            rc = parse_int_field(path, "line skip", val, 0, 1LL << 31, &line_skip, err, errlen);
         } else if (strcasecmp(key, "data file") == 0 || strcasecmp(key, "datafile") == 0) {
             if (strncasecmp(val, "LIST", 4) == 0 || strchr(val, ' ') != NULL) {
                 free(file);
@@ -728,6 +821,10 @@ static int read_nrrd(const char *path, sc_image *img, char *err, size_t errlen)
             }
             snprintf(datafile, sizeof datafile, "%s", val);
         } /* space, kinds, centerings, units, content...: geometry already covered */
+        if (rc != SC_OK) {
+            free(file);
+            return rc;
+        }
     }
     if (!have_type || (ndims != 2 && ndims != 3)) {
         free(file);
@@ -739,7 +836,9 @@ static int read_nrrd(const char *path, sc_image *img, char *err, size_t errlen)
             img->dir[r * 3 + a] *= to_lps[r];
         }
     }
-    rc = set_dims(img, dsz, ndims, err, errlen);
+    char what[1100];
+    snprintf(what, sizeof what, "%s: sizes", path);
+    rc = set_dims(img, dsz, ndims, lim->max_voxels, what, err, errlen);
     if (rc != SC_OK) {
         free(file);
         return rc;
@@ -749,8 +848,11 @@ static int read_nrrd(const char *path, sc_image *img, char *err, size_t errlen)
     uint8_t *other = NULL;
     if (datafile[0] != 0) {
         char dp[2048];
-        sibling_path(dp, sizeof dp, path, datafile);
-        rc = read_file(dp, &other, &srclen, err, errlen);
+        rc = sibling_path(dp, sizeof dp, path, "data file", datafile, lim->allow_data_path, err,
+                          errlen);
+        if (rc == SC_OK) {
+            rc = read_file(dp, max_bytes, &other, &srclen, err, errlen);
+        }
         if (rc != SC_OK) {
             free(file);
             return rc;
@@ -797,6 +899,12 @@ static int read_nrrd(const char *path, sc_image *img, char *err, size_t errlen)
         free(img->data);
         img->data = NULL;
         return fail(err, errlen, SC_ERR_NO_SPACE, "out of memory");
+    }
+    if (enc == ENC_GZIP && (uint64_t)byte_skip > max_bytes) {
+        free(file);
+        free(other);
+        return fail(err, errlen, SC_ERR_NO_SPACE, "%s: byte skip %lld above the ceiling", path,
+                    byte_skip);
     }
     if (enc == ENC_GZIP) {
         /* byte skip applies to the decompressed data (NRRD spec) */
@@ -856,25 +964,47 @@ static int ends_with(const char *s, const char *suffix)
     return a >= b && strcasecmp(s + a - b, suffix) == 0;
 }
 
+sc_read_limits sc_read_default_limits(void)
+{
+    sc_read_limits l;
+    l.max_voxels = SC_IMPORT_DEFAULT_MAX_VOXELS;
+    l.allow_data_path = 0;
+    return l;
+}
+
 int sc_image_read(const char *path, sc_image *img, char *err, size_t errlen)
+{
+    const sc_read_limits lim = sc_read_default_limits();
+    return sc_image_read_ex(path, &lim, img, err, errlen);
+}
+
+int sc_image_read_ex(const char *path, const sc_read_limits *lim_in, sc_image *img, char *err,
+                     size_t errlen)
 {
     if (path == NULL || img == NULL) {
         return fail(err, errlen, SC_ERR_INVALID_ARG, "no path");
     }
     image_init(img);
+    sc_read_limits lim = lim_in != NULL ? *lim_in : sc_read_default_limits();
+    if (lim.max_voxels < 1u || lim.max_voxels > SC_MAX_VOLUME_VOXELS) {
+        lim.max_voxels = SC_MAX_VOLUME_VOXELS;
+    }
     int rc;
     struct stat st;
     const int is_dir = stat(path, &st) == 0 && S_ISDIR(st.st_mode);
+    if (!is_dir && stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
+        return fail(err, errlen, SC_ERR_IO, "%s: not a regular file", path);
+    }
     if (ends_with(path, ".mha") || ends_with(path, ".mhd")) {
-        rc = read_metaimage(path, img, err, errlen);
+        rc = read_metaimage(path, &lim, img, err, errlen);
     } else if (ends_with(path, ".nrrd") || ends_with(path, ".nhdr")) {
-        rc = read_nrrd(path, img, err, errlen);
+        rc = read_nrrd(path, &lim, img, err, errlen);
     } else if (is_dir || ends_with(path, ".dcm") || ends_with(path, ".dicom")) {
 #ifdef SC_HAVE_DCMTK
-        rc = sc_dicom_read(path, img, err, errlen);
+        rc = sc_dicom_read(path, lim.max_voxels, img, err, errlen);
         if (rc == SC_OK) {
             long long d[3] = {img->dim[0], img->dim[1], img->dim[2]};
-            rc = set_dims(img, d, 3, err, errlen);
+            rc = set_dims(img, d, 3, lim.max_voxels, path, err, errlen);
             if (rc != SC_OK) {
                 sc_image_free(img);
                 return rc;
@@ -893,25 +1023,53 @@ int sc_image_read(const char *path, sc_image *img, char *err, size_t errlen)
         return rc;
     }
     for (int a = 0; a < 3; a++) {
-        if (!isfinite(img->spacing[a]) || !(img->spacing[a] > 0.0) || !isfinite(img->origin[a])) {
+        if (!isfinite(img->spacing[a]) || !(img->spacing[a] >= SC_IMPORT_MIN_SPACING_MM) ||
+            !(img->spacing[a] <= SC_IMPORT_MAX_SPACING_MM)) {
+            const double sp = img->spacing[a];
             sc_image_free(img);
-            return fail(err, errlen, SC_ERR_CASE_SPACING, "%s: spacing/origin not finite > 0",
-                        path);
+            return fail(err, errlen, SC_ERR_CASE_SPACING,
+                        "%s: spacing of axis %d is %g mm, not in %g..%g mm (ElementSpacing, "
+                        "NRRD spacings / space directions, DICOM Pixel Spacing / slice positions)",
+                        path, a, sp, SC_IMPORT_MIN_SPACING_MM, SC_IMPORT_MAX_SPACING_MM);
+        }
+        if (!isfinite(img->origin[a]) || fabs(img->origin[a]) > SC_IMPORT_MAX_ORIGIN_MM) {
+            const double o = img->origin[a];
+            sc_image_free(img);
+            return fail(err, errlen, SC_ERR_CASE_TRANSFORM,
+                        "%s: origin coordinate %d is %g mm, not within +-%g mm (Offset, NRRD space "
+                        "origin, DICOM Image Position)",
+                        path, a, o, SC_IMPORT_MAX_ORIGIN_MM);
         }
     }
-    /* direction cosines must be a rotation (orthonormal, det +1) */
+    /* direction cosines must be orthonormal (either handedness) */
     const double *d = img->dir;
     for (int a = 0; a < 3; a++) {
         for (int b = 0; b < 3; b++) {
             double dot = d[a] * d[b] + d[3 + a] * d[3 + b] + d[6 + a] * d[6 + b];
-            if (fabs(dot - (a == b ? 1.0 : 0.0)) > 1e-4) {
+            if (!(fabs(dot - (a == b ? 1.0 : 0.0)) <= 1e-4)) {
                 sc_image_free(img);
                 return fail(err, errlen, SC_ERR_CASE_TRANSFORM,
-                            "%s: direction cosines not orthonormal", path);
+                            "%s: direction cosines not orthonormal (TransformMatrix, NRRD space "
+                            "directions, DICOM Image Orientation)",
+                            path);
             }
         }
     }
-    /* a left-handed grid is fine: the case frame is chosen right-handed (sc_import_case) */
+    /* non-finite voxels (NaN, +-inf in float data) are refused: no rule could say what tissue
+     * they are; the first one is named */
+    const size_t n = image_count(img);
+    for (size_t i = 0; i < n; i++) {
+        if (!isfinite(img->data[i])) {
+            const uint32_t x = (uint32_t)(i % img->dim[0]);
+            const uint32_t y = (uint32_t)(i / img->dim[0] % img->dim[1]);
+            const uint32_t z = (uint32_t)(i / img->dim[0] / img->dim[1]);
+            const double v = img->data[i];
+            sc_image_free(img);
+            return fail(err, errlen, SC_ERR_NOT_FINITE,
+                        "%s: voxel (%u, %u, %u) is %g: non-finite values are refused", path, x, y,
+                        z, v);
+        }
+    }
     return SC_OK;
 }
 
@@ -931,6 +1089,7 @@ sc_import_opts sc_import_default_opts(void)
     o.mesh_nodes[0] = 24u;
     o.mesh_nodes[1] = 12u;
     o.mesh_nodes[2] = 12u;
+    o.limits = sc_read_default_limits();
     o.image_to_probe = sc_xform_identity();
     o.tracker_to_patient = sc_xform_identity();
     return o;
@@ -1264,14 +1423,24 @@ int sc_import_case(const sc_import_opts *o, sc_import_result *r, char *err, size
             return fail(err, errlen, SC_ERR_INVALID_ARG, "--label-map without --labels");
         }
     }
+    const float rs = o->spacing_mm;
+    if (!isfinite(rs) || rs < 0.0f || (rs > 0.0f && (rs < 0.01f || rs > 50.0f))) {
+        return fail(err, errlen, SC_ERR_CASE_SPACING, "--spacing %g: 0.01 .. 50 mm",
+                    (double)o->spacing_mm);
+    }
+    if (o->has_window &&
+        (!isfinite(o->window_lo) || !isfinite(o->window_hi) || !(o->window_hi > o->window_lo))) {
+        return fail(err, errlen, SC_ERR_INVALID_ARG, "--window %g:%g: finite, LO below HI",
+                    (double)o->window_lo, (double)o->window_hi);
+    }
     sc_image vol, lab;
-    int rc = sc_image_read(o->volume_path, &vol, err, errlen);
+    int rc = sc_image_read_ex(o->volume_path, &o->limits, &vol, err, errlen);
     if (rc != SC_OK) {
         return rc;
     }
     int have_lab = 0;
     if (o->labels_path != NULL) {
-        rc = sc_image_read(o->labels_path, &lab, err, errlen);
+        rc = sc_image_read_ex(o->labels_path, &o->limits, &lab, err, errlen);
         if (rc != SC_OK) {
             sc_image_free(&vol);
             return rc;
@@ -1309,7 +1478,7 @@ int sc_import_case(const sc_import_opts *o, sc_import_result *r, char *err, size
     }
     long long dl[3] = {dim[0], dim[1], dim[2]};
     sc_image tmp;
-    rc = set_dims(&tmp, dl, 3, err, errlen);
+    rc = set_dims(&tmp, dl, 3, o->limits.max_voxels, "case grid", err, errlen);
     if (rc != SC_OK) {
         goto out;
     }

@@ -21,10 +21,35 @@
 #include "sc_case.h"
 #include "sc_image.h"
 
-/* Read a MetaImage or NRRD file (by extension; .mha .mhd .nrrd .nhdr). On error returns a
- * negative sc_err (SC_ERR_NOT_FOUND, SC_ERR_IO, SC_ERR_PARSE, SC_ERR_NOT_SUPPORTED,
- * SC_ERR_NO_SPACE, SC_ERR_CASE_DIMS) and a message in err. */
+/* Ceilings of the readers, checked before anything is allocated or inflated: a header that
+ * declares more voxels than max_voxels is refused (the reader holds 8 bytes per voxel, plus
+ * the raw or compressed bytes), so a small compressed file cannot claim gigabytes. */
+#ifndef SC_IMPORT_DEFAULT_MAX_VOXELS
+#define SC_IMPORT_DEFAULT_MAX_VOXELS (64u * 1024u * 1024u) /* 512 MiB of doubles */
+#endif
+#define SC_IMPORT_MIN_SPACING_MM 1e-3 /* 1 um */
+#define SC_IMPORT_MAX_SPACING_MM 100.0
+#define SC_IMPORT_MAX_ORIGIN_MM  1e5 /* 100 m: anything beyond is a broken header */
+
+typedef struct sc_read_limits {
+    uint64_t max_voxels; /* per image, 1..SC_MAX_VOLUME_VOXELS; also bounds the case grid */
+    int allow_data_path; /* 1: a header may name its data file by an absolute path or through
+                          * '..'; 0 (default): only beside the header (or below it) */
+} sc_read_limits;
+
+sc_read_limits sc_read_default_limits(void);
+
+/* Read a MetaImage or NRRD file (by extension; .mha .mhd .nrrd .nhdr), or DICOM (.dcm or a
+ * folder) when built with DCMTK. Every header number is range-checked before use (whole
+ * numbers for sizes and skips; spacing SC_IMPORT_MIN..MAX_SPACING_MM, origin within
+ * SC_IMPORT_MAX_ORIGIN_MM, orthonormal directions); non-finite voxels are refused (the first
+ * one named). On error returns a negative sc_err (SC_ERR_NOT_FOUND, SC_ERR_IO, SC_ERR_PARSE,
+ * SC_ERR_NOT_SUPPORTED, SC_ERR_NO_SPACE, SC_ERR_CASE_DIMS, SC_ERR_CASE_SPACING,
+ * SC_ERR_CASE_TRANSFORM, SC_ERR_NOT_FINITE, SC_ERR_INVALID_ARG for a data file path) and a
+ * message naming the file and the field in err. sc_image_read uses the default limits. */
 int sc_image_read(const char *path, sc_image *img, char *err, size_t errlen);
+int sc_image_read_ex(const char *path, const sc_read_limits *lim, sc_image *img, char *err,
+                     size_t errlen);
 void sc_image_free(sc_image *img);
 
 typedef struct sc_import_opts {
@@ -53,6 +78,7 @@ typedef struct sc_import_opts {
      * (names of config/sc_labels.h); "*" covers values not listed. NULL: the values are the
      * project's own (0..SC_LABEL_COUNT-1). */
     const char *label_map;
+    sc_read_limits limits;       /* default sc_read_default_limits() */
     sc_xform image_to_probe;     /* probe calibration; default identity */
     int has_registration;        /* 0: the default registration below */
     sc_xform tracker_to_patient; /* mannequin registration (tracker -> the file's world frame);

@@ -10,6 +10,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
+#include <memory>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -21,6 +24,9 @@
 #include "dcmtk/dcmjpls/djdecode.h"
 
 extern "C" {
+#define _Static_assert static_assert // sc_config.h is C11
+#include "sc_config.h"
+#undef _Static_assert
 #include "sc_err.h"
 }
 
@@ -119,7 +125,8 @@ void read_plane(DcmItem *it, dicom_file &f, frame_geom *g)
     }
 }
 
-int load_one(const std::string &path, dicom_file &f, char *err, size_t errlen)
+int load_one(const std::string &path, dicom_file &f, uint64_t max_voxels, char *err,
+             size_t errlen)
 {
     OFCondition c = f.ff.loadFile(path.c_str());
     if (c.bad()) {
@@ -181,6 +188,21 @@ int load_one(const std::string &path, dicom_file &f, char *err, size_t errlen)
             f.intercept = v;
         }
     }
+    // sizes from the file are checked before anything is sized by them (NumberOfFrames
+    // 2147483647 must not size a vector)
+    if (f.rows == 0 || f.cols == 0 || (f.bits != 8 && f.bits != 16)) {
+        return fail(err, errlen, SC_ERR_NOT_SUPPORTED,
+                    "%s: Rows %u, Columns %u, Bits Allocated %u (8 or 16 supported)", path.c_str(),
+                    f.rows, f.cols, f.bits);
+    }
+    if ((uint64_t)f.frames > SC_MAX_VOLUME_DIM ||
+        (uint64_t)f.rows * f.cols * (uint64_t)f.frames > max_voxels) {
+        return fail(err, errlen, SC_ERR_NO_SPACE,
+                    "%s: Number of Frames %ld x Rows %u x Columns %u is above the ceiling (%u "
+                    "frames, %llu voxels; --max-voxels)",
+                    path.c_str(), (long)f.frames, f.rows, f.cols, SC_MAX_VOLUME_DIM,
+                    (unsigned long long)max_voxels);
+    }
     f.fg.assign((size_t)f.frames, frame_geom());
     frame_geom top;
     read_plane(f.ds, f, &top);
@@ -193,10 +215,6 @@ int load_one(const std::string &path, dicom_file &f, char *err, size_t errlen)
     }
     if (!f.fg[0].has_pos && top.has_pos) {
         f.fg[0] = top;
-    }
-    if (f.rows == 0 || f.cols == 0 || (f.bits != 8 && f.bits != 16)) {
-        return fail(err, errlen, SC_ERR_NOT_SUPPORTED, "%s: %ux%u, %u bits allocated", path.c_str(),
-                    f.cols, f.rows, f.bits);
     }
     if (f.spp != 1 && f.spp != 3) {
         return fail(err, errlen, SC_ERR_NOT_SUPPORTED, "%s: %u samples per pixel", path.c_str(),
@@ -269,7 +287,9 @@ double dot3(const double *a, const double *b)
 
 } // namespace
 
-extern "C" int sc_dicom_read(const char *path, sc_image *img, char *err, size_t errlen)
+namespace
+{
+int dicom_read(const char *path, uint64_t max_voxels, sc_image *img, char *err, size_t errlen)
 {
     register_codecs();
     struct stat st;
@@ -294,18 +314,17 @@ extern "C" int sc_dicom_read(const char *path, sc_image *img, char *err, size_t 
         files.push_back(path);
     }
     // load every file that is an image; a directory must hold exactly one series
+    std::vector<std::unique_ptr<dicom_file>> owned; // freed on every return and exception
     std::vector<dicom_file *> imgs;
-    auto cleanup = [&]() {
-        for (dicom_file *f : imgs) {
-            delete f;
-        }
-    };
+    auto cleanup = [&]() {};
     char first_err[256] = "";
     for (const std::string &fp : files) {
-        dicom_file *f = new dicom_file();
-        int rc = load_one(fp, *f, first_err[0] ? nullptr : first_err, sizeof first_err);
+        owned.push_back(std::make_unique<dicom_file>());
+        dicom_file *f = owned.back().get();
+        int rc =
+            load_one(fp, *f, max_voxels, first_err[0] ? nullptr : first_err, sizeof first_err);
         if (rc != SC_OK) {
-            delete f;
+            owned.pop_back();
             if (files.size() == 1 || rc == SC_ERR_NOT_SUPPORTED) {
                 cleanup();
                 return fail(err, errlen, rc, "%s", first_err);
@@ -362,6 +381,12 @@ extern "C" int sc_dicom_read(const char *path, sc_image *img, char *err, size_t 
             sl.push_back({f, k, {g.pos[0], g.pos[1], g.pos[2]}, dot3(g.pos, normal)});
         }
     }
+    if (sl.size() < 2) {
+        return fail(err, errlen, SC_ERR_NOT_SUPPORTED,
+                    "%s: a single 2D frame, not a volume (a volume is a series of 2 or more "
+                    "slices, or a multi-frame object with frame positions)",
+                    path);
+    }
     std::sort(sl.begin(), sl.end(), [](const slice &a, const slice &b) { return a.d < b.d; });
     double dz = 1.0;
     if (sl.size() > 1) {
@@ -377,9 +402,12 @@ extern "C" int sc_dicom_read(const char *path, sc_image *img, char *err, size_t 
         }
     }
     const size_t npix = (size_t)f0.rows * f0.cols, n = npix * sl.size();
-    if (sl.size() > 65535u) {
+    if (sl.size() > SC_MAX_VOLUME_DIM || (uint64_t)n > max_voxels) {
         cleanup();
-        return fail(err, errlen, SC_ERR_NOT_SUPPORTED, "%zu slices", sl.size());
+        return fail(err, errlen, SC_ERR_NO_SPACE,
+                    "%s: %zu slices of %u x %u: above the ceiling (%u slices, %llu voxels)", path,
+                    sl.size(), f0.cols, f0.rows, SC_MAX_VOLUME_DIM,
+                    (unsigned long long)max_voxels);
     }
     std::memset(img, 0, sizeof *img);
     // DICOM patient coordinates are LPS (PS3.3 C.7.6.2.1.1)
@@ -418,6 +446,31 @@ extern "C" int sc_dicom_read(const char *path, sc_image *img, char *err, size_t 
     }
     cleanup();
     return SC_OK;
+}
+
+} // namespace
+
+extern "C" int sc_dicom_read(const char *path, uint64_t max_voxels, sc_image *img, char *err,
+                             size_t errlen)
+{
+    // DCMTK and the standard library may throw (std::bad_alloc above all): nothing escapes
+    // into the C caller
+    img->data = nullptr;
+    try {
+        return dicom_read(path, max_voxels, img, err, errlen);
+    } catch (const std::bad_alloc &) {
+        std::free(img->data);
+        img->data = nullptr;
+        return fail(err, errlen, SC_ERR_NO_SPACE, "%s: out of memory while decoding", path);
+    } catch (const std::exception &e) {
+        std::free(img->data);
+        img->data = nullptr;
+        return fail(err, errlen, SC_ERR_PARSE, "%s: %s", path, e.what());
+    } catch (...) {
+        std::free(img->data);
+        img->data = nullptr;
+        return fail(err, errlen, SC_ERR_PARSE, "%s: unreadable (exception)", path);
+    }
 }
 
 extern "C" int sc_dicom_write_fixture(const char *dir, const sc_image *vol, int bits, int is_signed,

@@ -15,6 +15,7 @@
 #define SC_DICOM_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "sc_image.h"
 
@@ -23,8 +24,10 @@ extern "C" {
 #endif
 
 /* Errors: SC_ERR_NOT_FOUND, SC_ERR_IO, SC_ERR_PARSE, SC_ERR_NOT_SUPPORTED, SC_ERR_NO_SPACE;
- * a message in err. Dimension limits are checked by the caller (sc_image_read). */
-int sc_dicom_read(const char *path, sc_image *img, char *err, size_t errlen);
+ * a message in err. Frame counts and rows x columns x frames are checked against max_voxels
+ * before anything is sized by them; DCMTK's and the C++ library's exceptions are caught and
+ * reported (SC_ERR_NO_SPACE for std::bad_alloc, SC_ERR_PARSE otherwise). */
+int sc_dicom_read(const char *path, uint64_t max_voxels, sc_image *img, char *err, size_t errlen);
 
 /* Test fixture writer: writes vol (values must fit the type) as DICOM: a series of slices
  * into directory dir (multiframe = 0) or one enhanced multi-frame file dir/volume.dcm
