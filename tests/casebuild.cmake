@@ -8,6 +8,7 @@ foreach(_src ${_casebuild_tests})
   target_compile_definitions(${_name} PRIVATE _GNU_SOURCE SC_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
                                               SC_BINARY_DIR="${PROJECT_BINARY_DIR}")
   target_link_libraries(${_name} PRIVATE sc_phantom sc_caseimport sc_linux sc_test_support)
+  add_dependencies(${_name} sc-casebuild) # some run the program (reconstruct, CLI paths)
   add_test(NAME ${_name} COMMAND ${_name})
   set_tests_properties(${_name} PROPERTIES LABELS casebuild TIMEOUT 600)
 endforeach()

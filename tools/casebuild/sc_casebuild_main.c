@@ -8,6 +8,9 @@
  *                [--depth-axis AX] [--lateral-axis AX] [--label-map V=NAME,...]
  *                [--max-voxels N] [--allow-data-path yes]
  *                [--calibration 12 numbers] [--registration 12 numbers] (row-major R, then t)
+ *   sc-casebuild reconstruct --sequence SEQ.igs.mha -o OUT.scase [--transform NAME]
+ *                [--image-to-probe 12 numbers] [--recon-spacing MM] [--splat nearest|trilinear]
+ *                [--fill-passes N] [--volume-out V.mha] [import options]
  *   sc-casebuild info CASE.scase
  *   sc-casebuild verify CASE.scase...
  *   sc-casebuild slice CASE.scase --axis x|y|z --index N -o OUT.pgm [--labels]
@@ -30,6 +33,7 @@
 #include "sc_isosurface.h"
 #include "sc_labels.h"
 #include "sc_phantom.h"
+#include "sc_reconstruct.h"
 #include "sc_storage_linux.h"
 
 static const char *const label_names[] = {
@@ -56,6 +60,10 @@ static int usage(void)
             "               [--registration R00,..,R22,TX,TY,TZ] (tracker -> patient, mm)\n"
             "               (FILE: .mha, .mhd, .nrrd, .nhdr, raw or compressed; .dcm or a DICOM\n"
             "                series folder when built with DCMTK)\n"
+            "  sc-casebuild reconstruct --sequence SEQ.igs.mha -o OUT.scase [--transform NAME]\n"
+            "               [--image-to-probe A00,..,A22,TX,TY,TZ] [--recon-spacing MM]\n"
+            "               [--splat nearest|trilinear] [--fill-passes N] [--volume-out V.mha]\n"
+            "               [import options but --volume]  (PLUS tracked 2D sequence)\n"
             "  sc-casebuild info CASE\n"
             "  sc-casebuild verify CASE...\n"
             "  sc-casebuild slice CASE --axis x|y|z --index N -o OUT.pgm [--labels]\n"
@@ -362,99 +370,124 @@ static int parse_floats(const char *s, float *v, int n)
     return *s == '\0' ? 0 : -1;
 }
 
+/* One option of import (also taken by reconstruct): 0 taken, 1 not an import option,
+ * 2 bad value (a message printed). */
+static int parse_import_opt(const char *a, const char *val, sc_import_opts *o, const char **out)
+{
+    if (strcmp(a, "-o") == 0) {
+        *out = val;
+    } else if (strcmp(a, "--volume") == 0) {
+        o->volume_path = val;
+    } else if (strcmp(a, "--labels") == 0) {
+        o->labels_path = val;
+    } else if (strcmp(a, "--name") == 0) {
+        o->name = val;
+    } else if (strcmp(a, "--description") == 0) {
+        o->description = val;
+    } else if (strcmp(a, "--spacing") == 0) {
+        if (num_f32("--spacing", val, 0.01, 50.0, &o->spacing_mm) != 0) {
+            return 2;
+        }
+    } else if (strcmp(a, "--window") == 0) {
+        const char *colon = strchr(val, ':');
+        char lo_s[64];
+        if (colon == NULL || (size_t)(colon - val) >= sizeof lo_s) {
+            fprintf(stderr, "sc-casebuild: --window '%s': LO:HI\n", val);
+            return 2;
+        }
+        memcpy(lo_s, val, (size_t)(colon - val));
+        lo_s[colon - val] = 0;
+        if (num_f32("--window LO", lo_s, -1e30, 1e30, &o->window_lo) != 0 ||
+            num_f32("--window HI", colon + 1, -1e30, 1e30, &o->window_hi) != 0) {
+            return 2;
+        }
+        if (!(o->window_hi > o->window_lo)) {
+            fprintf(stderr, "sc-casebuild: --window '%s': HI must be above LO\n", val);
+            return 2;
+        }
+        o->has_window = 1;
+    } else if (strcmp(a, "--mesh-nodes") == 0) {
+        char buf[64];
+        const uint32_t maxn[3] = {SC_MAX_MESH_NX, SC_MAX_MESH_NY, SC_MAX_MESH_NZ};
+        snprintf(buf, sizeof buf, "%s", val);
+        char *save = NULL, *tok = strtok_r(buf, ",", &save);
+        for (int k = 0; k < 3; k++) {
+            if (tok == NULL || num_u32("--mesh-nodes", tok, 2u, maxn[k], &o->mesh_nodes[k])) {
+                fprintf(stderr, "sc-casebuild: --mesh-nodes '%s': NX,NY,NZ, each 2..%u,%u,%u\n",
+                        val, maxn[0], maxn[1], maxn[2]);
+                return 2;
+            }
+            tok = strtok_r(NULL, ",", &save);
+        }
+        if (tok != NULL) {
+            fprintf(stderr, "sc-casebuild: --mesh-nodes '%s': three counts\n", val);
+            return 2;
+        }
+    } else if (strcmp(a, "--max-voxels") == 0) {
+        if (num_u64("--max-voxels", val, 1u, SC_MAX_VOLUME_VOXELS, &o->limits.max_voxels)) {
+            return 2;
+        }
+    } else if (strcmp(a, "--allow-data-path") == 0) {
+        if (strcmp(val, "yes") != 0 && strcmp(val, "no") != 0) {
+            fprintf(stderr, "sc-casebuild: --allow-data-path '%s': yes or no\n", val);
+            return 2;
+        }
+        o->limits.allow_data_path = strcmp(val, "yes") == 0;
+    } else if (strcmp(a, "--depth-axis") == 0) {
+        o->depth_axis = val;
+    } else if (strcmp(a, "--lateral-axis") == 0) {
+        o->lateral_axis = val;
+    } else if (strcmp(a, "--label-map") == 0) {
+        o->label_map = val;
+    } else if (strcmp(a, "--calibration") == 0 || strcmp(a, "--registration") == 0) {
+        float v[12];
+        if (parse_floats(val, v, 12) != 0) {
+            return 2;
+        }
+        sc_xform *x = a[2] == 'c' ? &o->image_to_probe : &o->tracker_to_patient;
+        o->has_registration |= a[2] == 'r';
+        memcpy(x->r, v, sizeof x->r);
+        memcpy(x->t_mm, v + 9, sizeof x->t_mm);
+    } else if (strcmp(a, "--mesh-box") == 0) {
+        if (parse_floats(val, o->mesh_box_mm, 6) != 0) {
+            fprintf(stderr, "sc-casebuild: --mesh-box '%s': six finite numbers (mm)\n", val);
+            return 2;
+        }
+        o->has_mesh_box = 1;
+    } else {
+        return 1;
+    }
+    return 0;
+}
+
+static void print_import(const char *out, const sc_import_result *r)
+{
+    static const char axis_names[] = "ijk";
+    printf("%s: case frame x = %c%c, y = %c%c, z (depth) = %c%c of the source grid; mesh box %s "
+           "[%.2f %.2f %.2f] + [%.2f %.2f %.2f] mm\n",
+           out, r->frame_sign[0] > 0 ? '+' : '-', axis_names[r->frame_axis[0]],
+           r->frame_sign[1] > 0 ? '+' : '-', axis_names[r->frame_axis[1]],
+           r->frame_sign[2] > 0 ? '+' : '-', axis_names[r->frame_axis[2]],
+           r->mesh_box_derived ? "(from the labels)" : "(given)", (double)r->def.mesh.origin_mm[0],
+           (double)r->def.mesh.origin_mm[1], (double)r->def.mesh.origin_mm[2],
+           (double)r->def.mesh.size_mm[0], (double)r->def.mesh.size_mm[1],
+           (double)r->def.mesh.size_mm[2]);
+}
+
 static int cmd_import(int argc, char **argv)
 {
     sc_import_opts o = sc_import_default_opts();
     const char *out = NULL;
-    for (int i = 0; i < argc; i++) {
-        const char *a = argv[i];
-        const char *val = i + 1 < argc ? argv[i + 1] : NULL;
-        if (val == NULL) {
+    for (int i = 0; i + 1 < argc || i < argc; i += 2) {
+        if (i + 1 >= argc) {
             return usage();
         }
-        i++;
-        if (strcmp(a, "-o") == 0) {
-            out = val;
-        } else if (strcmp(a, "--volume") == 0) {
-            o.volume_path = val;
-        } else if (strcmp(a, "--labels") == 0) {
-            o.labels_path = val;
-        } else if (strcmp(a, "--name") == 0) {
-            o.name = val;
-        } else if (strcmp(a, "--description") == 0) {
-            o.description = val;
-        } else if (strcmp(a, "--spacing") == 0) {
-            if (num_f32("--spacing", val, 0.01, 50.0, &o.spacing_mm) != 0) {
-                return 2;
-            }
-        } else if (strcmp(a, "--window") == 0) {
-            const char *colon = strchr(val, ':');
-            char lo_s[64];
-            if (colon == NULL || (size_t)(colon - val) >= sizeof lo_s) {
-                fprintf(stderr, "sc-casebuild: --window '%s': LO:HI\n", val);
-                return 2;
-            }
-            memcpy(lo_s, val, (size_t)(colon - val));
-            lo_s[colon - val] = 0;
-            if (num_f32("--window LO", lo_s, -1e30, 1e30, &o.window_lo) != 0 ||
-                num_f32("--window HI", colon + 1, -1e30, 1e30, &o.window_hi) != 0) {
-                return 2;
-            }
-            if (!(o.window_hi > o.window_lo)) {
-                fprintf(stderr, "sc-casebuild: --window '%s': HI must be above LO\n", val);
-                return 2;
-            }
-            o.has_window = 1;
-        } else if (strcmp(a, "--mesh-nodes") == 0) {
-            char buf[64];
-            const uint32_t maxn[3] = {SC_MAX_MESH_NX, SC_MAX_MESH_NY, SC_MAX_MESH_NZ};
-            snprintf(buf, sizeof buf, "%s", val);
-            char *save = NULL, *tok = strtok_r(buf, ",", &save);
-            for (int k = 0; k < 3; k++) {
-                if (tok == NULL || num_u32("--mesh-nodes", tok, 2u, maxn[k], &o.mesh_nodes[k])) {
-                    fprintf(stderr, "sc-casebuild: --mesh-nodes '%s': NX,NY,NZ, each 2..%u,%u,%u\n",
-                            val, maxn[0], maxn[1], maxn[2]);
-                    return 2;
-                }
-                tok = strtok_r(NULL, ",", &save);
-            }
-            if (tok != NULL) {
-                fprintf(stderr, "sc-casebuild: --mesh-nodes '%s': three counts\n", val);
-                return 2;
-            }
-        } else if (strcmp(a, "--max-voxels") == 0) {
-            if (num_u64("--max-voxels", val, 1u, SC_MAX_VOLUME_VOXELS, &o.limits.max_voxels)) {
-                return 2;
-            }
-        } else if (strcmp(a, "--allow-data-path") == 0) {
-            if (strcmp(val, "yes") != 0 && strcmp(val, "no") != 0) {
-                fprintf(stderr, "sc-casebuild: --allow-data-path '%s': yes or no\n", val);
-                return 2;
-            }
-            o.limits.allow_data_path = strcmp(val, "yes") == 0;
-        } else if (strcmp(a, "--depth-axis") == 0) {
-            o.depth_axis = val;
-        } else if (strcmp(a, "--lateral-axis") == 0) {
-            o.lateral_axis = val;
-        } else if (strcmp(a, "--label-map") == 0) {
-            o.label_map = val;
-        } else if (strcmp(a, "--calibration") == 0 || strcmp(a, "--registration") == 0) {
-            float v[12];
-            if (parse_floats(val, v, 12) != 0) {
-                return usage();
-            }
-            sc_xform *x = a[2] == 'c' ? &o.image_to_probe : &o.tracker_to_patient;
-            o.has_registration |= a[2] == 'r';
-            memcpy(x->r, v, sizeof x->r);
-            memcpy(x->t_mm, v + 9, sizeof x->t_mm);
-        } else if (strcmp(a, "--mesh-box") == 0) {
-            if (parse_floats(val, o.mesh_box_mm, 6) != 0) {
-                fprintf(stderr, "sc-casebuild: --mesh-box '%s': six finite numbers (mm)\n", val);
-                return 2;
-            }
-            o.has_mesh_box = 1;
-        } else {
+        const int rc = parse_import_opt(argv[i], argv[i + 1], &o, &out);
+        if (rc == 1) {
             return usage();
+        }
+        if (rc == 2) {
+            return 2;
         }
     }
     if (out == NULL || o.volume_path == NULL) {
@@ -467,16 +500,133 @@ static int cmd_import(int argc, char **argv)
         fprintf(stderr, "sc-casebuild: import: %s: %s\n", sc_err_name(rc), err);
         return 1;
     }
-    static const char axis_names[] = "ijk";
-    printf("%s: case frame x = %c%c, y = %c%c, z (depth) = %c%c of the source grid; mesh box %s "
-           "[%.2f %.2f %.2f] + [%.2f %.2f %.2f] mm\n",
-           out, r.frame_sign[0] > 0 ? '+' : '-', axis_names[r.frame_axis[0]],
-           r.frame_sign[1] > 0 ? '+' : '-', axis_names[r.frame_axis[1]],
-           r.frame_sign[2] > 0 ? '+' : '-', axis_names[r.frame_axis[2]],
-           r.mesh_box_derived ? "(from the labels)" : "(given)", (double)r.def.mesh.origin_mm[0],
-           (double)r.def.mesh.origin_mm[1], (double)r.def.mesh.origin_mm[2],
-           (double)r.def.mesh.size_mm[0], (double)r.def.mesh.size_mm[1],
-           (double)r.def.mesh.size_mm[2]);
+    print_import(out, &r);
+    rc = write_case_file(&r.def, out);
+    sc_import_result_free(&r);
+    return rc;
+}
+
+/* reconstruct: a PLUS tracked sequence -> a volume (tracker frame) -> import as a case */
+static int cmd_reconstruct(int argc, char **argv)
+{
+    sc_import_opts o = sc_import_default_opts();
+    sc_recon_opts ro = sc_recon_default_opts();
+    const char *out = NULL, *seq_path = NULL, *transform = NULL, *vol_out = NULL;
+    for (int i = 0; i < argc; i += 2) {
+        if (i + 1 >= argc) {
+            return usage();
+        }
+        const char *a = argv[i], *val = argv[i + 1];
+        if (strcmp(a, "--sequence") == 0) {
+            seq_path = val;
+        } else if (strcmp(a, "--transform") == 0) {
+            transform = val;
+        } else if (strcmp(a, "--volume-out") == 0) {
+            vol_out = val;
+        } else if (strcmp(a, "--recon-spacing") == 0) {
+            float v;
+            if (num_f32("--recon-spacing", val, 0.05, 10.0, &v) != 0) {
+                return 2;
+            }
+            ro.spacing_mm = (double)v;
+        } else if (strcmp(a, "--splat") == 0) {
+            if (strcmp(val, "nearest") != 0 && strcmp(val, "trilinear") != 0) {
+                fprintf(stderr, "sc-casebuild: --splat '%s': nearest or trilinear\n", val);
+                return 2;
+            }
+            ro.trilinear = strcmp(val, "trilinear") == 0;
+        } else if (strcmp(a, "--fill-passes") == 0) {
+            if (num_u32("--fill-passes", val, 0u, 64u, &ro.fill_passes) != 0) {
+                return 2;
+            }
+        } else if (strcmp(a, "--image-to-probe") == 0) {
+            float v[12];
+            if (parse_floats(val, v, 12) != 0) {
+                fprintf(stderr, "sc-casebuild: --image-to-probe '%s': 12 finite numbers (3x3 "
+                                "row-major, then the translation, mm)\n",
+                        val);
+                return 2;
+            }
+            for (int k = 0; k < 12; k++) {
+                ro.image_to_probe[k] = (double)v[k];
+            }
+        } else if (strcmp(a, "--volume") == 0) {
+            fprintf(stderr, "sc-casebuild: reconstruct takes --sequence, not --volume\n");
+            return 2;
+        } else {
+            const int rc = parse_import_opt(a, val, &o, &out);
+            if (rc == 1) {
+                return usage();
+            }
+            if (rc == 2) {
+                return 2;
+            }
+        }
+    }
+    if (out == NULL || seq_path == NULL) {
+        return usage();
+    }
+    ro.max_voxels = o.limits.max_voxels;
+    char err[512];
+    sc_plus_seq seq;
+    int rc = sc_plusseq_read(seq_path, &o.limits, transform, &seq, err, sizeof err);
+    if (rc != SC_OK) {
+        fprintf(stderr, "sc-casebuild: reconstruct: %s: %s\n", sc_err_name(rc), err);
+        return 1;
+    }
+    sc_image vol;
+    sc_recon_stats st;
+    rc = sc_reconstruct(&seq, &ro, &vol, &st, err, sizeof err);
+    const uint32_t nframes = seq.frames.dim[2], nvalid = seq.valid_count;
+    sc_plusseq_free(&seq);
+    if (rc != SC_OK) {
+        fprintf(stderr, "sc-casebuild: reconstruct: %s: %s\n", sc_err_name(rc), err);
+        return 1;
+    }
+    printf("%s: %u of %u frames, %" PRIu64 " pixels %s-splatted into %u x %u x %u at %.3g mm: "
+           "%.1f%% from the frames, %.1f%% hole-filled, %.1f%% empty; beam (depth) direction "
+           "[%.3f %.3f %.3f] in the tracker frame\n",
+           seq_path, nvalid, nframes, st.pixels, ro.trilinear ? "trilinear" : "nearest",
+           vol.dim[0], vol.dim[1], vol.dim[2], ro.spacing_mm,
+           100.0 * (double)st.filled / (double)st.voxels,
+           100.0 * (double)st.hole_filled / (double)st.voxels,
+           100.0 * (double)st.empty / (double)st.voxels, st.beam_dir[0], st.beam_dir[1],
+           st.beam_dir[2]);
+    char tmp[4200];
+    if (vol_out == NULL) {
+        snprintf(tmp, sizeof tmp, "%s.volume.mha", out);
+        vol_out = tmp;
+    }
+    rc = sc_image_write_mha(&vol, vol_out);
+    sc_image_free(&vol);
+    if (rc != SC_OK) {
+        fprintf(stderr, "sc-casebuild: reconstruct: cannot write %s\n", vol_out);
+        return 1;
+    }
+    /* depth: the grid axis (the tracker's) closest to the mean beam direction */
+    char depth[4] = "+k";
+    if (o.depth_axis == NULL) {
+        int best = 0;
+        for (int r = 1; r < 3; r++) {
+            if (fabs(st.beam_dir[r]) > fabs(st.beam_dir[best])) {
+                best = r;
+            }
+        }
+        depth[0] = st.beam_dir[best] < 0.0 ? '-' : '+';
+        depth[1] = (char)('i' + best);
+        o.depth_axis = depth;
+    }
+    o.volume_path = vol_out;
+    sc_import_result r;
+    rc = sc_import_case(&o, &r, err, sizeof err);
+    if (vol_out == tmp) {
+        remove(tmp);
+    }
+    if (rc != SC_OK) {
+        fprintf(stderr, "sc-casebuild: reconstruct: import: %s: %s\n", sc_err_name(rc), err);
+        return 1;
+    }
+    print_import(out, &r);
     rc = write_case_file(&r.def, out);
     sc_import_result_free(&r);
     return rc;
@@ -712,6 +862,9 @@ int main(int argc, char **argv)
     }
     if (strcmp(cmd, "import") == 0) {
         return cmd_import(argc - 2, argv + 2);
+    }
+    if (strcmp(cmd, "reconstruct") == 0) {
+        return cmd_reconstruct(argc - 2, argv + 2);
     }
     if (strcmp(cmd, "info") == 0) {
         return cmd_info(argc - 2, argv + 2);

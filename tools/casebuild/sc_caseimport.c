@@ -419,7 +419,7 @@ static int read_metaimage(const char *path, const sc_read_limits *lim, sc_image 
         return rc;
     }
     int ndims = 0, have_type = 0, compressed = 0, big = 0, channels = 1, have_spacing = 0;
-    int have_matrix = 0, have_anat = 0;
+    int have_matrix = 0, have_anat = 0, is_sequence = 0;
     double anat_dir[9];
     long long dsz[3] = {1, 1, 1};
     long long header_size = 0, comp_size = -1;
@@ -523,6 +523,9 @@ static int read_metaimage(const char *path, const sc_read_limits *lim, sc_image 
                 free(file);
                 return fail(err, errlen, SC_ERR_NOT_SUPPORTED, "%s: ASCII MetaImage data", path);
             }
+        } else if (strncasecmp(key, "Seq_Frame", 9) == 0 ||
+                   strcasecmp(key, "UltrasoundImageOrientation") == 0) {
+            is_sequence = 1;
         } else if (strcasecmp(key, "ElementDataFile") == 0) {
             snprintf(datafile, sizeof datafile, "%s", val);
             data_off = pos;
@@ -548,6 +551,14 @@ static int read_metaimage(const char *path, const sc_read_limits *lim, sc_image 
         free(file);
         return fail(err, errlen, SC_ERR_PARSE,
                     "%s: MetaImage needs NDims 2 or 3, ElementType, ElementDataFile", path);
+    }
+    if (is_sequence && !lim->allow_sequence) {
+        free(file);
+        return fail(err, errlen, SC_ERR_NOT_SUPPORTED,
+                    "%s: a tracked 2D sequence (PLUS Seq_Frame fields: frames with per-frame "
+                    "transforms), not a volume; build the volume with `sc-casebuild reconstruct "
+                    "--sequence %s ...`",
+                    path, path);
     }
     if (have_anat) {
         /* ITK's world is LPS; the matrix, when given, is the geometry (as ITK reads it) */
@@ -969,6 +980,7 @@ sc_read_limits sc_read_default_limits(void)
     sc_read_limits l;
     l.max_voxels = SC_IMPORT_DEFAULT_MAX_VOXELS;
     l.allow_data_path = 0;
+    l.allow_sequence = 0;
     return l;
 }
 

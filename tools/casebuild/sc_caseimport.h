@@ -35,6 +35,8 @@ typedef struct sc_read_limits {
     uint64_t max_voxels; /* per image, 1..SC_MAX_VOLUME_VOXELS; also bounds the case grid */
     int allow_data_path; /* 1: a header may name its data file by an absolute path or through
                           * '..'; 0 (default): only beside the header (or below it) */
+    int allow_sequence;  /* 1: read a PLUS sequence's frames as a W x H x frames image (the
+                          * reconstruction reader); 0: refuse it, pointing to `reconstruct` */
 } sc_read_limits;
 
 sc_read_limits sc_read_default_limits(void);
