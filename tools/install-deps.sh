@@ -8,7 +8,7 @@ set -euo pipefail
 
 base=(build-essential cmake pkg-config libccd-dev libcmocka-dev libpng-dev zlib1g-dev libdrm-dev
       python3-pydicom python3-numpy
-      libdcmtk-dev teem-apps
+      libdcmtk-dev libteem-dev teem-apps
       python3 python3-canmatrix libsdl2-dev xvfb xauth can-utils)
 cross=(gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi
        gcc-aarch64-linux-gnu qemu-user-static dpkg-dev)

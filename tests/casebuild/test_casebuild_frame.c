@@ -220,7 +220,7 @@ static void left_handed_grid_becomes_a_right_handed_case(void **state)
     char hdr[512];
     snprintf(hdr, sizeof hdr,
              "NRRD0004\ntype: uchar\ndimension: 3\nsizes: %u %u %u\n"
-             "space directions: (1,0,0) (0,1,0) (0,0,-1)\nencoding: raw\n\n",
+             "space dimension: 3\nspace directions: (1,0,0) (0,1,0) (0,0,-1)\nencoding: raw\n\n",
              DX, DY, DZ);
     write_file("lh.nrrd", hdr, g_vox, N);
     sc_import_result r;

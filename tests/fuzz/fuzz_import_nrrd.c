@@ -6,6 +6,18 @@
 
 #include <zlib.h>
 
+#ifdef SC_HAVE_TEEM
+/* libnrrd 1.12 (Debian's libteem) leaks its gzip reader's state (_nrrdGzOpen: the zlib stream
+ * and buffers, about 40 KB) when a gzip stream is corrupt or ends early; a bug of the library,
+ * not of sonocomp, in a one-shot host tool. Suppressed here by name only, so that any other
+ * leak still fails the target. */
+const char *__lsan_default_suppressions(void);
+const char *__lsan_default_suppressions(void)
+{
+    return "leak:_nrrdGzOpen\n";
+}
+#endif
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     if (size == 0u) {
