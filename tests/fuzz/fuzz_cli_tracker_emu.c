@@ -23,6 +23,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         SC_FUZZ_CHECK((a.iface == NULL) != (a.log_path == NULL));
         SC_FUZZ_CHECK(a.t0_s >= 0.0 && a.t0_s < 1e11);
         SC_FUZZ_CHECK(a.def.n_faults <= SC_EMU_MAX_FAULTS);
+        for (size_t f = 0; f < a.def.n_faults; f++) {
+            SC_FUZZ_CHECK(a.def.faults[f].period >= 1u && isfinite(a.def.faults[f].start_s));
+        }
+        SC_FUZZ_CHECK(isfinite(a.def.rate_hz) && isfinite(a.def.duration_s) &&
+                      isfinite(a.def.period_s) && isfinite(a.def.silence_ms));
         static sc_emu emu;
         if (sc_emu_init(&emu, &a.def) == 0) {
             SC_FUZZ_CHECK(a.def.script != SC_EMU_CSV);

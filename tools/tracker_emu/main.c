@@ -39,12 +39,13 @@ static void usage(void)
             "faults: bad-crc counter-jump repeat silence implausible\n");
 }
 
+/* A whole, finite number (NaN and infinities compare false with every range below). */
 static int parse_double(const char *s, double *out)
 {
     char *end;
     errno = 0;
     const double v = strtod(s, &end);
-    if (end == s || *end != '\0' || errno != 0) {
+    if (end == s || *end != '\0' || errno != 0 || !isfinite(v)) {
         return -1;
     }
     *out = v;
