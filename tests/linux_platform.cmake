@@ -10,6 +10,5 @@ endforeach()
 
 # The viewer's GIF writer is tested against an independent decoder.
 if(TARGET test_sc_viewer_gif)
-  target_sources(test_sc_viewer_gif PRIVATE ${PROJECT_SOURCE_DIR}/tools/viewer/vw_gif.c)
-  target_include_directories(test_sc_viewer_gif PRIVATE ${PROJECT_SOURCE_DIR}/tools/viewer)
+  target_link_libraries(test_sc_viewer_gif PRIVATE sc_viewer_parts)
 endif()

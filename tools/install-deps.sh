@@ -4,16 +4,20 @@
 #   tools/install-deps.sh base      build + tests on the host (default)
 #   tools/install-deps.sh cross     cortex-m7 (arm-none-eabi, newlib) and aarch64 (qemu-user)
 #   tools/install-deps.sh hil       the SocketCAN/KMS VM bench (qemu-system, busybox, kernel)
+#   tools/install-deps.sh fuzz      the fuzz preset (clang 14 with libFuzzer and its sanitizers)
 set -euo pipefail
 
-base=(build-essential cmake pkg-config libccd-dev libcmocka-dev libpng-dev zlib1g-dev libdrm-dev
+base=(build-essential cmake pkg-config libccd-dev libcmocka-dev libpng-dev zlib1g-dev libgif-dev
+      libdrm-dev
       python3-pydicom python3-numpy
       libdcmtk-dev libteem-dev teem-apps
       python3 python3-canmatrix libsdl2-dev xvfb xauth can-utils)
 cross=(gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi
        gcc-aarch64-linux-gnu qemu-user-static dpkg-dev)
-cross_arm64=(libcmocka-dev:arm64 libccd-dev:arm64 zlib1g-dev:arm64 libpng-dev:arm64)
+cross_arm64=(libcmocka-dev:arm64 libccd-dev:arm64 zlib1g-dev:arm64 libpng-dev:arm64
+             libgif-dev:arm64)
 hil=(qemu-system-x86 busybox-static can-utils)
+fuzz=(clang clang-14 libclang-rt-14-dev llvm-14)
 
 if [ "$(id -u)" -ne 0 ]; then
     echo "install-deps: run as root (apt-get needs it)" >&2
@@ -58,8 +62,11 @@ cross)
 hil)
     apt_install "${base[@]}" "${hil[@]}"
     ;;
+fuzz)
+    apt_install "${base[@]}" "${fuzz[@]}"
+    ;;
 *)
-    echo "usage: $0 [base|cross|hil]" >&2
+    echo "usage: $0 [base|cross|hil|fuzz]" >&2
     exit 2
     ;;
 esac

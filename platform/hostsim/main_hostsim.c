@@ -145,6 +145,8 @@ static int parse_faults(const char *s, sc_hs_can_faults *f)
     return 0;
 }
 
+/* The command line into *o (nothing else is touched: tests/fuzz/fuzz_cli_hostsim.c calls it).
+ * 0 to go on, -1 after --help or --version (exit 0), 2 for a usage error. */
 static int parse_args(int argc, char **argv, options *o)
 {
     *o = (options){.case_name = "neck-ijv",
@@ -175,6 +177,7 @@ static int parse_args(int argc, char **argv, options *o)
         {0, 0, 0, 0}};
     int c;
     opterr = 0;
+    optind = 0; /* glibc: a full re-initialisation, so that it can be called again */
     while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
         uint64_t u;
         double d;
@@ -247,8 +250,8 @@ static int parse_args(int argc, char **argv, options *o)
             break;
         case O_RAW: o->frame_raw_path = optarg; break;
         case O_QUIET: o->quiet = 1; break;
-        case O_HELP: usage(stdout); exit(0);
-        case O_VERSION: printf("sc-hostsim %s\n", SC_HOSTSIM_VERSION); exit(0);
+        case O_HELP: usage(stdout); return -1;
+        case O_VERSION: printf("sc-hostsim %s\n", SC_HOSTSIM_VERSION); return -1;
         default:
             fprintf(stderr, "sc-hostsim: unknown or incomplete option '%s'\n", argv[optind - 1]);
             usage(stderr);
@@ -363,7 +366,7 @@ int main(int argc, char **argv)
     options o;
     int rc = parse_args(argc, argv, &o);
     if (rc) {
-        return rc;
+        return rc < 0 ? 0 : rc;
     }
     if (mkdir_p(o.out_dir) != 0) {
         fprintf(stderr, "sc-hostsim: cannot create %s: %s\n", o.out_dir, strerror(errno));

@@ -411,10 +411,13 @@ static void final_report(const sc_engine *e, double wall_s, const char *stop_rea
 
 /* ---- main ------------------------------------------------------------------------------- */
 
-int main(int argc, char **argv)
+/* The command line into *a (nothing else is touched: tests/fuzz/fuzz_cli_sonocomp.c calls it).
+ * Returns -1 to go on, or the exit status: EXIT_OK after --help, --help-config, --version;
+ * EXIT_USAGE for a bad option or value. */
+static int parse_cli(int argc, char **argv, cli *a)
 {
-    cli a;
-    memset(&a, 0, sizeof a);
+    memset(a, 0, sizeof *a);
+    optind = 0; /* glibc: a full re-initialisation, so that it can be called again */
     enum { OPT_CHECK = 1000, OPT_HELP_CONFIG, OPT_CASE_DIR, OPT_INJECT, OPT_CAN_REPLAY };
     static const struct option lo[] = {{"config", required_argument, NULL, 'c'},
                                        {"set", required_argument, NULL, 's'},
@@ -433,23 +436,23 @@ int main(int argc, char **argv)
         char *end = NULL;
         switch (opt) {
         case 'c':
-            a.config_path = optarg;
+            a->config_path = optarg;
             break;
         case 's':
-            if (a.set_n == sizeof a.sets / sizeof a.sets[0]) {
+            if (a->set_n == sizeof a->sets / sizeof a->sets[0]) {
                 fprintf(stderr, "sonocomp: too many --set options\n");
                 return EXIT_USAGE;
             }
-            a.sets[a.set_n++] = optarg;
+            a->sets[a->set_n++] = optarg;
             break;
         case OPT_CHECK:
-            a.check_config = 1;
+            a->check_config = 1;
             break;
         case OPT_HELP_CONFIG:
             help_config();
             return EXIT_OK;
         case OPT_CASE_DIR:
-            a.case_dir = optarg;
+            a->case_dir = optarg;
             break;
         case OPT_INJECT: {
             errno = 0;
@@ -458,24 +461,24 @@ int main(int argc, char **argv)
                 fprintf(stderr, "sonocomp: --inject-loss %s: expected 0..1000\n", optarg);
                 return EXIT_USAGE;
             }
-            a.inject_loss_permille = (uint32_t)v;
+            a->inject_loss_permille = (uint32_t)v;
             break;
         }
         case OPT_CAN_REPLAY:
-            a.can_replay_path = optarg;
+            a->can_replay_path = optarg;
             break;
         case 'n':
             errno = 0;
-            a.frames = strtoull(optarg, &end, 10);
-            if (errno || !end || *end || optarg[0] == '-' || a.frames == 0u) {
+            a->frames = strtoull(optarg, &end, 10);
+            if (errno || !end || *end || optarg[0] == '-' || a->frames == 0u) {
                 fprintf(stderr, "sonocomp: --frames %s: expected a positive count\n", optarg);
                 return EXIT_USAGE;
             }
             break;
         case 't':
             errno = 0;
-            a.seconds = strtod(optarg, &end);
-            if (errno || !end || *end || !(a.seconds > 0.0) || !isfinite(a.seconds)) {
+            a->seconds = strtod(optarg, &end);
+            if (errno || !end || *end || !(a->seconds > 0.0) || !isfinite(a->seconds)) {
                 fprintf(stderr, "sonocomp: --seconds %s: expected positive seconds\n", optarg);
                 return EXIT_USAGE;
             }
@@ -494,6 +497,16 @@ int main(int argc, char **argv)
     if (optind < argc) {
         fprintf(stderr, "sonocomp: unexpected argument '%s' (see --help)\n", argv[optind]);
         return EXIT_USAGE;
+    }
+    return -1;
+}
+
+int main(int argc, char **argv)
+{
+    cli a;
+    const int parsed = parse_cli(argc, argv, &a);
+    if (parsed >= 0) {
+        return parsed;
     }
 
     /* configuration: defaults, the file, then --set */

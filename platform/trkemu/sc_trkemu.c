@@ -275,13 +275,43 @@ int sc_emu_next(sc_emu *e, sc_can_frame *out, size_t cap, uint64_t *t_ns)
     return (int)n;
 }
 
+/* One line (its '\n' kept) into buf[cap], NUL-terminated: 1, 0 at the end of the file, -1 for a
+ * line of cap - 1 bytes or more or one holding a NUL byte (the rest of it is consumed). */
+static int read_line(FILE *fp, char *buf, size_t cap)
+{
+    size_t n = 0;
+    int bad = 0, c = EOF;
+    while ((c = getc(fp)) != EOF) {
+        if (c == 0 || n + 2u > cap) {
+            bad = 1;
+        } else {
+            buf[n++] = (char)c;
+        }
+        if (c == '\n') {
+            break;
+        }
+    }
+    buf[n] = '\0';
+    if (c == EOF && n == 0u && !bad) {
+        return 0;
+    }
+    return bad ? -1 : 1;
+}
+
 int sc_emu_load_csv(FILE *fp, sc_emu_row *rows, size_t cap, size_t *n, size_t *bad_line)
 {
     char line[512];
     size_t count = 0, line_no = 0;
     *bad_line = 0;
-    while (fgets(line, sizeof line, fp)) {
+    int got;
+    while ((got = read_line(fp, line, sizeof line)) != 0) {
         line_no++;
+        if (got < 0) {
+            /* longer than any row, or a NUL byte: refused, not read in pieces that would each
+             * count (and might each parse) as a line of their own */
+            *bad_line = line_no;
+            return SC_ERR_PARSE;
+        }
         char *s = line;
         while (*s == ' ' || *s == '\t') {
             s++;

@@ -122,7 +122,8 @@ typedef int (*sc_emu_send_fn)(void *ctx, const sc_can_frame *frame);
 int sc_emu_feed(sc_emu *e, uint64_t until_ns, sc_emu_send_fn send, void *ctx);
 
 /* Loads csv rows (comma separated, '#' comments and a header line allowed, times strictly
- * increasing). 0, or SC_ERR_PARSE with *bad_line set, SC_ERR_NO_SPACE above cap. */
+ * increasing; a line of 510 bytes at most, no NUL byte). 0, or SC_ERR_PARSE with *bad_line
+ * set, SC_ERR_NO_SPACE above cap. */
 int sc_emu_load_csv(FILE *fp, sc_emu_row *rows, size_t cap, size_t *n, size_t *bad_line);
 
 const char *sc_emu_script_name(sc_emu_script s);

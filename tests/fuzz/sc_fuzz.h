@@ -1,12 +1,19 @@
 /*
  * sc_fuzz.h: the contract of a fuzz target.
  *
- * Each tests/fuzz/fuzz_<parser>.c defines LLVMFuzzerTestOneInput (libFuzzer's entry point) and
- * sc_fuzz_seed (valid inputs to start mutating from). The same file builds two ways:
- *  - with clang and -DSC_FUZZ=ON, as a libFuzzer binary (coverage-guided, run by hand/nightly);
- *  - always, as a ctest "smoke" binary with tests/fuzz/sc_fuzz_main.c: a deterministic
- *    mutational driver (bit flips, byte sets, truncation, extension, splices of seeds) that
- *    runs a fixed number of inputs under ASan/UBSan in the dev preset.
+ * Each tests/fuzz/fuzz_<name>.c defines LLVMFuzzerTestOneInput (libFuzzer's entry point) and
+ * sc_fuzz_seed (valid inputs to start mutating from). The same file builds two ways
+ * (tests/fuzz.cmake):
+ *  - with the fuzz preset (clang, -DSC_FUZZ=ON, every library instrumented) as a libFuzzer
+ *    binary, run by tools/fuzz.sh NAME SECONDS and in CI by tools/check-fuzz.sh, starting from
+ *    the checked-in corpus tests/fuzz/corpus/<name>/ (tools/fuzz-seeds.sh writes the seeds
+ *    there);
+ *  - always, as a ctest "smoke" binary with tests/fuzz/sc_fuzz_main.c: it replays that corpus
+ *    and the crash regressions tests/fuzz/regress/<name>/, then runs a deterministic
+ *    mutational driver (bit flips, byte sets, truncation, extension, splices of seeds) for a
+ *    fixed number of inputs under ASan/UBSan in the dev preset.
+ * Optional beside it: fuzz_<name>.libs (libraries to link besides sc_hostsim, whitespace
+ * separated) and fuzz_<name>.dict (a libFuzzer dictionary).
  * A target must accept any input without crashing, hanging or leaking, and may check its own
  * invariants with SC_FUZZ_CHECK (aborts with a message).
  */

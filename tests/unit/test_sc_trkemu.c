@@ -161,6 +161,32 @@ static void csv_rows_load_and_bad_rows_name_their_line(void **state)
     fclose(fp);
 }
 
+/* A line longer than a row can be (or holding a NUL) is refused with its own number, never
+ * read in pieces: here a 600-byte comment whose tail would parse as a second row. */
+static void csv_overlong_lines_are_refused_whole(void **state)
+{
+    (void)state;
+    static char text[1024];
+    sc_emu_row rows[4];
+    size_t n = 0, bad = 0;
+    int len = snprintf(text, sizeof text, "0,1,2,3,1,0,0,0\n#%*s1,1,2,3,1,0,0,0\n", 600, "");
+    FILE *fp = fmemopen(text, (size_t)len, "r");
+    assert_int_equal(sc_emu_load_csv(fp, rows, 4, &n, &bad), SC_ERR_PARSE);
+    fclose(fp);
+    assert_int_equal(bad, 2);
+    /* the longest line accepted: 510 bytes before its newline */
+    len = snprintf(text, sizeof text, "0,1,2,3,1,0,0,0%*s\n", 510 - 15, "");
+    fp = fmemopen(text, (size_t)len, "r");
+    assert_int_equal(sc_emu_load_csv(fp, rows, 4, &n, &bad), 0);
+    fclose(fp);
+    assert_int_equal(n, 1);
+    const char with_nul[] = "0,1,2,3,1,0,0,0\n1,1,2,3\0,1,0,0,0\n";
+    fp = fmemopen((void *)with_nul, sizeof with_nul - 1u, "r");
+    assert_int_equal(sc_emu_load_csv(fp, rows, 4, &n, &bad), SC_ERR_PARSE);
+    fclose(fp);
+    assert_int_equal(bad, 2);
+}
+
 typedef struct sink {
     uint32_t frames;
     uint32_t ids[64];
@@ -211,6 +237,7 @@ int main(void)
         cmocka_unit_test(press_goes_down_to_the_depth_and_back_with_a_contact_force),
         cmocka_unit_test(every_injected_fault_is_counted_by_the_tracker),
         cmocka_unit_test(csv_rows_load_and_bad_rows_name_their_line),
+        cmocka_unit_test(csv_overlong_lines_are_refused_whole),
         cmocka_unit_test(feed_sends_every_due_sample_once),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -39,12 +39,13 @@ static void usage(void)
             "faults: bad-crc counter-jump repeat silence implausible\n");
 }
 
+/* A whole, finite number (NaN and infinities compare false with every range below). */
 static int parse_double(const char *s, double *out)
 {
     char *end;
     errno = 0;
     const double v = strtod(s, &end);
-    if (end == s || *end != '\0' || errno != 0) {
+    if (end == s || *end != '\0' || errno != 0 || !isfinite(v)) {
         return -1;
     }
     *out = v;
@@ -71,6 +72,12 @@ static int parse_fault(char *arg, sc_emu_fault *f)
     return 0;
 }
 
+typedef struct emu_cli {
+    sc_emu_def def;
+    const char *iface, *log_path, *log_iface, *csv;
+    double t0_s;
+} emu_cli;
+
 static void sleep_until(const struct timespec *t0, uint64_t t_ns)
 {
     struct timespec t = *t0;
@@ -84,12 +91,14 @@ static void sleep_until(const struct timespec *t0, uint64_t t_ns)
     }
 }
 
-int main(int argc, char **argv)
+/* The command line into *a (nothing else is touched: tests/fuzz/fuzz_cli_tracker_emu.c calls
+ * it). Returns -1 to go on, 0 after --help, 2 for a usage error. */
+static int parse_cli(int argc, char **argv, emu_cli *a)
 {
-    sc_emu_def def = sc_emu_default_def();
-    const char *iface = NULL, *log_path = NULL, *log_iface = "vcan0", *csv = NULL;
-    double t0_s = 1700000000.0;
+    *a = (emu_cli){.def = sc_emu_default_def(), .log_iface = "vcan0", .t0_s = 1700000000.0};
+    sc_emu_def *const def = &a->def;
     int have_script = 0;
+    optind = 0; /* glibc: a full re-initialisation, so that it can be called again */
     static const struct option opts[] = {
         {"script", required_argument, 0, 's'},
         {"csv", required_argument, 0, 'c'},
@@ -118,67 +127,67 @@ int main(int argc, char **argv)
         int bad = 0;
         switch (c) {
         case 's':
-            bad = sc_emu_script_from_name(optarg, &def.script) != 0 || def.script == SC_EMU_CSV;
+            bad = sc_emu_script_from_name(optarg, &def->script) != 0 || def->script == SC_EMU_CSV;
             have_script = 1;
             break;
         case 'c':
-            csv = optarg;
-            def.script = SC_EMU_CSV;
+            a->csv = optarg;
+            def->script = SC_EMU_CSV;
             have_script = 1;
             break;
         case 'r':
-            bad = parse_double(optarg, &def.rate_hz) != 0;
+            bad = parse_double(optarg, &def->rate_hz) != 0;
             break;
         case 'd':
-            bad = parse_double(optarg, &def.duration_s) != 0;
+            bad = parse_double(optarg, &def->duration_s) != 0;
             break;
         case 'F':
-            def.fd = 1;
+            def->fd = 1;
             break;
         case 'p':
-            bad = sscanf(optarg, "%f,%f,%f", &def.point_mm[0], &def.point_mm[1],
-                         &def.point_mm[2]) != 3;
+            bad = sscanf(optarg, "%f,%f,%f", &def->point_mm[0], &def->point_mm[1],
+                         &def->point_mm[2]) != 3;
             break;
         case 'D':
             bad = parse_double(optarg, &v) != 0;
-            def.depth_mm = (float)v;
+            def->depth_mm = (float)v;
             break;
         case 'H':
             bad = parse_double(optarg, &v) != 0;
-            def.hover_mm = (float)v;
+            def->hover_mm = (float)v;
             break;
         case 'L':
             bad = parse_double(optarg, &v) != 0;
-            def.length_mm = (float)v;
+            def->length_mm = (float)v;
             break;
         case 'T':
-            bad = parse_double(optarg, &def.period_s) != 0;
+            bad = parse_double(optarg, &def->period_s) != 0;
             break;
         case 'A':
             bad = parse_double(optarg, &v) != 0;
-            def.angle_deg = (float)v;
+            def->angle_deg = (float)v;
             break;
         case 'n':
-            def.force_valid = 0;
+            def->force_valid = 0;
             break;
         case 'f':
-            bad = def.n_faults >= SC_EMU_MAX_FAULTS ||
-                  parse_fault(optarg, &def.faults[def.n_faults++]) != 0;
+            bad = def->n_faults >= SC_EMU_MAX_FAULTS ||
+                  parse_fault(optarg, &def->faults[def->n_faults++]) != 0;
             break;
         case 'S':
-            bad = parse_double(optarg, &def.silence_ms) != 0 || def.silence_ms < 0.0;
+            bad = parse_double(optarg, &def->silence_ms) != 0 || def->silence_ms < 0.0;
             break;
         case 'i':
-            iface = optarg;
+            a->iface = optarg;
             break;
         case 'l':
-            log_path = optarg;
+            a->log_path = optarg;
             break;
         case 'I':
-            log_iface = optarg;
+            a->log_iface = optarg;
             break;
         case 't':
-            bad = parse_double(optarg, &t0_s) != 0 || t0_s < 0.0;
+            bad = parse_double(optarg, &a->t0_s) != 0 || !(a->t0_s >= 0.0 && a->t0_s < 1e11);
             break;
         case 'h':
             usage();
@@ -193,10 +202,24 @@ int main(int argc, char **argv)
             return 2;
         }
     }
-    if (!have_script || (iface == NULL) == (log_path == NULL) || optind != argc) {
+    if (!have_script || (a->iface == NULL) == (a->log_path == NULL) || optind != argc) {
         usage();
         return 2;
     }
+    return -1;
+}
+
+int main(int argc, char **argv)
+{
+    emu_cli a;
+    const int parsed = parse_cli(argc, argv, &a);
+    if (parsed >= 0) {
+        return parsed;
+    }
+    sc_emu_def def = a.def;
+    const char *const iface = a.iface, *const log_path = a.log_path, *const log_iface = a.log_iface;
+    const char *const csv = a.csv;
+    const double t0_s = a.t0_s;
     if (csv) {
         FILE *fp = fopen(csv, "r");
         if (fp == NULL) {

@@ -311,14 +311,17 @@ static int parse_double(const char *s, double *out)
     return 0;
 }
 
-int main(int argc, char **argv)
+/* The command line into *o (nothing else is touched: tests/fuzz/fuzz_cli_viewer.c calls it).
+ * Returns -1 to go on, 0 after --help or --version, 2 for a usage error. */
+static int parse_opts(int argc, char **argv, vw_opts *o)
 {
-    vw_opts o = {.bind_addr = "0.0.0.0",
-                 .port = 5600u,
-                 .png_every = 1u,
-                 .gif_every = 2u,
-                 .width = 640u,
-                 .height = 640u};
+    *o = (vw_opts){.bind_addr = "0.0.0.0",
+                   .port = 5600u,
+                   .png_every = 1u,
+                   .gif_every = 2u,
+                   .width = 640u,
+                   .height = 640u};
+    optind = 0; /* glibc: a full re-initialisation, so that it can be called again */
     enum {
         OPT_HEADLESS = 1000,
         OPT_IDLE,
@@ -356,37 +359,37 @@ int main(int argc, char **argv)
                 fprintf(stderr, "sc-viewer: --port %s: expected 1..65535\n", optarg);
                 return 2;
             }
-            o.port = (uint16_t)u;
+            o->port = (uint16_t)u;
             break;
         case 'b':
-            o.bind_addr = optarg;
+            o->bind_addr = optarg;
             break;
         case OPT_HEADLESS:
-            o.headless = 1;
+            o->headless = 1;
             break;
         case 'n':
-            if (parse_u64(optarg, &o.frames)) {
+            if (parse_u64(optarg, &o->frames)) {
                 fprintf(stderr, "sc-viewer: --frames %s: expected a count\n", optarg);
                 return 2;
             }
             break;
         case 't':
-            if (parse_double(optarg, &o.seconds)) {
+            if (parse_double(optarg, &o->seconds)) {
                 fprintf(stderr, "sc-viewer: --seconds %s: expected seconds\n", optarg);
                 return 2;
             }
             break;
         case OPT_IDLE:
-            if (parse_double(optarg, &o.idle_s)) {
+            if (parse_double(optarg, &o->idle_s)) {
                 fprintf(stderr, "sc-viewer: --idle %s: expected seconds\n", optarg);
                 return 2;
             }
             break;
         case OPT_PNG:
-            o.png_dir = optarg;
+            o->png_dir = optarg;
             break;
         case OPT_HOLD:
-            if (parse_double(optarg, &o.hold_s) || o.hold_s > 3600.0) {
+            if (parse_double(optarg, &o->hold_s) || o->hold_s > 3600.0) {
                 fprintf(stderr, "sc-viewer: --hold %s: expected seconds\n", optarg);
                 return 2;
             }
@@ -399,16 +402,16 @@ int main(int argc, char **argv)
                 return 2;
             }
             if (c == OPT_PNG_EVERY) {
-                o.png_every = (uint32_t)u;
+                o->png_every = (uint32_t)u;
             } else {
-                o.gif_every = (uint32_t)u;
+                o->gif_every = (uint32_t)u;
             }
             break;
         case OPT_GIF:
-            o.gif_path = optarg;
+            o->gif_path = optarg;
             break;
         case OPT_SHOT:
-            o.screenshot = optarg;
+            o->screenshot = optarg;
             break;
         case OPT_SIZE: {
             unsigned w = 0, h = 0;
@@ -418,12 +421,12 @@ int main(int argc, char **argv)
                 fprintf(stderr, "sc-viewer: --size %s: expected WxH, 64..4096\n", optarg);
                 return 2;
             }
-            o.width = w;
-            o.height = h;
+            o->width = w;
+            o->height = h;
             break;
         }
         case 'q':
-            o.quiet = 1;
+            o->quiet = 1;
             break;
         case 'h':
             usage(stdout);
@@ -439,6 +442,16 @@ int main(int argc, char **argv)
     if (optind < argc) {
         fprintf(stderr, "sc-viewer: unexpected argument %s\n", argv[optind]);
         return 2;
+    }
+    return -1;
+}
+
+int main(int argc, char **argv)
+{
+    vw_opts o;
+    const int parsed = parse_opts(argc, argv, &o);
+    if (parsed >= 0) {
+        return parsed;
     }
     if (o.png_dir) {
         struct stat sb;

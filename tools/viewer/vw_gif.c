@@ -1,161 +1,114 @@
-/* vw_gif.c: animated GIF writer (see vw_gif.h). LZW after the GIF89a specification, appendix F:
- * variable code width from 9 to 12 bits, a clear code when the table is full. */
+/* vw_gif.c: animated GIF through giflib's streaming writer (see vw_gif.h). */
 #include "vw_gif.h"
 
+#include <gif_lib.h>
 #include <stdlib.h>
 #include <string.h>
 
-static void put_bytes(vw_gif *g, const void *p, size_t n)
+static int fail(vw_gif *g, int code)
 {
-    if (!g->err && fwrite(p, 1, n, g->f) != n) {
-        g->err = 1;
+    if (!g->err) {
+        g->err = code ? code : E_GIF_ERR_WRITE_FAILED;
     }
+    return -1;
 }
 
-static void put_u16(vw_gif *g, uint16_t v)
+/* A failed open leaves nothing behind to close. */
+static int fail_open(vw_gif *g, int code)
 {
-    uint8_t b[2] = {(uint8_t)v, (uint8_t)(v >> 8)};
-    put_bytes(g, b, 2);
-}
-
-static void flush_block(vw_gif *g)
-{
-    if (g->block_n) {
-        uint8_t n = (uint8_t)g->block_n;
-        put_bytes(g, &n, 1);
-        put_bytes(g, g->block, g->block_n);
-        g->block_n = 0;
-    }
-}
-
-static void reset_dict(vw_gif *g)
-{
-    for (uint32_t i = 0; i < g->used_n; i++) {
-        g->dict[g->used[i]] = 0;
-    }
-    g->used_n = 0;
-}
-
-static void put_code(vw_gif *g, uint32_t code, uint32_t width)
-{
-    g->bits |= code << g->nbits;
-    g->nbits += width;
-    while (g->nbits >= 8u) {
-        g->block[g->block_n++] = (uint8_t)g->bits;
-        g->bits >>= 8;
-        g->nbits -= 8u;
-        if (g->block_n == 255u) {
-            flush_block(g);
-        }
-    }
+    fail(g, code);
+    const int err = g->err;
+    (void)vw_gif_close(g);
+    g->err = err;
+    return -1;
 }
 
 int vw_gif_open(vw_gif *g, const char *path, uint16_t width, uint16_t height,
                 const uint8_t palette[768])
 {
     memset(g, 0, sizeof *g);
-    g->dict = calloc(4096u * 256u, sizeof(uint16_t));
-    if (!g->dict) {
-        return -1;
+    if (width == 0u || height == 0u) {
+        return fail(g, E_GIF_ERR_DATA_TOO_BIG);
     }
-    g->f = fopen(path, "wb");
-    if (!g->f) {
-        free(g->dict);
-        g->dict = NULL;
-        return -1;
+    g->row = malloc(width);
+    if (!g->row) {
+        return fail(g, E_GIF_ERR_NOT_ENOUGH_MEM);
     }
+    int err = 0;
+    GifFileType *gif = EGifOpenFileName(path, false, &err);
+    if (!gif) {
+        free(g->row);
+        g->row = NULL;
+        return fail(g, err);
+    }
+    g->gif = gif;
     g->width = width;
     g->height = height;
-    put_bytes(g, "GIF89a", 6);
-    put_u16(g, width);
-    put_u16(g, height);
-    const uint8_t lsd[3] = {0xF7, 0, 0}; /* global table of 256, 8-bit colour resolution */
-    put_bytes(g, lsd, 3);
-    put_bytes(g, palette, 768);
+    EGifSetGifVersion(gif, true); /* GIF89a: delays and the loop extension */
+    GifColorType colours[256];
+    for (int i = 0; i < 256; i++) {
+        colours[i].Red = palette[3 * i];
+        colours[i].Green = palette[3 * i + 1];
+        colours[i].Blue = palette[3 * i + 2];
+    }
+    ColorMapObject *map = GifMakeMapObject(256, colours);
+    if (!map) {
+        return fail_open(g, E_GIF_ERR_NOT_ENOUGH_MEM);
+    }
+    const int rc = EGifPutScreenDesc(gif, width, height, 8, 0, map);
+    GifFreeMapObject(map); /* the screen descriptor keeps its own copy */
+    if (rc != GIF_OK) {
+        return fail_open(g, gif->Error);
+    }
     /* NETSCAPE2.0 application extension: loop forever */
-    const uint8_t loop[19] = {0x21, 0xFF, 0x0B, 'N', 'E',  'T',  'S',  'C',  'A', 'P',
-                              'E',  '2',  '.',  '0', 0x03, 0x01, 0x00, 0x00, 0x00};
-    put_bytes(g, loop, sizeof loop);
-    return g->err ? -1 : 0;
+    static const GifByteType app[11] = {'N', 'E', 'T', 'S', 'C', 'A', 'P', 'E', '2', '.', '0'};
+    static const GifByteType loop[3] = {1, 0, 0};
+    if (EGifPutExtensionLeader(gif, APPLICATION_EXT_FUNC_CODE) != GIF_OK ||
+        EGifPutExtensionBlock(gif, sizeof app, app) != GIF_OK ||
+        EGifPutExtensionBlock(gif, sizeof loop, loop) != GIF_OK ||
+        EGifPutExtensionTrailer(gif) != GIF_OK) {
+        return fail_open(g, gif->Error);
+    }
+    return 0;
 }
 
 int vw_gif_add(vw_gif *g, const uint8_t *index, uint16_t delay_cs)
 {
-    if (!g->f) {
+    GifFileType *gif = g->gif;
+    if (!gif || g->err) {
         return -1;
     }
-    const uint8_t gce[4] = {0x21, 0xF9, 0x04, 0x00};
-    put_bytes(g, gce, 4);
-    put_u16(g, delay_cs);
-    const uint8_t gce_end[2] = {0x00, 0x00};
-    put_bytes(g, gce_end, 2);
-    const uint8_t desc = 0x2C;
-    put_bytes(g, &desc, 1);
-    put_u16(g, 0);
-    put_u16(g, 0);
-    put_u16(g, g->width);
-    put_u16(g, g->height);
-    const uint8_t flags_min[2] = {0x00, 8u}; /* no local table; LZW minimum code size 8 */
-    put_bytes(g, flags_min, 2);
-
-    const uint32_t clear = 256u, eoi = 257u;
-    uint32_t width = 9u, next = 258u;
-    reset_dict(g);
-    g->bits = 0;
-    g->nbits = 0;
-    g->block_n = 0;
-    put_code(g, clear, width);
-    const size_t n = (size_t)g->width * g->height;
-    uint32_t prefix = index[0];
-    for (size_t i = 1; i < n; i++) {
-        const uint8_t c = index[i];
-        const uint16_t child = g->dict[prefix * 256u + c];
-        if (child) {
-            prefix = child;
-            continue;
-        }
-        put_code(g, prefix, width);
-        if (next < 4096u) {
-            if (next == (1u << width)) {
-                width++;
-            }
-            g->dict[prefix * 256u + c] = (uint16_t)next++;
-            g->used[g->used_n++] = prefix * 256u + c;
-        } else {
-            put_code(g, clear, width);
-            reset_dict(g);
-            width = 9u;
-            next = 258u;
-        }
-        prefix = c;
+    GraphicsControlBlock gcb = {.DisposalMode = DISPOSAL_UNSPECIFIED,
+                                .UserInputFlag = false,
+                                .DelayTime = delay_cs,
+                                .TransparentColor = NO_TRANSPARENT_COLOR};
+    GifByteType ext[4];
+    const size_t ext_n = EGifGCBToExtension(&gcb, ext);
+    if (EGifPutExtension(gif, GRAPHICS_EXT_FUNC_CODE, (int)ext_n, ext) != GIF_OK ||
+        EGifPutImageDesc(gif, 0, 0, g->width, g->height, false, NULL) != GIF_OK) {
+        return fail(g, gif->Error);
     }
-    put_code(g, prefix, width);
-    put_code(g, eoi, width);
-    if (g->nbits) {
-        g->block[g->block_n++] = (uint8_t)g->bits;
-        g->bits = 0;
-        g->nbits = 0;
+    for (uint32_t y = 0; y < g->height; y++) {
+        memcpy(g->row, index + (size_t)y * g->width, g->width);
+        if (EGifPutLine(gif, g->row, g->width) != GIF_OK) {
+            return fail(g, gif->Error);
+        }
     }
-    flush_block(g);
-    const uint8_t term = 0;
-    put_bytes(g, &term, 1);
     g->frames++;
-    return g->err ? -1 : 0;
+    return 0;
 }
 
 int vw_gif_close(vw_gif *g)
 {
-    int rc = 0;
-    if (g->f) {
-        const uint8_t trailer = 0x3B;
-        put_bytes(g, &trailer, 1);
-        if (fclose(g->f) != 0) {
-            g->err = 1;
+    int rc = g->err ? -1 : 0;
+    if (g->gif) {
+        int err = 0;
+        if (EGifCloseFile(g->gif, &err) != GIF_OK) {
+            rc = fail(g, err);
         }
-        g->f = NULL;
-        rc = g->err ? -1 : 0;
+        g->gif = NULL;
     }
-    free(g->dict);
-    g->dict = NULL;
+    free(g->row);
+    g->row = NULL;
     return rc;
 }
