@@ -49,8 +49,10 @@ static void pose(uint32_t k, double m[16])
     m[15] = 1.0;
 }
 
-/* write the sweep (every `step`-th frame) as NAME */
-static void write_sweep(const char *name, uint32_t step, char *path, size_t n)
+/* write the sweep (every `step`-th frame) as NAME, frames stored in PLUS orientation `orient`
+ * (MF: as acquired; UN: mirrored both ways) */
+static void write_sweep_as(const char *name, uint32_t step, const char *orient, char *path,
+                           size_t n)
 {
     snprintf(path, n, "%s/%s", g_dir, name);
     FILE *f = fopen(path, "wb");
@@ -60,9 +62,9 @@ static void write_sweep(const char *name, uint32_t step, char *path, size_t n)
             "ObjectType = Image\nNDims = 3\nAnatomicalOrientation = RAI\nBinaryData = True\n"
             "BinaryDataByteOrderMSB = False\nCompressedData = False\nDimSize = %u %u %u\n"
             "ElementNumberOfChannels = 1\nElementSpacing = %g %g 1\nElementType = MET_UCHAR\n"
-            "Kinds = domain domain list\nUltrasoundImageOrientation = MF\n"
+            "Kinds = domain domain list\nUltrasoundImageOrientation = %s\n"
             "UltrasoundImageType = BRIGHTNESS\n",
-            W, H, nf, PX, PX);
+            W, H, nf, PX, PX, orient);
     uint32_t fi = 0;
     for (uint32_t k = 0; k < NF; k += step, fi++) {
         double m[16];
@@ -92,7 +94,9 @@ static void write_sweep(const char *name, uint32_t step, char *path, size_t n)
                                                           m[4] * iu + m[5] * iv + m[7],
                                                           m[8] * iu + m[9] * iv + m[11],
                                                       };
-                px[v * W + u] = (uint8_t)lrint(field(p));
+                const uint32_t su = orient[0] == 'U' ? W - 1u - u : u;
+                const uint32_t sv = orient[1] == 'N' ? H - 1u - v : v;
+                px[sv * W + su] = (uint8_t)lrint(field(p));
             }
         }
         assert_int_equal(fwrite(px, 1, sizeof px, f), sizeof px);
@@ -100,6 +104,11 @@ static void write_sweep(const char *name, uint32_t step, char *path, size_t n)
     memset(px, 255, sizeof px); /* the invalid frame's pixels: would show if used */
     assert_int_equal(fwrite(px, 1, sizeof px, f), sizeof px);
     assert_int_equal(fclose(f), 0);
+}
+
+static void write_sweep(const char *name, uint32_t step, char *path, size_t n)
+{
+    write_sweep_as(name, step, "MF", path, n);
 }
 
 typedef struct err_stats {
@@ -175,6 +184,34 @@ static void sweep_reconstructs_the_phantom_within_stated_error(void **state)
         sc_image_free(&v);
     }
     sc_plusseq_free(&seq);
+}
+
+static void frames_stored_in_another_orientation_read_as_mf(void **state)
+{
+    (void)state;
+    char path[512], err[256];
+    write_sweep_as("un.igs.mha", 1u, "UN", path, sizeof path);
+    sc_plus_seq seq;
+    int rc = sc_plusseq_read(path, NULL, NULL, &seq, err, sizeof err);
+    if (rc != SC_OK) {
+        fail_msg("%s", err);
+    }
+    assert_true(seq.flip_u && seq.flip_v);
+    sc_recon_opts o = sc_recon_default_opts();
+    sc_image v;
+    sc_recon_stats st;
+    assert_int_equal(sc_reconstruct(&seq, &o, &v, &st, err, sizeof err), SC_OK);
+    const err_stats e = compare(&v);
+    print_message("UN-stored sweep: mean error %.3f, max %.2f; beam [%.2f %.2f %.2f]\n", e.mean,
+                  e.max, st.beam_dir[0], st.beam_dir[1], st.beam_dir[2]);
+    assert_true(e.mean < 0.25 && e.max < 1.2); /* as the MF sweep */
+    assert_true(st.beam_dir[2] < -0.99);
+    sc_image_free(&v);
+    sc_plusseq_free(&seq);
+    write_sweep_as("xx.igs.mha", 4u, "XF", path, sizeof path);
+    assert_int_equal(sc_plusseq_read(path, NULL, NULL, &seq, err, sizeof err),
+                     SC_ERR_NOT_SUPPORTED);
+    assert_non_null(strstr(err, "UltrasoundImageOrientation"));
 }
 
 static void sparse_sweep_holes_are_filled(void **state)
@@ -287,6 +324,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(sweep_reconstructs_the_phantom_within_stated_error),
+        cmocka_unit_test(frames_stored_in_another_orientation_read_as_mf),
         cmocka_unit_test(sparse_sweep_holes_are_filled),
         cmocka_unit_test(import_refuses_a_sequence_and_the_volume_imports),
     };
