@@ -69,18 +69,20 @@ static void write_sweep_as(const char *name, uint32_t step, const char *orient, 
     for (uint32_t k = 0; k < NF; k += step, fi++) {
         double m[16];
         pose(k, m);
-        fprintf(f, "Seq_Frame%04u_FrameNumber = %u\nSeq_Frame%04u_ProbeToTrackerTransform =", fi,
-                k, fi);
+        fprintf(f, "Seq_Frame%04u_FrameNumber = %u\nSeq_Frame%04u_ProbeToTrackerTransform =", fi, k,
+                fi);
         for (int i = 0; i < 16; i++) {
             fprintf(f, " %.17g", m[i]);
         }
-        fprintf(f, "\nSeq_Frame%04u_ProbeToTrackerTransformStatus = OK\n"
-                   "Seq_Frame%04u_Timestamp = %.3f\n",
+        fprintf(f,
+                "\nSeq_Frame%04u_ProbeToTrackerTransformStatus = OK\n"
+                "Seq_Frame%04u_Timestamp = %.3f\n",
                 fi, fi, 0.05 * k);
     }
     /* a frame whose tracking was lost: a wrong pose 50 mm away, status INVALID */
-    fprintf(f, "Seq_Frame%04u_ProbeToTrackerTransform = 1 0 0 50 0 1 0 50 0 0 1 50 0 0 0 1\n"
-               "Seq_Frame%04u_ProbeToTrackerTransformStatus = INVALID\n",
+    fprintf(f,
+            "Seq_Frame%04u_ProbeToTrackerTransform = 1 0 0 50 0 1 0 50 0 0 1 50 0 0 0 1\n"
+            "Seq_Frame%04u_ProbeToTrackerTransformStatus = INVALID\n",
             fi, fi);
     fprintf(f, "ElementDataFile = LOCAL\n");
     static uint8_t px[W * H];
@@ -89,11 +91,12 @@ static void write_sweep_as(const char *name, uint32_t step, const char *orient, 
         pose(k, m);
         for (uint32_t v = 0; v < H; v++) {
             for (uint32_t u = 0; u < W; u++) {
-                const double iu = PX * u, iv = PX * v, p[3] = {
-                                                          m[0] * iu + m[1] * iv + m[3],
-                                                          m[4] * iu + m[5] * iv + m[7],
-                                                          m[8] * iu + m[9] * iv + m[11],
-                                                      };
+                const double iu = PX * u, iv = PX * v,
+                             p[3] = {
+                                 m[0] * iu + m[1] * iv + m[3],
+                                 m[4] * iu + m[5] * iv + m[7],
+                                 m[8] * iu + m[9] * iv + m[11],
+                             };
                 const uint32_t su = orient[0] == 'U' ? W - 1u - u : u;
                 const uint32_t sv = orient[1] == 'N' ? H - 1u - v : v;
                 px[sv * W + su] = (uint8_t)lrint(field(p));
@@ -169,8 +172,8 @@ static void sweep_reconstructs_the_phantom_within_stated_error(void **state)
                       "error vs the phantom over %llu voxels: mean %.3f, max %.2f grey levels\n",
                       trilinear ? "trilinear" : "nearest", v.dim[0], v.dim[1], v.dim[2],
                       100.0 * (double)st.filled / (double)st.voxels,
-                      100.0 * (double)st.hole_filled / (double)st.voxels,
-                      (unsigned long long)e.n, e.mean, e.max);
+                      100.0 * (double)st.hole_filled / (double)st.voxels, (unsigned long long)e.n,
+                      e.mean, e.max);
         /* the bounds stated in docs/case-format.md (measured: nearest mean 0.256, max 1.21;
          * trilinear mean 0.150, max 0.66 grey levels) */
         assert_true(e.n > 10000u);
@@ -241,7 +244,7 @@ static void sparse_sweep_holes_are_filled(void **state)
                   100.0 * (double)st.hole_filled / (double)st.voxels, e0.mean, e.mean, e.max);
     assert_true(st.hole_filled > 0u);
     assert_true(e0.mean > 10.0); /* the holes are there without filling */
-    assert_true(e.mean < 1.0); /* measured 0.706, max 4.48 */
+    assert_true(e.mean < 1.0);   /* measured 0.706, max 4.48 */
     assert_true(e.max < 6.0);
     sc_image_free(&v);
     sc_plusseq_free(&seq);

@@ -191,8 +191,8 @@ int sc_plusseq_read(const char *path, const sc_read_limits *lim_in, const char *
     free(have);
     if (rc == SC_OK && missing < nf) {
         rc = fail(err, errlen, SC_ERR_PARSE,
-                  "%s: frame %u has no Seq_Frame%04u_%sTransform (--transform names another)",
-                  path, missing, missing, tname);
+                  "%s: frame %u has no Seq_Frame%04u_%sTransform (--transform names another)", path,
+                  missing, missing, tname);
     }
     if (rc == SC_OK && nvalid < 2u) {
         rc = fail(err, errlen, SC_ERR_PARSE, "%s: %u frames with a valid %s transform (2 needed)",
@@ -388,8 +388,7 @@ int sc_reconstruct(const sc_plus_seq *seq, const sc_recon_opts *o, sc_image *vol
                     for (int dl = -1; dl <= 1; dl++) {
                         for (int dj = -1; dj <= 1; dj++) {
                             for (int di = -1; di <= 1; di++) {
-                                const long ii = (long)i + di, jj = (long)j + dj,
-                                           ll = (long)l + dl;
+                                const long ii = (long)i + di, jj = (long)j + dj, ll = (long)l + dl;
                                 if (ii < 0 || jj < 0 || ll < 0 || ii >= (long)dim[0] ||
                                     jj >= (long)dim[1] || ll >= (long)dim[2]) {
                                     continue;

@@ -52,11 +52,11 @@ int sc_plusseq_read(const char *path, const sc_read_limits *lim, const char *tra
 void sc_plusseq_free(sc_plus_seq *seq);
 
 typedef struct sc_recon_opts {
-    double spacing_mm;        /* output voxel size, 0.05 .. 10 mm (default 0.5) */
-    int trilinear;            /* 0: pixel-nearest splatting, 1: trilinear (default) */
-    uint32_t fill_passes;     /* hole-filling passes, 0 .. 64 (default 3) */
+    double spacing_mm;         /* output voxel size, 0.05 .. 10 mm (default 0.5) */
+    int trilinear;             /* 0: pixel-nearest splatting, 1: trilinear (default) */
+    uint32_t fill_passes;      /* hole-filling passes, 0 .. 64 (default 3) */
     double image_to_probe[12]; /* affine: 3x3 row-major then translation (mm) */
-    uint64_t max_voxels;      /* ceiling of the output grid (checked before allocating) */
+    uint64_t max_voxels;       /* ceiling of the output grid (checked before allocating) */
 } sc_recon_opts;
 
 sc_recon_opts sc_recon_default_opts(void);
