@@ -4,7 +4,8 @@
 # MetaImage header written by Python, LPS with AnatomicalOrientation, depth +j; pydicom: an
 # axial DICOM series, depth along the rows) -> sc-casebuild import with the defaults (depth
 # from the file's patient frame, mesh box from the labels, registration of the tracker
-# emulator) -> the engine on the host simulator pressing 8 mm at the mesh box's top centre.
+# emulator) -> the engine on the host simulator pressing 8 mm at the mesh box's top centre
+# (3 s: hover, descend, hold; the press script's deepest point).
 # Checks: the three cases have the same label map (the frame was found in each file), and in
 # each the vein collapses (min area ratio < 0.5) while the artery holds (> 0.8), running.
 #   e2e_import_press.sh SC_CASEBUILD SC_HOSTSIM SOURCE_DIR WORK_DIR
@@ -26,7 +27,7 @@ for f in nrrd mha dicom; do
     fi
     "$cb" info "$work/$f.scase" | grep -q "labels found.* vein artery" || { echo "e2e: $f: info lacks vein/artery" >&2; fail=1; }
     mkdir -p "$work/out-$f"
-    "$hs" --case "$work/$f.scase" --out "$work/out-$f" --every 0 --quiet > "$work/out-$f/stdout.txt"
+    "$hs" --case "$work/$f.scase" --out "$work/out-$f" --every 0 --quiet --seconds 3 > "$work/out-$f/stdout.txt"
     line=$(grep "^compression" "$work/out-$f/summary.txt")
     state=$(grep "^final state" "$work/out-$f/summary.txt")
     vein=$(sed -n 's/.*min vein area ratio \([0-9.]*\) .*/\1/p' <<< "$line")
@@ -38,4 +39,17 @@ for f in nrrd mha dicom; do
     fi
     grep -q "running" <<< "$state" || { echo "e2e: $f: $state" >&2; fail=1; }
 done
+# A case without a vein label (the segmentation's vein named muscle): info lists the vein as
+# absent, the host simulator's summary says so instead of a -1 ratio and still writes the
+# deepest press's image.
+novein=${map/2=vein/2=muscle}
+"$cb" import --volume "$work/in/nrrd/vol.nrrd" --labels "$work/in/nrrd/lab.nrrd" --label-map "$novein" -o "$work/novein.scase" > /dev/null
+"$cb" info "$work/novein.scase" | grep -q "labels absent.* vein" || { echo "e2e: novein: info does not list the vein as absent" >&2; fail=1; }
+mkdir -p "$work/out-novein"
+"$hs" --case "$work/novein.scase" --out "$work/out-novein" --every 0 --quiet --seconds 3 > /dev/null
+line=$(grep "^compression" "$work/out-novein/summary.txt")
+echo "novein: $line"
+grep -q "no vein label in the case; deepest press at frame" <<< "$line" || { echo "e2e: novein: $line" >&2; fail=1; }
+grep -q -- "-1" <<< "$line" && { echo "e2e: novein: a -1 ratio in the summary" >&2; fail=1; }
+[ -f "$work/out-novein/deepest_compression.png" ] || { echo "e2e: novein: no deepest_compression.png" >&2; fail=1; }
 exit $fail

@@ -187,8 +187,7 @@ static void depth_and_lateral_options_permute_and_flip_exactly(void **state)
     fill_source();
     char hdr[512];
     snprintf(hdr, sizeof hdr,
-             "NRRD0004\ntype: uchar\ndimension: 3\nsizes: %u %u %u\nencoding: raw\n\n", DX, DY,
-             DZ);
+             "NRRD0004\ntype: uchar\ndimension: 3\nsizes: %u %u %u\nencoding: raw\n\n", DX, DY, DZ);
     write_file("plain.nrrd", hdr, g_vox, N);
     sc_import_result r;
     char err[256];
@@ -335,8 +334,10 @@ static void label_map_names_source_values_and_refuses_unknowns(void **state)
     if (rc != SC_OK) {
         fail_msg("%s", err);
     }
-    const uint8_t want_of[41] = {[0] = SC_LABEL_OUTSIDE, [10] = SC_LABEL_MUSCLE,
-                                 [20] = SC_LABEL_VEIN,   [30] = SC_LABEL_ARTERY,
+    const uint8_t want_of[41] = {[0] = SC_LABEL_OUTSIDE,
+                                 [10] = SC_LABEL_MUSCLE,
+                                 [20] = SC_LABEL_VEIN,
+                                 [30] = SC_LABEL_ARTERY,
                                  [40] = SC_LABEL_BONE};
     for (size_t i = 0; i < sizeof g_lab; i++) {
         assert_int_equal(r.labels[i], want_of[g_lab[i]]);

@@ -41,8 +41,8 @@ static inline const char *sc_fuzz_import_dir(void)
     return dir;
 }
 
-static inline void sc_fuzz_import_put(const char *name, const uint8_t *data, size_t size, char *path,
-                               size_t n)
+static inline void sc_fuzz_import_put(const char *name, const uint8_t *data, size_t size,
+                                      char *path, size_t n)
 {
     snprintf(path, n, "%s/%s", sc_fuzz_import_dir(), name);
     FILE *f = fopen(path, "wb");

@@ -140,6 +140,15 @@ int sc_plusseq_read(const char *path, const sc_read_limits *lim_in, const char *
         if (strcasecmp(key, "ElementDataFile") == 0) {
             break;
         }
+        if (strcasecmp(key, "UltrasoundImageOrientation") == 0) {
+            if (strlen(val) != 2u || strchr("MU", val[0]) == NULL || strchr("FN", val[1]) == NULL) {
+                rc = fail(err, errlen, SC_ERR_NOT_SUPPORTED,
+                          "%s: UltrasoundImageOrientation '%s' (MF, UF, MN or UN)", path, val);
+            }
+            seq->flip_u = val[0] == 'U';
+            seq->flip_v = val[1] == 'N';
+            continue;
+        }
         if (strncmp(key, "Seq_Frame", 9) != 0) {
             continue;
         }
@@ -182,8 +191,8 @@ int sc_plusseq_read(const char *path, const sc_read_limits *lim_in, const char *
     free(have);
     if (rc == SC_OK && missing < nf) {
         rc = fail(err, errlen, SC_ERR_PARSE,
-                  "%s: frame %u has no Seq_Frame%04u_%sTransform (--transform names another)",
-                  path, missing, missing, tname);
+                  "%s: frame %u has no Seq_Frame%04u_%sTransform (--transform names another)", path,
+                  missing, missing, tname);
     }
     if (rc == SC_OK && nvalid < 2u) {
         rc = fail(err, errlen, SC_ERR_PARSE, "%s: %u frames with a valid %s transform (2 needed)",
@@ -227,6 +236,18 @@ static void frame_map(const sc_plus_seq *seq, const sc_recon_opts *o, uint32_t k
         ev[r] = cv * sy;
         base[r] = c0 + t[r * 4 + 3];
     }
+    /* a stored pixel (u, v) of a U? or ?N frame is the MF pixel (W-1-u, v) or (u, H-1-v) */
+    const double wm = (double)(seq->frames.dim[0] - 1u), hm = (double)(seq->frames.dim[1] - 1u);
+    for (int r = 0; r < 3; r++) {
+        if (seq->flip_u) {
+            base[r] += wm * eu[r];
+            eu[r] = -eu[r];
+        }
+        if (seq->flip_v) {
+            base[r] += hm * ev[r];
+            ev[r] = -ev[r];
+        }
+    }
 }
 
 int sc_reconstruct(const sc_plus_seq *seq, const sc_recon_opts *o, sc_image *vol,
@@ -266,7 +287,7 @@ int sc_reconstruct(const sc_plus_seq *seq, const sc_recon_opts *o, sc_image *vol
             }
         }
         for (int r = 0; r < 3 && nv > 0.0; r++) {
-            beam[r] += ev[r] / nv;
+            beam[r] += (seq->flip_v ? -ev[r] : ev[r]) / nv; /* the MF depth direction */
         }
     }
     const double sp = o->spacing_mm;
@@ -367,8 +388,7 @@ int sc_reconstruct(const sc_plus_seq *seq, const sc_recon_opts *o, sc_image *vol
                     for (int dl = -1; dl <= 1; dl++) {
                         for (int dj = -1; dj <= 1; dj++) {
                             for (int di = -1; di <= 1; di++) {
-                                const long ii = (long)i + di, jj = (long)j + dj,
-                                           ll = (long)l + dl;
+                                const long ii = (long)i + di, jj = (long)j + dj, ll = (long)l + dl;
                                 if (ii < 0 || jj < 0 || ll < 0 || ii >= (long)dim[0] ||
                                     jj >= (long)dim[1] || ll >= (long)dim[2]) {
                                     continue;

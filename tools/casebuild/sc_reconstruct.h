@@ -7,8 +7,11 @@
  * MetaImage of W x H x N 8-bit frames whose header holds, per frame,
  *   Seq_FrameNNNN_<Name>Transform = 16 numbers (a 4x4 matrix, row-major, mm)
  *   Seq_FrameNNNN_<Name>TransformStatus = OK | INVALID   (absent: OK)
- * with <Name> "ProbeToTracker" by default (PLUS's ProbeToReference and others by option).
- * A pixel (u, v) of a frame (u along a row, v down the rows) is the image point
+ * with <Name> "ProbeToTracker" by default (PLUS's ProbeToReference and others by option),
+ * and UltrasoundImageOrientation (PLUS's MF, UF, MN, UN; absent: MF): frames stored in
+ * another orientation are read as MF (U: columns mirrored, N: rows mirrored), as PLUS does.
+ * A pixel (u, v) of an MF frame (u along a row, v down the rows, away from the transducer)
+ * is the image point
  * (u * sx, v * sy, 0) mm (sx, sy: the file's ElementSpacing), carried to the probe by the
  * image-to-probe calibration (an affine 3x4 map, PLUS's ImageToProbe; default identity) and
  * to the tracker by the frame's transform.
@@ -35,6 +38,8 @@ typedef struct sc_plus_seq {
     uint8_t *valid;    /* N: 1 when the frame's transform status is OK */
     uint32_t valid_count;
     char name[64]; /* the transform used, e.g. "ProbeToTracker" */
+    int flip_u;    /* UltrasoundImageOrientation U?: the marked side is on the right */
+    int flip_v;    /* ?N: the transducer (near) at the bottom of the image */
 } sc_plus_seq;
 
 /* Read a PLUS sequence. transform: the <Name> of the per-frame transform (NULL:
@@ -47,11 +52,11 @@ int sc_plusseq_read(const char *path, const sc_read_limits *lim, const char *tra
 void sc_plusseq_free(sc_plus_seq *seq);
 
 typedef struct sc_recon_opts {
-    double spacing_mm;        /* output voxel size, 0.05 .. 10 mm (default 0.5) */
-    int trilinear;            /* 0: pixel-nearest splatting, 1: trilinear (default) */
-    uint32_t fill_passes;     /* hole-filling passes, 0 .. 64 (default 3) */
+    double spacing_mm;         /* output voxel size, 0.05 .. 10 mm (default 0.5) */
+    int trilinear;             /* 0: pixel-nearest splatting, 1: trilinear (default) */
+    uint32_t fill_passes;      /* hole-filling passes, 0 .. 64 (default 3) */
     double image_to_probe[12]; /* affine: 3x3 row-major then translation (mm) */
-    uint64_t max_voxels;      /* ceiling of the output grid (checked before allocating) */
+    uint64_t max_voxels;       /* ceiling of the output grid (checked before allocating) */
 } sc_recon_opts;
 
 sc_recon_opts sc_recon_default_opts(void);
