@@ -10,11 +10,11 @@
 _Static_assert(SC_MSG_CMD_CASE == 0 && SC_MSG_POSE_FD == 8, "rx message indices 0..8");
 _Static_assert(SC_TRK_RX_MSGS == (unsigned)SC_MSG_POSE_FD + 1u, "rx state per message");
 _Static_assert(SC_CMD_MSGS == (unsigned)SC_MSG_CMD_SYNC + 1u, "commands first");
-/* 2,192 bytes on x86_64 with the default SC_CAN_CMD_QUEUE_MAX of 8: 9 E2E receivers of 64 B
+/* 2,304 bytes on x86_64 with the default SC_CAN_CMD_QUEUE_MAX of 8: 9 E2E receivers of 64 B
  * and their last payloads (180 B), 2 assembly slots of 56 B, the command FIFO (48 B each),
- * 5 pending commands (72 B each) and last crypto PDUs, the SecOC receiver (256 B), counters
+ * 5 pending commands (72 B each), the last accepted pairs and their times (120 B), the SecOC receiver (256 B), counters
  * (152 B). */
-_Static_assert(sizeof(sc_tracker) <= 1900u + 48u * SC_CAN_CMD_QUEUE_MAX, "tracker state grew");
+_Static_assert(sizeof(sc_tracker) <= 1920u + 48u * SC_CAN_CMD_QUEUE_MAX, "tracker state grew");
 
 sc_tracker_def sc_tracker_default_def(void)
 {
@@ -384,20 +384,23 @@ static sc_trk_outcome auth_outcome(sc_secoc_result r)
 }
 
 /* A cryptographic PDU: pair it with its held command, verify, and queue the command. */
-static sc_trk_outcome on_auth(sc_tracker *t, const sc_can_frame *f, sc_msg m)
+static sc_trk_outcome on_auth(sc_tracker *t, const sc_can_frame *f, sc_msg m, uint64_t ts_ns)
 {
     const unsigned k = (unsigned)m - (unsigned)SC_MSG_AUTH_CASE;
     sc_trk_pending *p = &t->pending[k];
     sc_secoc_auth a;
     sc_secoc_auth_decode(f->data, &a);
+    /* the last accepted cryptographic PDU again: within SC_TRK_AUTH_PAIR_MS a bus duplicate,
+     * later a replay (its freshness is stale); either way never applied twice */
     const int same_auth = t->have_last_auth[k] && memcmp(t->last_auth[k], f->data, 8u) == 0;
+    const int soon = ts_ns >= t->last_auth_ns[k] &&
+                     ts_ns - t->last_auth_ns[k] <= (uint64_t)SC_TRK_AUTH_PAIR_MS * 1000000u;
     if (!p->used || a.link != (p->pdu[1] & 0x0Fu)) {
-        return same_auth ? SC_TRK_DUPLICATE : SC_TRK_AUTH_ORPHAN;
+        return same_auth ? (soon ? SC_TRK_DUPLICATE : SC_TRK_AUTH_STALE) : SC_TRK_AUTH_ORPHAN;
     }
     p->used = 0u;
     if (same_auth && memcmp(t->last_auth_pdu[k], p->pdu, 8u) == 0) {
-        return SC_TRK_DUPLICATE; /* the last accepted pair again (repeated or replayed):
-                                  * never applied twice */
+        return soon ? SC_TRK_DUPLICATE : SC_TRK_AUTH_STALE;
     }
     const sc_msg cm = (sc_msg)k;
     const uint64_t *sync = p->cmd.kind == SC_CMD_SYNC_FRESHNESS ? &p->cmd.fv_high : NULL;
@@ -408,6 +411,7 @@ static sc_trk_outcome on_auth(sc_tracker *t, const sc_can_frame *f, sc_msg m)
     }
     memcpy(t->last_auth[k], f->data, 8u);
     memcpy(t->last_auth_pdu[k], p->pdu, 8u);
+    t->last_auth_ns[k] = ts_ns;
     t->have_last_auth[k] = 1u;
     if (sync != NULL) {
         return SC_TRK_AUTH_SYNCED;
@@ -437,15 +441,15 @@ static sc_trk_outcome classify_and_handle(sc_tracker *t, const sc_can_frame *f, 
     if (rc != 0) {
         return SC_TRK_BAD_LENGTH;
     }
+    /* receive times at microsecond resolution, the candump log's: a replayed log then gives
+     * every time-dependent decision (speed, timeout) exactly as the live run did */
+    const uint64_t ts_ns = (f->ts_ns != 0u ? f->ts_ns : now_ns) / 1000u * 1000u;
     if (SC_MSG_IS_AUTH(m)) {
-        return on_auth(t, f, m);
+        return on_auth(t, f, m, ts_ns);
     }
     if (m == SC_MSG_POSE_FD && !t->def.accept_fd) {
         return SC_TRK_FD_DISABLED;
     }
-    /* receive times at microsecond resolution, the candump log's: a replayed log then gives
-     * every time-dependent decision (speed, timeout) exactly as the live run did */
-    const uint64_t ts_ns = (f->ts_ns != 0u ? f->ts_ns : now_ns) / 1000u * 1000u;
     sc_e2e_rx *rx = &t->rx[m];
     const uint32_t lost_before = rx->lost;
     const sc_e2e_status s = sc_e2e_check(rx, f->data, f->len, ts_ns);

@@ -29,7 +29,7 @@
  *
  * Thread and memory rules: one sc_tracker object, caller-owned (inside the engine object),
  * used from one thread. Never allocates, never calls the OS; deterministic for a given frame
- * sequence and time stamps. sizeof(sc_tracker) = 2,192 bytes (x86_64, default limits).
+ * sequence and time stamps. sizeof(sc_tracker) = 2,304 bytes (x86_64, default limits).
  */
 #ifndef SC_TRACKER_H
 #define SC_TRACKER_H
@@ -159,6 +159,7 @@ typedef struct sc_tracker {
     uint8_t last_ok[SC_TRK_RX_MSGS][SC_TRK_FRAME_MAX]; /* last usable payload (duplicates) */
     uint8_t last_auth[SC_CMD_MSGS][SC_SECOC_AUTH_PDU_BYTES]; /* last accepted crypto PDU */
     uint8_t last_auth_pdu[SC_CMD_MSGS][8];                    /* and its command */
+    uint64_t last_auth_ns[SC_CMD_MSGS];                       /* and when it came */
     uint8_t have_last_auth[SC_CMD_MSGS];
     sc_trk_pending pending[SC_CMD_MSGS];
     sc_secoc_rx secoc;

@@ -449,6 +449,16 @@ static void final_report(const sc_engine *e, double wall_s, const char *stop_rea
            (unsigned long long)c->case_loads, (unsigned long long)c->case_load_failures,
            (unsigned long long)c->phys_resets, (unsigned long long)c->imaging_errors,
            (unsigned long long)c->watchdog_kicks);
+    const sc_tracker *t = sc_engine_get_tracker(e);
+    const sc_trk_counters *tc = sc_tracker_counters(t);
+    printf("  command authentication: %u authenticated, %llu refused (bad MAC %u, stale %u, "
+           "not synced %u, unknown sender %u, orphan MAC %u, MAC missing %u), %u duplicates\n",
+           (unsigned)sc_tracker_authenticated(t), (unsigned long long)c->commands_auth_refused,
+           (unsigned)tc->outcome[SC_TRK_AUTH_BAD_MAC], (unsigned)tc->outcome[SC_TRK_AUTH_STALE],
+           (unsigned)tc->outcome[SC_TRK_AUTH_NOT_SYNCED],
+           (unsigned)tc->outcome[SC_TRK_AUTH_UNKNOWN_SENDER],
+           (unsigned)tc->outcome[SC_TRK_AUTH_ORPHAN], (unsigned)tc->auth_missing,
+           (unsigned)tc->outcome[SC_TRK_DUPLICATE]);
     printf("  log records dropped %llu\n", (unsigned long long)sc_log_linux_dropped(&g_log));
     fflush(stdout);
     sc_log_linux_msg(&g_log, SC_LOG_INFO, "final_stats",
