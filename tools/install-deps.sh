@@ -8,11 +8,12 @@ set -euo pipefail
 
 base=(build-essential cmake pkg-config libccd-dev libcmocka-dev libpng-dev zlib1g-dev libdrm-dev
       python3-pydicom python3-numpy
-      libdcmtk-dev
+      libdcmtk-dev libmbedtls-dev
       python3 python3-canmatrix libsdl2-dev xvfb xauth can-utils)
 cross=(gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi
        gcc-aarch64-linux-gnu qemu-user-static dpkg-dev)
-cross_arm64=(libcmocka-dev:arm64 libccd-dev:arm64 zlib1g-dev:arm64 libpng-dev:arm64)
+cross_arm64=(libcmocka-dev:arm64 libccd-dev:arm64 zlib1g-dev:arm64 libpng-dev:arm64
+             libmbedtls-dev:arm64)
 hil=(qemu-system-x86 busybox-static can-utils)
 
 if [ "$(id -u)" -ne 0 ]; then
