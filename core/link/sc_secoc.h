@@ -37,10 +37,8 @@
 #include <stdint.h>
 
 #include "sc_aes_cmac.h"
+#include "sc_config.h" /* SC_SECOC_SENDERS */
 
-#ifndef SC_SECOC_SENDERS
-#define SC_SECOC_SENDERS 4u /* freshness states kept: sender ids 0..3 */
-#endif
 #define SC_SECOC_MAX_SENDER_ID   15u
 #define SC_SECOC_FV_TRUNC_BITS   16u
 #define SC_SECOC_MAC_BYTES       5u  /* 40-bit truncated MAC */
@@ -48,7 +46,6 @@
 #define SC_SECOC_INPUT_BYTES     19u /* data id 2 + authentic PDU 8 + sender 1 + freshness 8 */
 #define SC_SECOC_DEFAULT_WINDOW  1024u
 #define SC_SECOC_MAX_WINDOW      32768u /* half the truncated range: rebuilding stays unique */
-_Static_assert(SC_SECOC_SENDERS >= 1u && SC_SECOC_SENDERS <= 16u, "4-bit sender ids");
 
 /* The decoded cryptographic PDU. */
 typedef struct sc_secoc_auth {
