@@ -20,9 +20,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define SC_AES_BLOCK_BYTES 16u
+#define SC_AES_BLOCK_BYTES  16u
 #define SC_AES128_KEY_BYTES 16u
-#define SC_AES128_ROUNDS 10u
+#define SC_AES128_ROUNDS    10u
 
 typedef struct sc_aes128 {
     uint8_t rk[(SC_AES128_ROUNDS + 1u) * SC_AES_BLOCK_BYTES]; /* round keys, 176 bytes */

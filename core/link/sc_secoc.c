@@ -79,8 +79,8 @@ void sc_secoc_sign(const sc_cmac_key *k, uint16_t data_id, const uint8_t pdu[8],
 {
     uint8_t mac[SC_AES_BLOCK_BYTES];
     mac_of(k, data_id, pdu, sender, fv, mac);
-    sc_secoc_auth a = {.sender = sender, .link = (uint8_t)(pdu[1] & 0x0Fu),
-                       .fv_low = (uint16_t)(fv & 0xFFFFu)};
+    sc_secoc_auth a = {
+        .sender = sender, .link = (uint8_t)(pdu[1] & 0x0Fu), .fv_low = (uint16_t)(fv & 0xFFFFu)};
     memcpy(a.mac, mac, SC_SECOC_MAC_BYTES);
     sc_secoc_auth_encode(&a, auth_pdu);
 }

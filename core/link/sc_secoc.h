@@ -39,13 +39,13 @@
 #include "sc_aes_cmac.h"
 #include "sc_config.h" /* SC_SECOC_SENDERS */
 
-#define SC_SECOC_MAX_SENDER_ID   15u
-#define SC_SECOC_FV_TRUNC_BITS   16u
-#define SC_SECOC_MAC_BYTES       5u  /* 40-bit truncated MAC */
-#define SC_SECOC_AUTH_PDU_BYTES  8u
-#define SC_SECOC_INPUT_BYTES     19u /* data id 2 + authentic PDU 8 + sender 1 + freshness 8 */
-#define SC_SECOC_DEFAULT_WINDOW  1024u
-#define SC_SECOC_MAX_WINDOW      32768u /* half the truncated range: rebuilding stays unique */
+#define SC_SECOC_MAX_SENDER_ID  15u
+#define SC_SECOC_FV_TRUNC_BITS  16u
+#define SC_SECOC_MAC_BYTES      5u /* 40-bit truncated MAC */
+#define SC_SECOC_AUTH_PDU_BYTES 8u
+#define SC_SECOC_INPUT_BYTES    19u /* data id 2 + authentic PDU 8 + sender 1 + freshness 8 */
+#define SC_SECOC_DEFAULT_WINDOW 1024u
+#define SC_SECOC_MAX_WINDOW     32768u /* half the truncated range: rebuilding stays unique */
 
 /* The decoded cryptographic PDU. */
 typedef struct sc_secoc_auth {
@@ -81,11 +81,11 @@ extern const uint8_t sc_secoc_bench_key[SC_AES128_KEY_BYTES];
 sc_secoc_def sc_secoc_default_def(void);
 
 typedef enum sc_secoc_result {
-    SC_SECOC_OK = 0,          /* MAC verified, freshness new: the command may be applied */
-    SC_SECOC_UNKNOWN_SENDER,  /* sender id >= SC_SECOC_SENDERS */
-    SC_SECOC_NOT_SYNCED,      /* no sync accepted from this sender yet */
-    SC_SECOC_STALE,           /* freshness not in (last, last + window] (replayed, too old) */
-    SC_SECOC_BAD_MAC,         /* wrong key, altered frame, forged */
+    SC_SECOC_OK = 0,         /* MAC verified, freshness new: the command may be applied */
+    SC_SECOC_UNKNOWN_SENDER, /* sender id >= SC_SECOC_SENDERS */
+    SC_SECOC_NOT_SYNCED,     /* no sync accepted from this sender yet */
+    SC_SECOC_STALE,          /* freshness not in (last, last + window] (replayed, too old) */
+    SC_SECOC_BAD_MAC,        /* wrong key, altered frame, forged */
     SC_SECOC_RESULT_COUNT
 } sc_secoc_result;
 

@@ -12,8 +12,8 @@ _Static_assert(SC_TRK_RX_MSGS == (unsigned)SC_MSG_POSE_FD + 1u, "rx state per me
 _Static_assert(SC_CMD_MSGS == (unsigned)SC_MSG_CMD_SYNC + 1u, "commands first");
 /* 2,304 bytes on x86_64 with the default SC_CAN_CMD_QUEUE_MAX of 8: 9 E2E receivers of 64 B
  * and their last payloads (180 B), 2 assembly slots of 56 B, the command FIFO (48 B each),
- * 5 pending commands (72 B each), the last accepted pairs and their times (120 B), the SecOC receiver (256 B), counters
- * (152 B). */
+ * 5 pending commands (72 B each), the last accepted pairs and their times (120 B), the SecOC
+ * receiver (256 B), counters (152 B). */
 _Static_assert(sizeof(sc_tracker) <= 1920u + 48u * SC_CAN_CMD_QUEUE_MAX, "tracker state grew");
 
 sc_tracker_def sc_tracker_default_def(void)
@@ -135,9 +135,8 @@ int sc_trk_outcome_is_implausible(sc_trk_outcome o)
 
 int sc_trk_outcome_is_auth_reject(sc_trk_outcome o)
 {
-    return o == SC_TRK_AUTH_ORPHAN ||
-           o == SC_TRK_AUTH_UNKNOWN_SENDER || o == SC_TRK_AUTH_NOT_SYNCED ||
-           o == SC_TRK_AUTH_STALE || o == SC_TRK_AUTH_BAD_MAC;
+    return o == SC_TRK_AUTH_ORPHAN || o == SC_TRK_AUTH_UNKNOWN_SENDER ||
+           o == SC_TRK_AUTH_NOT_SYNCED || o == SC_TRK_AUTH_STALE || o == SC_TRK_AUTH_BAD_MAC;
 }
 
 static void inc(uint32_t *c)

@@ -136,9 +136,8 @@ int sc_hs_fault_plan_parse(const char *spec, sc_hs_fault_plan *p, char *why, siz
             e->recover_frames = -1;
         }
     }
-    const int any_random = p->random.drop_ppm || p->random.corrupt_ppm ||
-                           p->random.duplicate_ppm || p->random.reorder_ppm ||
-                           p->random.delay_ns;
+    const int any_random = p->random.drop_ppm || p->random.corrupt_ppm || p->random.duplicate_ppm ||
+                           p->random.reorder_ppm || p->random.delay_ns;
     if (any_random && p->n < SC_HS_FAULTS_MAX_EPISODES) {
         /* the random window as an episode of its own, for the results */
         sc_hs_episode *e = &p->ep[p->n++];
@@ -192,8 +191,8 @@ static sc_fault fault_of(sc_hs_episode_kind k)
     return SC_FAULT_TRACKER_DATA;
 }
 
-static const uint16_t k_flood_ids[] = {0x085, 0x086, 0x087, 0x08D, 0x08E,
-                                       0x08F, 0x103, 0x104, 0x111, 0x555, 0x7FF};
+static const uint16_t k_flood_ids[] = {0x085, 0x086, 0x087, 0x08D, 0x08E, 0x08F,
+                                       0x103, 0x104, 0x111, 0x555, 0x7FF};
 
 static void flood(sc_hs_fault_run *r, const sc_hs_episode *e, uint64_t t)
 {

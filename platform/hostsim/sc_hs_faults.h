@@ -51,17 +51,17 @@ typedef struct sc_hs_episode {
     uint64_t start_ns, end_ns; /* virtual time from the run's start */
     /* results */
     uint8_t started, ended;
-    uint32_t edges_at_start;   /* health raise edges of the episode's fault bit */
-    uint32_t edges;            /* raise edges since the start (during the episode + recovery) */
-    int32_t recover_frames;    /* frames after the end until recovered (1: the first frame
-                                * after the clearing had recovered); -1: not (yet) */
+    uint32_t edges_at_start; /* health raise edges of the episode's fault bit */
+    uint32_t edges;          /* raise edges since the start (during the episode + recovery) */
+    int32_t recover_frames;  /* frames after the end until recovered (1: the first frame
+                              * after the clearing had recovered); -1: not (yet) */
     uint32_t frames_since_end;
     uint32_t untracked_frames; /* frames without a valid pose while the episode ran */
     uint64_t injected;         /* flood frames sent, display calls refused, sends refused */
     uint64_t filtered_at_start;
     uint64_t refused_at_start; /* peer sends refused before the episode */
     uint64_t display_refused_at_start;
-    uint64_t filtered;         /* flood: frames the engine's acceptance filters kept out */
+    uint64_t filtered; /* flood: frames the engine's acceptance filters kept out */
     uint64_t frames_at_start, complete_at_end;
 } sc_hs_episode;
 
@@ -80,13 +80,13 @@ const char *sc_hs_episode_kind_name(sc_hs_episode_kind k);
 typedef struct sc_hs_fault_run {
     sc_hs_fault_plan plan;
     sc_hs_rig *rig;
-    uint64_t t0_ns;        /* virtual time of the run's start */
-    int flood_node;        /* bus node of the flooding stranger, -1: none */
+    uint64_t t0_ns; /* virtual time of the run's start */
+    int flood_node; /* bus node of the flooding stranger, -1: none */
     sc_can_dev flood_dev;
     uint64_t flood_sent;
     uint32_t flood_seq;
-    uint8_t silent;        /* a silence episode is running: tracker frames are discarded */
-    uint64_t silenced;     /* tracker frames discarded */
+    uint8_t silent;         /* a silence episode is running: tracker frames are discarded */
+    uint64_t silenced;      /* tracker frames discarded */
     uint64_t tx_refused_at; /* peer sends refused so far (bus-off) */
 } sc_hs_fault_run;
 

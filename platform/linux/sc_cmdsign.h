@@ -25,10 +25,10 @@
 
 typedef struct sc_cmdsign {
     uint8_t key[SC_AES128_KEY_BYTES];
-    sc_cmac_key ck;  /* the core's CMAC (used when Mbed TLS is absent) */
-    uint8_t sender;  /* 0..SC_SECOC_SENDERS-1 */
+    sc_cmac_key ck;    /* the core's CMAC (used when Mbed TLS is absent) */
+    uint8_t sender;    /* 0..SC_SECOC_SENDERS-1 */
     uint8_t use_clock; /* syncs jump to the wall clock */
-    uint64_t fv;     /* last freshness value used */
+    uint64_t fv;       /* last freshness value used */
     sc_e2e_tx tx[SC_CMD_MSGS];
 } sc_cmdsign;
 

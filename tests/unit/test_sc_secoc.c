@@ -288,8 +288,7 @@ static void two_senders_keep_separate_freshness(void **state)
 static void crypto_pdu_fields_round_trip(void **state)
 {
     (void)state;
-    const sc_secoc_auth a = {.sender = 0xA, .link = 0x5, .fv_low = 0xBEEF,
-                             .mac = {1, 2, 3, 4, 5}};
+    const sc_secoc_auth a = {.sender = 0xA, .link = 0x5, .fv_low = 0xBEEF, .mac = {1, 2, 3, 4, 5}};
     uint8_t b[8];
     sc_secoc_auth_encode(&a, b);
     const uint8_t want[8] = {0x5A, 0xEF, 0xBE, 1, 2, 3, 4, 5};
@@ -310,8 +309,10 @@ static void crypto_pdu_fields_round_trip(void **state)
     uint8_t key[16];
     assert_int_equal(sc_cmdsign_parse_key("736f6e6f636f6d702d62656e63682d31", key), SC_OK);
     assert_memory_equal(key, sc_secoc_bench_key, 16);
-    assert_int_equal(sc_cmdsign_parse_key("736f6e6f636f6d702d62656e63682d3", key), SC_ERR_CFG_VALUE);
-    assert_int_equal(sc_cmdsign_parse_key("x36f6e6f636f6d702d62656e63682d31", key), SC_ERR_CFG_VALUE);
+    assert_int_equal(sc_cmdsign_parse_key("736f6e6f636f6d702d62656e63682d3", key),
+                     SC_ERR_CFG_VALUE);
+    assert_int_equal(sc_cmdsign_parse_key("x36f6e6f636f6d702d62656e63682d31", key),
+                     SC_ERR_CFG_VALUE);
 }
 
 int main(void)
