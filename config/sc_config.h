@@ -190,6 +190,18 @@ _Static_assert((1u << SC_SPRINGS_HASH_BITS) >= 2u * SC_MAX_SPRINGS,
 #endif
 _Static_assert(SC_CAN_CMD_QUEUE_MAX >= 1u && SC_CAN_CMD_QUEUE_MAX <= 255u,
                "command queue length must fit uint8_t");
+/* Command authentication (core/link/sc_secoc.h): senders whose freshness the engine keeps
+ * (ids 0 .. SC_SECOC_SENDERS - 1; 24 bytes each), and how long a command waits for its
+ * cryptographic PDU (sent back to back: 50 ms is 20 frame times at a loaded 500 kbit/s). */
+#ifndef SC_SECOC_SENDERS
+#define SC_SECOC_SENDERS 4u
+#endif
+_Static_assert(SC_SECOC_SENDERS >= 1u && SC_SECOC_SENDERS <= 16u, "4-bit sender ids");
+#ifndef SC_TRK_AUTH_PAIR_MS
+#define SC_TRK_AUTH_PAIR_MS 50u
+#endif
+_Static_assert(SC_TRK_AUTH_PAIR_MS >= 1u && SC_TRK_AUTH_PAIR_MS <= 1000u,
+               "a command waits 1 .. 1000 ms for its MAC");
 /* Clock readings per estimate of the SocketCAN time stamp offset (REALTIME -> MONOTONIC,
  * platform/linux/sc_socketcan.h); the narrowest bracket wins. In the HIL VM under TCG the
  * readings were 0.4-0.5 us wide on average, the widest of ~1100 per run 2-139 us (preempted):

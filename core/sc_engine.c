@@ -75,8 +75,10 @@ static void take_bus_errors(sc_engine *e)
 static void update_tracker_faults(sc_engine *e, uint64_t now, uint8_t tracked)
 {
     const sc_trk_counters *n = sc_tracker_counters(&e->tracker);
+    /* duplicates (nothing lost, nothing wrong) are counted by the tracker but raise nothing */
     const uint32_t rejects = sc_tracker_rejected_e2e(&e->tracker) +
                              sc_tracker_rejected_implausible(&e->tracker) +
+                             sc_tracker_rejected_auth(&e->tracker) +
                              n->outcome[SC_TRK_BAD_LENGTH] + n->outcome[SC_TRK_POSE_STALE] +
                              n->outcome[SC_TRK_CMD_REJECTED];
     if (rejects != e->tracker_rejects_seen) {
@@ -104,6 +106,7 @@ static void stage_rx(sc_engine *e, uint64_t now, sc_probe_in *out)
         e->counters.can_rx_burst_limited++;
     }
     take_bus_errors(e);
+    e->counters.commands_auth_refused = sc_tracker_rejected_auth(&e->tracker);
 
     /* the last pose is kept while lifted (status, getters); the transform is recomputed */
     out->tracked = 0;
@@ -308,6 +311,8 @@ static void apply_command(sc_engine *e, const sc_cmd *c)
     case SC_CMD_SET_IMAGING:
         rc = apply_imaging(e, &c->imaging);
         break;
+    case SC_CMD_SYNC_FRESHNESS: /* consumed by the tracker, never queued */
+        break;
     case SC_CMD_RESET:
         if ((c->reset_target & SC_RESET_TISSUE) && e->case_loaded) {
             sc_tissue_reset(running_tissue(e));
@@ -322,7 +327,8 @@ static void apply_command(sc_engine *e, const sc_cmd *c)
     if (rc == SC_OK) {
         e->counters.commands_applied++;
         sc_health_clear(&e->health, SC_FAULT_CONFIG);
-        sc_log(&e->hal->log, SC_LOG_INFO, "command_applied", SC_OK, (int64_t)c->kind, 0);
+        sc_log(&e->hal->log, SC_LOG_INFO, "command_applied", SC_OK, (int64_t)c->kind,
+               (int64_t)c->sender);
     } else {
         count_refusal(e, "command_refused", rc, (int64_t)c->kind);
     }
@@ -545,11 +551,16 @@ static void control_step(sc_engine *e)
 
 static int set_filters(sc_engine *e)
 {
-    /* the protocol's receive ids: commands 0x080..0x083, classic pose 0x100..0x103 (0x103 is
-     * unused and rejected by the tracker), FD pose 0x110 */
+    /* exactly the protocol's receive ids, so that foreign traffic (a flood at full bus load
+     * included) stays in the controller: commands 0x080..0x084, their cryptographic PDUs
+     * 0x088..0x08C, classic pose 0x100..0x102, FD pose 0x110 */
     const sc_can_filter f[] = {
-        {.id = SC_CANID_CMD_CASE, .mask = 0x7FCu, .flags = 0},
-        {.id = SC_CANID_POSE_POS, .mask = 0x7FCu, .flags = 0},
+        {.id = SC_CANID_CMD_CASE, .mask = 0x7FCu, .flags = 0},  /* 0x080..0x083 */
+        {.id = SC_CANID_CMD_SYNC, .mask = 0x7FFu, .flags = 0},  /* 0x084 */
+        {.id = SC_CANID_AUTH_CASE, .mask = 0x7FCu, .flags = 0}, /* 0x088..0x08B */
+        {.id = SC_CANID_AUTH_SYNC, .mask = 0x7FFu, .flags = 0}, /* 0x08C */
+        {.id = SC_CANID_POSE_POS, .mask = 0x7FEu, .flags = 0},  /* 0x100..0x101 */
+        {.id = SC_CANID_POSE_AUX, .mask = 0x7FFu, .flags = 0},  /* 0x102 */
         {.id = SC_CANID_POSE_FD, .mask = 0x7FFu, .flags = 0},
     };
     const int rc = sc_can_set_filters(&e->hal->can, f, SC_COUNT_OF(f));

@@ -20,8 +20,9 @@
  * (counted and reported, never queued). Worst-case work per stage, bounded by config/ limits:
  *   rx       CAN -> sc_probe_in (the probe's pose in the volume frame, or lifted).
  *            At most SC_CAN_RX_BURST_MAX frames drained into the tracker (E2E, 3-frame pose
- *            assembly, plausibility; commands are queued, not applied), the newest valid pose
- *            carried tracker -> volume frame with the case's registration. O(burst).
+ *            assembly, plausibility; commands authenticated (AES-CMAC and freshness, at most
+ *            one 2-block CMAC per frame drained) and queued, not applied), the newest valid
+ *            pose carried tracker -> volume frame with the case's registration. O(burst).
  *   physics  sc_probe_in -> sc_tissue_out (contact, node state of the tet mesh).
  *            One tissue step (sc_tissue.h): MSDS O(iterations x nodes) or FEM O(iterations x
  *            nonzeros), collider O(contact candidates), skin, stability guard O(nodes).
@@ -143,6 +144,9 @@ typedef struct sc_engine_counters {
     uint64_t can_tx_failed;         /* status frames the controller refused */
     uint64_t commands_applied;
     uint64_t commands_refused;      /* unknown case id, switch busy, bad settings */
+    uint64_t commands_auth_refused; /* commands refused by authentication (sc_secoc.h): no
+                                     * MAC, bad MAC, stale/replayed, unknown or unsynced
+                                     * sender (by reason: the tracker's counters) */
     uint64_t case_loads;            /* switches completed */
     uint64_t case_load_failures;    /* switches refused (storage, validation, rebuild) */
     int last_case_error;            /* sc_err of the last refused case */

@@ -4,7 +4,10 @@
 # (platform/dlink/sc_dlink.c assembler). Checks:
 #  1. nothing injected: every line of every frame arrives (lines_lost = 0, all frames complete);
 #  2. 2% loss injected at the sender: the viewer counts exactly the injected lines as lost;
-#  3. the viewer's recordings exist (PNG frames, an animated GIF with frames in it).
+#  3. the viewer's recordings exist (PNG frames, an animated GIF with frames in it);
+#  4. the viewer accepts datagrams only from its configured sender: with --sender 127.0.0.2
+#     every datagram of the sender (from 127.0.0.1) is refused and counted, no frame is shown;
+#     a non-loopback --bind without --sender is a usage error.
 set -eu
 VIEWER=$1
 SENDER=$2
@@ -39,6 +42,7 @@ run_pair clean 0 --record-png "$WORK/png" --png-every 30 --gif "$WORK/session.gi
 [ "$(field lines_lost "$WORK/clean.viewer")" = 0 ] || fail "clean: lines lost"
 [ "$(field lines_received "$WORK/clean.viewer")" = $((FRAMES * LINES)) ] || fail "clean: lines received"
 [ "$(field rejected "$WORK/clean.viewer")" = 0 ] || fail "clean: rejected packets"
+[ "$(field rej_sender "$WORK/clean.viewer")" = 0 ] || fail "clean: datagrams refused by sender"
 [ "$(field lines_dropped "$WORK/clean.sender")" = 0 ] || fail "clean: sender dropped lines"
 ls "$WORK"/png/view_*.png > /dev/null 2>&1 || fail "no PNG recorded"
 [ "$(field gif_frames "$WORK/clean.viewer")" -ge 1 ] || fail "no GIF frames"
@@ -50,4 +54,19 @@ injected=$(field lines_injected "$WORK/lossy.sender")
 [ "$(field lines_dropped "$WORK/lossy.sender")" = 0 ] || fail "lossy: sender dropped lines besides the injected ones"
 [ "$(field lines_lost "$WORK/lossy.viewer")" = "$injected" ] || fail "lossy: viewer lost $(field lines_lost "$WORK/lossy.viewer") lines, $injected injected"
 [ "$(field frames "$WORK/lossy.viewer")" = "$FRAMES" ] || fail "lossy: viewer frames"
-echo "PASS: no loss without injection; exactly $injected injected lines counted lost"
+FRAMES=10
+run_pair foreign 0 --sender 127.0.0.2 --seconds 3
+# every datagram: per frame LINES line packets, a frame begin and a frame end
+refused=$(field rej_sender "$WORK/foreign.viewer")
+[ "$refused" = $((FRAMES * (LINES + 2))) ] || fail "foreign sender: $refused datagrams refused"
+[ "$(field frames "$WORK/foreign.viewer")" = 0 ] || fail "foreign sender: frames shown"
+[ "$(field lines_received "$WORK/foreign.viewer")" = 0 ] || fail "foreign sender: lines taken"
+grep -q "refused .* datagrams from senders other than 127.0.0.2 (last from 127.0.0.1)" \
+    "$WORK/foreign.viewer.err" || fail "foreign sender: not reported"
+set +e
+"$VIEWER" --headless --quiet --bind 0.0.0.0 --seconds 1 > /dev/null 2> "$WORK/anybind.err"
+rc=$?
+set -e
+[ "$rc" = 2 ] || fail "--bind 0.0.0.0 without --sender: exit $rc, expected 2"
+grep -q "not a loopback address" "$WORK/anybind.err" || fail "--bind 0.0.0.0: no reason given"
+echo "PASS: no loss without injection; exactly $injected injected lines counted lost; $refused datagrams from a foreign sender refused"

@@ -10,12 +10,12 @@ set -euo pipefail
 base=(build-essential cmake pkg-config libccd-dev libcmocka-dev libpng-dev zlib1g-dev libgif-dev
       libdrm-dev
       python3-pydicom python3-numpy
-      libdcmtk-dev libteem-dev teem-apps
+      libdcmtk-dev libteem-dev teem-apps libmbedtls-dev
       python3 python3-canmatrix libsdl2-dev xvfb xauth can-utils)
 cross=(gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi
        gcc-aarch64-linux-gnu qemu-user-static dpkg-dev)
 cross_arm64=(libcmocka-dev:arm64 libccd-dev:arm64 zlib1g-dev:arm64 libpng-dev:arm64
-             libgif-dev:arm64)
+             libgif-dev:arm64 libmbedtls-dev:arm64)
 hil=(qemu-system-x86 busybox-static can-utils)
 fuzz=(clang clang-14 libclang-rt-14-dev llvm-14)
 

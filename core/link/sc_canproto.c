@@ -50,6 +50,20 @@ static const sc_can_sig sigs_cmd_reset[] = {
     E2E_SIGS,
     {"ResetTarget", 16, 2, 0, 1.0f, 0.0f, 1.0f, 3.0f, ""},
 };
+static const sc_can_sig sigs_cmd_sync[] = {
+    E2E_SIGS,
+    {"FreshnessMid", 16, 24, 0, 1.0f, 0.0f, 0.0f, 16777215.0f, ""},
+    {"FreshnessHigh", 40, 24, 0, 1.0f, 0.0f, 0.0f, 16777215.0f, ""},
+};
+/* The cryptographic PDU (sc_secoc.h); the 40-bit MAC as two integer signals so that every
+ * signal stays exact in float32 (MacA = MAC bytes 0..2, MacB = bytes 3..4, little-endian). */
+static const sc_can_sig sigs_auth[] = {
+    {"SenderId", 0, 4, 0, 1.0f, 0.0f, 0.0f, 15.0f, ""},
+    {"Link", 4, 4, 0, 1.0f, 0.0f, 0.0f, 15.0f, ""},
+    {"FreshnessLow", 8, 16, 0, 1.0f, 0.0f, 0.0f, 65535.0f, ""},
+    {"MacA", 24, 24, 0, 1.0f, 0.0f, 0.0f, 16777215.0f, ""},
+    {"MacB", 48, 16, 0, 1.0f, 0.0f, 0.0f, 65535.0f, ""},
+};
 static const sc_can_sig sigs_pose_pos[] = {
     E2E_SIGS,
     SIG_POS("PosX", 16),
@@ -97,9 +111,21 @@ static const sc_can_sig sigs_diag[] = {
     {"LiftEvents", 56, 8, 0, 1.0f, 0.0f, 0.0f, 255.0f, ""},
 };
 
+static const sc_can_sig sigs_auth_diag[] = {
+    E2E_SIGS,
+    {"CmdsAuthenticated", 16, 16, 0, 1.0f, 0.0f, 0.0f, 65535.0f, ""},
+    {"AuthRejected", 32, 16, 0, 1.0f, 0.0f, 0.0f, 65535.0f, ""},
+    {"AuthBadMac", 48, 8, 0, 1.0f, 0.0f, 0.0f, 255.0f, ""},
+    {"AuthStale", 56, 8, 0, 1.0f, 0.0f, 0.0f, 255.0f, ""},
+};
+
 #define MSG(n, id, len, fd, cyc, to, sigs)                                                         \
     {                                                                                              \
-        n, id, id, len, fd, cyc, to, (uint8_t)(sizeof(sigs) / sizeof((sigs)[0])), sigs             \
+        n, id, id, len, fd, cyc, to, 1u, (uint8_t)(sizeof(sigs) / sizeof((sigs)[0])), sigs         \
+    }
+#define MSG_AUTH(n, id)                                                                            \
+    {                                                                                              \
+        n, id, id, 8, 0, 0, 0, 0u, (uint8_t)(sizeof(sigs_auth) / sizeof(sigs_auth[0])), sigs_auth  \
     }
 
 static const sc_can_msg_info msg_table[SC_MSG_COUNT] = {
@@ -107,6 +133,7 @@ static const sc_can_msg_info msg_table[SC_MSG_COUNT] = {
     [SC_MSG_CMD_METHOD] = MSG("CmdSetMethod", SC_CANID_CMD_METHOD, 8, 0, 0, 0, sigs_cmd_method),
     [SC_MSG_CMD_IMAGING] = MSG("CmdSetImaging", SC_CANID_CMD_IMAGING, 8, 0, 0, 0, sigs_cmd_imaging),
     [SC_MSG_CMD_RESET] = MSG("CmdReset", SC_CANID_CMD_RESET, 8, 0, 0, 0, sigs_cmd_reset),
+    [SC_MSG_CMD_SYNC] = MSG("CmdFreshnessSync", SC_CANID_CMD_SYNC, 8, 0, 0, 0, sigs_cmd_sync),
     [SC_MSG_POSE_POS] = MSG("ProbePosePos", SC_CANID_POSE_POS, 8, 0, 10, 100, sigs_pose_pos),
     [SC_MSG_POSE_QUAT] = MSG("ProbePoseQuat", SC_CANID_POSE_QUAT, 8, 0, 10, 100, sigs_pose_quat),
     [SC_MSG_POSE_AUX] = MSG("ProbePoseAux", SC_CANID_POSE_AUX, 8, 0, 10, 100, sigs_pose_aux),
@@ -114,7 +141,16 @@ static const sc_can_msg_info msg_table[SC_MSG_COUNT] = {
     [SC_MSG_STATUS] = MSG("EngineStatus", SC_CANID_STATUS, 8, 0, 100, 0, sigs_status),
     [SC_MSG_TIMING] = MSG("EngineTiming", SC_CANID_TIMING, 8, 0, 100, 0, sigs_timing),
     [SC_MSG_DIAG] = MSG("TrackerDiag", SC_CANID_DIAG, 8, 0, 100, 0, sigs_diag),
+    [SC_MSG_AUTH_DIAG] = MSG("AuthDiag", SC_CANID_AUTH_DIAG, 8, 0, 100, 0, sigs_auth_diag),
+    [SC_MSG_AUTH_CASE] = MSG_AUTH("CmdAuthSelectCase", SC_CANID_AUTH_CASE),
+    [SC_MSG_AUTH_METHOD] = MSG_AUTH("CmdAuthSetMethod", SC_CANID_AUTH_CASE + 1),
+    [SC_MSG_AUTH_IMAGING] = MSG_AUTH("CmdAuthSetImaging", SC_CANID_AUTH_CASE + 2),
+    [SC_MSG_AUTH_RESET] = MSG_AUTH("CmdAuthReset", SC_CANID_AUTH_CASE + 3),
+    [SC_MSG_AUTH_SYNC] = MSG_AUTH("CmdAuthFreshnessSync", SC_CANID_AUTH_SYNC),
 };
+_Static_assert(SC_CANID_AUTH_SYNC == SC_CANID_CMD_SYNC + SC_CANID_AUTH_OFFSET, "auth ids");
+_Static_assert(SC_MSG_AUTH_SYNC - SC_MSG_AUTH_CASE == SC_MSG_CMD_SYNC - SC_MSG_CMD_CASE,
+               "one cryptographic PDU per command");
 
 _Static_assert(sizeof(sigs_pose_fd) / sizeof(sigs_pose_fd[0]) <= SC_CANPROTO_MAX_SIGS,
                "raise SC_CANPROTO_MAX_SIGS");
@@ -387,9 +423,16 @@ int sc_canproto_decode_pose_part(const sc_can_frame *f, sc_pose_msg *p)
     case SC_MSG_CMD_METHOD:
     case SC_MSG_CMD_IMAGING:
     case SC_MSG_CMD_RESET:
+    case SC_MSG_CMD_SYNC:
     case SC_MSG_STATUS:
     case SC_MSG_TIMING:
     case SC_MSG_DIAG:
+    case SC_MSG_AUTH_DIAG:
+    case SC_MSG_AUTH_CASE:
+    case SC_MSG_AUTH_METHOD:
+    case SC_MSG_AUTH_IMAGING:
+    case SC_MSG_AUTH_RESET:
+    case SC_MSG_AUTH_SYNC:
     case SC_MSG_COUNT:
         break;
     }
@@ -397,6 +440,23 @@ int sc_canproto_decode_pose_part(const sc_can_frame *f, sc_pose_msg *p)
 }
 
 /* ---- commands ------------------------------------------------------------------------------ */
+
+sc_msg sc_canproto_cmd_msg(sc_cmd_kind k)
+{
+    switch (k) {
+    case SC_CMD_SELECT_CASE:
+        return SC_MSG_CMD_CASE;
+    case SC_CMD_SET_METHOD:
+        return SC_MSG_CMD_METHOD;
+    case SC_CMD_SET_IMAGING:
+        return SC_MSG_CMD_IMAGING;
+    case SC_CMD_RESET:
+        return SC_MSG_CMD_RESET;
+    case SC_CMD_SYNC_FRESHNESS:
+        return SC_MSG_CMD_SYNC;
+    }
+    return SC_MSG_COUNT;
+}
 
 int sc_canproto_encode_cmd(const sc_cmd *c, uint8_t counter, sc_can_frame *out)
 {
@@ -444,6 +504,13 @@ int sc_canproto_encode_cmd(const sc_cmd *c, uint8_t counter, sc_can_frame *out)
                  : SC_ERR_CAN_SIGNAL;
         put_u(out, m, 2u, c->reset_target & 3u);
         break;
+    case SC_CMD_SYNC_FRESHNESS:
+        m = SC_MSG_CMD_SYNC;
+        frame_begin(out, m);
+        rc = c->fv_high < ((uint64_t)1 << 48) ? 0 : SC_ERR_CAN_SIGNAL;
+        put_u(out, m, 2u, (uint32_t)(c->fv_high & 0xFFFFFFu));
+        put_u(out, m, 3u, (uint32_t)((c->fv_high >> 24) & 0xFFFFFFu));
+        break;
     default:
         return SC_ERR_INVALID_ARG;
     }
@@ -487,6 +554,11 @@ int sc_canproto_decode_cmd(const sc_can_frame *f, sc_cmd *out)
         c.reset_target = (uint8_t)get_u(f, m, 2u);
         nsig = 1;
         break;
+    case SC_MSG_CMD_SYNC:
+        c.kind = SC_CMD_SYNC_FRESHNESS;
+        c.fv_high = (uint64_t)get_u(f, m, 2u) | ((uint64_t)get_u(f, m, 3u) << 24);
+        nsig = 0;
+        break;
     case SC_MSG_POSE_POS:
     case SC_MSG_POSE_QUAT:
     case SC_MSG_POSE_AUX:
@@ -494,6 +566,12 @@ int sc_canproto_decode_cmd(const sc_can_frame *f, sc_cmd *out)
     case SC_MSG_STATUS:
     case SC_MSG_TIMING:
     case SC_MSG_DIAG:
+    case SC_MSG_AUTH_DIAG:
+    case SC_MSG_AUTH_CASE:
+    case SC_MSG_AUTH_METHOD:
+    case SC_MSG_AUTH_IMAGING:
+    case SC_MSG_AUTH_RESET:
+    case SC_MSG_AUTH_SYNC:
     case SC_MSG_COUNT:
         return SC_ERR_CAN_ID;
     }
@@ -555,6 +633,13 @@ int sc_canproto_encode_status(const sc_status_msg *s, sc_e2e_tx tx[SC_STATUS_FRA
     put_u(&out[2], m, 4u, sat_u(s->rejected_plausibility, 0xFFu));
     put_u(&out[2], m, 5u, sat_u(s->lift_events, 0xFFu));
 
+    m = SC_MSG_AUTH_DIAG;
+    frame_begin(&out[3], m);
+    put_u(&out[3], m, 2u, s->cmds_authenticated & 0xFFFFu);
+    put_u(&out[3], m, 3u, sat_u(s->auth_rejected, 0xFFFFu));
+    put_u(&out[3], m, 4u, sat_u(s->auth_bad_mac, 0xFFu));
+    put_u(&out[3], m, 5u, sat_u(s->auth_stale, 0xFFu));
+
     for (unsigned i = 0; i < SC_STATUS_FRAMES; i++) {
         rc = sc_e2e_protect(&tx[i], out[i].data, out[i].len);
         if (rc != 0) {
@@ -597,14 +682,26 @@ int sc_canproto_decode_status_part(const sc_can_frame *f, sc_status_msg *s)
         s->rejected_plausibility = get_u(f, m, 4u);
         s->lift_events = get_u(f, m, 5u);
         return 0;
+    case SC_MSG_AUTH_DIAG:
+        s->cmds_authenticated = get_u(f, m, 2u);
+        s->auth_rejected = get_u(f, m, 3u);
+        s->auth_bad_mac = get_u(f, m, 4u);
+        s->auth_stale = get_u(f, m, 5u);
+        return 0;
     case SC_MSG_CMD_CASE:
     case SC_MSG_CMD_METHOD:
     case SC_MSG_CMD_IMAGING:
     case SC_MSG_CMD_RESET:
+    case SC_MSG_CMD_SYNC:
     case SC_MSG_POSE_POS:
     case SC_MSG_POSE_QUAT:
     case SC_MSG_POSE_AUX:
     case SC_MSG_POSE_FD:
+    case SC_MSG_AUTH_CASE:
+    case SC_MSG_AUTH_METHOD:
+    case SC_MSG_AUTH_IMAGING:
+    case SC_MSG_AUTH_RESET:
+    case SC_MSG_AUTH_SYNC:
     case SC_MSG_COUNT:
         break;
     }

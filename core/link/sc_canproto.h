@@ -3,12 +3,15 @@
  * the tables here mirror it and tests/unit/test_sc_canproto.c checks them against the file).
  *
  * Messages (11-bit ids, Intel byte order, E2E header in bytes 0-1, see sc_e2e.h):
- *   0x080 CmdSelectCase  0x081 CmdSetMethod  0x082 CmdSetImaging  0x083 CmdReset   (in, event)
+ *   0x080 CmdSelectCase  0x081 CmdSetMethod  0x082 CmdSetImaging  0x083 CmdReset
+ *   0x084 CmdFreshnessSync                                                         (in, event)
+ *   0x088..0x08C CmdAuth*: the cryptographic PDU of command id - 8 (sc_secoc.h)    (in, event)
  *   0x100 ProbePosePos   0x101 ProbePoseQuat 0x102 ProbePoseAux                    (in, 10 ms)
  *   0x110 ProbePoseFD    (in, 10 ms, CAN FD 20 bytes: the three above in one frame)
- *   0x200 EngineStatus   0x201 EngineTiming  0x202 TrackerDiag                    (out, 100 ms)
+ *   0x200 EngineStatus   0x201 EngineTiming  0x202 TrackerDiag  0x203 AuthDiag    (out, 100 ms)
  * A classic pose spans the three 0x10x frames, tied by one E2E counter value shared by the
- * three frames of a sample. E2E data ID = CAN id.
+ * three frames of a sample. E2E data ID = CAN id. Every message but the CmdAuth* frames
+ * carries the E2E header (their integrity is their MAC's).
  *
  * All functions are pure: no state, no allocation, no OS; deterministic. Encoding validates
  * every physical value (finite, representable) and fails with SC_ERR_NOT_FINITE or
@@ -31,6 +34,7 @@ typedef enum sc_msg {
     SC_MSG_CMD_METHOD,
     SC_MSG_CMD_IMAGING,
     SC_MSG_CMD_RESET,
+    SC_MSG_CMD_SYNC,
     SC_MSG_POSE_POS,
     SC_MSG_POSE_QUAT,
     SC_MSG_POSE_AUX,
@@ -38,8 +42,19 @@ typedef enum sc_msg {
     SC_MSG_STATUS,
     SC_MSG_TIMING,
     SC_MSG_DIAG,
+    SC_MSG_AUTH_DIAG,
+    SC_MSG_AUTH_CASE, /* the cryptographic PDUs, in command order */
+    SC_MSG_AUTH_METHOD,
+    SC_MSG_AUTH_IMAGING,
+    SC_MSG_AUTH_RESET,
+    SC_MSG_AUTH_SYNC,
     SC_MSG_COUNT
 } sc_msg;
+
+#define SC_CMD_MSGS 5u /* commands SC_MSG_CMD_CASE..SC_MSG_CMD_SYNC; SC_MSG_AUTH_* likewise */
+/* 1 for the secured commands (authentic PDUs), 1 for their cryptographic PDUs. */
+#define SC_MSG_IS_CMD(m)  ((unsigned)(m) <= (unsigned)SC_MSG_CMD_SYNC)
+#define SC_MSG_IS_AUTH(m) ((unsigned)(m) >= (unsigned)SC_MSG_AUTH_CASE && (m) < SC_MSG_COUNT)
 
 #define SC_CANPROTO_MAX_SIGS 11u
 
@@ -48,6 +63,10 @@ enum {
     SC_CANID_CMD_METHOD = 0x081,
     SC_CANID_CMD_IMAGING = 0x082,
     SC_CANID_CMD_RESET = 0x083,
+    SC_CANID_CMD_SYNC = 0x084,
+    SC_CANID_AUTH_OFFSET = 0x008, /* CmdAuth id = command id + 8 */
+    SC_CANID_AUTH_CASE = 0x088,
+    SC_CANID_AUTH_SYNC = 0x08C,
     SC_CANID_POSE_POS = 0x100,
     SC_CANID_POSE_QUAT = 0x101,
     SC_CANID_POSE_AUX = 0x102,
@@ -55,6 +74,7 @@ enum {
     SC_CANID_STATUS = 0x200,
     SC_CANID_TIMING = 0x201,
     SC_CANID_DIAG = 0x202,
+    SC_CANID_AUTH_DIAG = 0x203,
 };
 
 /* One signal as in the DBC: raw little-endian bit field, phys = raw * factor + offset. */
@@ -78,6 +98,7 @@ typedef struct sc_can_msg_info {
     uint8_t fd;          /* 1: CAN FD frame */
     uint16_t cycle_ms;   /* 0: sent on event */
     uint16_t timeout_ms; /* receive timeout, 0: none */
+    uint8_t e2e;         /* 1: bytes 0-1 are the E2E header (all but the CmdAuth frames) */
     uint8_t sig_count;
     const sc_can_sig *sigs;
 } sc_can_msg_info;
@@ -130,6 +151,7 @@ typedef enum sc_cmd_kind {
     SC_CMD_SET_METHOD = 2,
     SC_CMD_SET_IMAGING = 3,
     SC_CMD_RESET = 4,
+    SC_CMD_SYNC_FRESHNESS = 5, /* CmdFreshnessSync: the sender's freshness bits 16..63 */
 } sc_cmd_kind;
 
 enum { SC_METHOD_MSDS = 0, SC_METHOD_FEM = 1 };
@@ -150,7 +172,12 @@ typedef struct sc_cmd {
     uint8_t method;         /* SET_METHOD: SC_METHOD_* */
     uint8_t reset_target;   /* RESET: SC_RESET_* */
     sc_imaging_cmd imaging; /* SET_IMAGING */
+    uint64_t fv_high;       /* SYNC_FRESHNESS: freshness value >> 16, 0..2^48-1 */
+    uint8_t sender;         /* the authenticated sender (set by the receiver; sc_secoc.h) */
 } sc_cmd;
+
+/* The message of a command kind (SC_MSG_COUNT for an unknown kind). O(1). */
+sc_msg sc_canproto_cmd_msg(sc_cmd_kind k);
 
 /* One frame, E2E-protected with `counter`. SC_ERR_INVALID_ARG for an unknown kind,
  * SC_ERR_CAN_SIGNAL / SC_ERR_NOT_FINITE for values outside the DBC ranges. */
@@ -177,15 +204,19 @@ typedef struct sc_status_msg {
     uint32_t rejected_e2e;   /* saturating on the bus */
     uint32_t rejected_plausibility;
     uint32_t lift_events;
+    uint32_t cmds_authenticated; /* sent modulo 65536 */
+    uint32_t auth_rejected;      /* every refused command authentication, saturating */
+    uint32_t auth_bad_mac;       /* of which: MAC wrong (saturating at 255) */
+    uint32_t auth_stale;         /* of which: freshness stale or replayed (saturating at 255) */
 } sc_status_msg;
 
-#define SC_STATUS_FRAMES 3u
-/* Encodes EngineStatus, EngineTiming, TrackerDiag (in that order) into out[0..2], each
- * protected with the counter of its sender state tx[0..2] (advanced). Counters saturate to
- * their fields. SC_ERR_CAN_SIGNAL for a state/method out of range or a non-finite ratio. */
+#define SC_STATUS_FRAMES 4u
+/* Encodes EngineStatus, EngineTiming, TrackerDiag, AuthDiag (in that order) into out[0..3],
+ * each protected with the counter of its sender state tx[0..3] (advanced). Counters saturate
+ * to their fields. SC_ERR_CAN_SIGNAL for a state/method out of range or a non-finite ratio. */
 int sc_canproto_encode_status(const sc_status_msg *s, sc_e2e_tx tx[SC_STATUS_FRAMES],
                               sc_can_frame out[SC_STATUS_FRAMES]);
-/* Writes the fields one of the three status frames carries into *s (ratios that are "not
+/* Writes the fields one of the four status frames carries into *s (ratios that are "not
  * available" decode to SC_AREA_RATIO_NOT_AVAILABLE). Errors of sc_canproto_classify,
  * SC_ERR_CAN_ID for a frame that is not a status frame. */
 int sc_canproto_decode_status_part(const sc_can_frame *f, sc_status_msg *s);

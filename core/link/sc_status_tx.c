@@ -6,6 +6,7 @@ void sc_status_tx_init(sc_status_tx *s)
     sc_e2e_tx_init(&s->tx[0], sc_canproto_info(SC_MSG_STATUS)->data_id);
     sc_e2e_tx_init(&s->tx[1], sc_canproto_info(SC_MSG_TIMING)->data_id);
     sc_e2e_tx_init(&s->tx[2], sc_canproto_info(SC_MSG_DIAG)->data_id);
+    sc_e2e_tx_init(&s->tx[3], sc_canproto_info(SC_MSG_AUTH_DIAG)->data_id);
 }
 
 int sc_status_tx_encode(sc_status_tx *s, const sc_tracker *t, sc_status_msg *msg,
@@ -16,5 +17,9 @@ int sc_status_tx_encode(sc_status_tx *s, const sc_tracker *t, sc_status_msg *msg
     msg->rejected_e2e = sc_tracker_rejected_e2e(t);
     msg->rejected_plausibility = sc_tracker_rejected_implausible(t);
     msg->lift_events = sc_tracker_counters(t)->lift_events;
+    msg->cmds_authenticated = sc_tracker_authenticated(t);
+    msg->auth_rejected = sc_tracker_rejected_auth(t);
+    msg->auth_bad_mac = sc_tracker_counters(t)->outcome[SC_TRK_AUTH_BAD_MAC];
+    msg->auth_stale = sc_tracker_counters(t)->outcome[SC_TRK_AUTH_STALE];
     return sc_canproto_encode_status(msg, s->tx, out);
 }

@@ -5,11 +5,16 @@
 
 #include "sc_err.h"
 
-_Static_assert(SC_MSG_CMD_CASE == 0 && SC_MSG_POSE_FD == 7, "rx message indices 0..7");
+#include <string.h>
+
+_Static_assert(SC_MSG_CMD_CASE == 0 && SC_MSG_POSE_FD == 8, "rx message indices 0..8");
 _Static_assert(SC_TRK_RX_MSGS == (unsigned)SC_MSG_POSE_FD + 1u, "rx state per message");
-/* 1,088 bytes on x86_64 with the default SC_CAN_CMD_QUEUE_MAX of 8: 8 E2E receivers of 64 B,
- * 2 assembly slots of 56 B, the command FIFO (28 B each), counters (116 B). */
-_Static_assert(sizeof(sc_tracker) <= 1200u + 28u * SC_CAN_CMD_QUEUE_MAX, "tracker state grew");
+_Static_assert(SC_CMD_MSGS == (unsigned)SC_MSG_CMD_SYNC + 1u, "commands first");
+/* 2,304 bytes on x86_64 with the default SC_CAN_CMD_QUEUE_MAX of 8: 9 E2E receivers of 64 B
+ * and their last payloads (180 B), 2 assembly slots of 56 B, the command FIFO (48 B each),
+ * 5 pending commands (72 B each), the last accepted pairs and their times (120 B), the SecOC
+ * receiver (256 B), counters (152 B). */
+_Static_assert(sizeof(sc_tracker) <= 1920u + 48u * SC_CAN_CMD_QUEUE_MAX, "tracker state grew");
 
 sc_tracker_def sc_tracker_default_def(void)
 {
@@ -24,6 +29,7 @@ sc_tracker_def sc_tracker_default_def(void)
         .pose_cycle_ms = 10u,
         .max_delta_counter = 3u,
         .accept_fd = 1u,
+        .secoc = sc_secoc_default_def(),
     };
 }
 
@@ -46,7 +52,8 @@ int sc_tracker_def_validate(const sc_tracker_def *d)
         return SC_ERR_RANGE;
     }
     if (d->pose_cycle_ms == 0u || d->pose_timeout_ms < d->pose_cycle_ms ||
-        d->max_delta_counter < 1u || d->max_delta_counter > SC_E2E_COUNTER_MOD - 2u) {
+        d->max_delta_counter < 1u || d->max_delta_counter > SC_E2E_COUNTER_MOD - 2u ||
+        d->secoc.window < 1u || d->secoc.window > SC_SECOC_MAX_WINDOW) {
         return SC_ERR_RANGE;
     }
     return 0;
@@ -93,6 +100,22 @@ const char *sc_trk_outcome_name(sc_trk_outcome o)
         return "cmd_queue_full";
     case SC_TRK_BUS_ERROR:
         return "bus_error";
+    case SC_TRK_DUPLICATE:
+        return "duplicate";
+    case SC_TRK_CMD_PENDING:
+        return "cmd_pending";
+    case SC_TRK_AUTH_SYNCED:
+        return "auth_synced";
+    case SC_TRK_AUTH_ORPHAN:
+        return "auth_orphan";
+    case SC_TRK_AUTH_UNKNOWN_SENDER:
+        return "auth_unknown_sender";
+    case SC_TRK_AUTH_NOT_SYNCED:
+        return "auth_not_synced";
+    case SC_TRK_AUTH_STALE:
+        return "auth_stale";
+    case SC_TRK_AUTH_BAD_MAC:
+        return "auth_bad_mac";
     case SC_TRK_OUTCOME_COUNT:
         break;
     }
@@ -108,6 +131,12 @@ int sc_trk_outcome_is_implausible(sc_trk_outcome o)
 {
     return o == SC_TRK_REJ_QUAT_NORM || o == SC_TRK_REJ_WORKSPACE || o == SC_TRK_REJ_FORCE ||
            o == SC_TRK_REJ_SPEED || o == SC_TRK_REJ_ANG_SPEED;
+}
+
+int sc_trk_outcome_is_auth_reject(sc_trk_outcome o)
+{
+    return o == SC_TRK_AUTH_ORPHAN || o == SC_TRK_AUTH_UNKNOWN_SENDER ||
+           o == SC_TRK_AUTH_NOT_SYNCED || o == SC_TRK_AUTH_STALE || o == SC_TRK_AUTH_BAD_MAC;
 }
 
 static void inc(uint32_t *c)
@@ -134,7 +163,7 @@ int sc_tracker_init(sc_tracker *t, const sc_tracker_def *def)
             return rc;
         }
     }
-    return 0;
+    return sc_secoc_rx_init(&t->secoc, &def->secoc);
 }
 
 static sc_trk_outcome e2e_outcome(sc_e2e_status s)
@@ -304,18 +333,91 @@ static sc_trk_outcome on_pose_part(sc_tracker *t, const sc_can_frame *f, uint8_t
     return take_sample(t, &m, counter, ts);
 }
 
-static sc_trk_outcome on_command(sc_tracker *t, const sc_can_frame *f)
+static sc_trk_outcome queue_command(sc_tracker *t, const sc_cmd *c)
+{
+    if (t->cmd_count >= SC_CAN_CMD_QUEUE_MAX) {
+        return SC_TRK_CMD_QUEUE_FULL;
+    }
+    t->cmd[(t->cmd_head + t->cmd_count) % SC_CAN_CMD_QUEUE_MAX] = *c;
+    t->cmd_count++;
+    return SC_TRK_COMMAND;
+}
+
+/* A command (authentic PDU) passed E2E: decode and hold it for its cryptographic PDU. A
+ * command still waiting under the same id never got its MAC: counted missing. */
+static sc_trk_outcome on_command(sc_tracker *t, const sc_can_frame *f, sc_msg m, uint64_t ts_ns)
 {
     sc_cmd c;
     if (sc_canproto_decode_cmd(f, &c) != 0) {
         return SC_TRK_CMD_REJECTED;
     }
-    if (t->cmd_count >= SC_CAN_CMD_QUEUE_MAX) {
-        return SC_TRK_CMD_QUEUE_FULL;
+    sc_trk_pending *p = &t->pending[m];
+    if (p->used && memcmp(p->pdu, f->data, sizeof(p->pdu)) == 0) {
+        return SC_TRK_DUPLICATE; /* the waiting command again */
     }
-    t->cmd[(t->cmd_head + t->cmd_count) % SC_CAN_CMD_QUEUE_MAX] = c;
-    t->cmd_count++;
-    return SC_TRK_COMMAND;
+    if (p->used) {
+        inc(&t->n.auth_missing);
+    }
+    p->used = 1u;
+    memcpy(p->pdu, f->data, sizeof(p->pdu));
+    p->ts_ns = ts_ns;
+    p->cmd = c;
+    return SC_TRK_CMD_PENDING;
+}
+
+static sc_trk_outcome auth_outcome(sc_secoc_result r)
+{
+    switch (r) {
+    case SC_SECOC_UNKNOWN_SENDER:
+        return SC_TRK_AUTH_UNKNOWN_SENDER;
+    case SC_SECOC_NOT_SYNCED:
+        return SC_TRK_AUTH_NOT_SYNCED;
+    case SC_SECOC_STALE:
+        return SC_TRK_AUTH_STALE;
+    case SC_SECOC_OK:
+    case SC_SECOC_BAD_MAC:
+    case SC_SECOC_RESULT_COUNT:
+        break;
+    }
+    return SC_TRK_AUTH_BAD_MAC;
+}
+
+/* A cryptographic PDU: pair it with its held command, verify, and queue the command. */
+static sc_trk_outcome on_auth(sc_tracker *t, const sc_can_frame *f, sc_msg m, uint64_t ts_ns)
+{
+    const unsigned k = (unsigned)m - (unsigned)SC_MSG_AUTH_CASE;
+    sc_trk_pending *p = &t->pending[k];
+    sc_secoc_auth a;
+    sc_secoc_auth_decode(f->data, &a);
+    /* the last accepted cryptographic PDU again: within SC_TRK_AUTH_PAIR_MS a bus duplicate,
+     * later a replay (its freshness is stale); either way never applied twice */
+    const int same_auth = t->have_last_auth[k] && memcmp(t->last_auth[k], f->data, 8u) == 0;
+    const int soon = ts_ns >= t->last_auth_ns[k] &&
+                     ts_ns - t->last_auth_ns[k] <= (uint64_t)SC_TRK_AUTH_PAIR_MS * 1000000u;
+    if (!p->used || a.link != (p->pdu[1] & 0x0Fu)) {
+        return same_auth ? (soon ? SC_TRK_DUPLICATE : SC_TRK_AUTH_STALE) : SC_TRK_AUTH_ORPHAN;
+    }
+    p->used = 0u;
+    if (same_auth && memcmp(t->last_auth_pdu[k], p->pdu, 8u) == 0) {
+        return soon ? SC_TRK_DUPLICATE : SC_TRK_AUTH_STALE;
+    }
+    const sc_msg cm = (sc_msg)k;
+    const uint64_t *sync = p->cmd.kind == SC_CMD_SYNC_FRESHNESS ? &p->cmd.fv_high : NULL;
+    const sc_secoc_result r =
+        sc_secoc_verify(&t->secoc, sc_canproto_info(cm)->data_id, p->pdu, &a, sync, NULL);
+    if (r != SC_SECOC_OK) {
+        return auth_outcome(r);
+    }
+    memcpy(t->last_auth[k], f->data, 8u);
+    memcpy(t->last_auth_pdu[k], p->pdu, 8u);
+    t->last_auth_ns[k] = ts_ns;
+    t->have_last_auth[k] = 1u;
+    if (sync != NULL) {
+        return SC_TRK_AUTH_SYNCED;
+    }
+    sc_cmd c = p->cmd;
+    c.sender = a.sender;
+    return queue_command(t, &c);
 }
 
 static sc_trk_outcome classify_and_handle(sc_tracker *t, const sc_can_frame *f, uint64_t now_ns)
@@ -331,32 +433,46 @@ static sc_trk_outcome classify_and_handle(sc_tracker *t, const sc_can_frame *f, 
     }
     sc_msg m;
     const int rc = sc_canproto_classify(f, &m);
-    if (rc == SC_ERR_CAN_ID || (rc == 0 && (unsigned)m >= SC_TRK_RX_MSGS)) {
+    if (rc == SC_ERR_CAN_ID ||
+        (rc == 0 && (unsigned)m >= SC_TRK_RX_MSGS && !SC_MSG_IS_AUTH(m))) {
         return SC_TRK_NOT_OURS;
     }
     if (rc != 0) {
         return SC_TRK_BAD_LENGTH;
     }
-    if (m == SC_MSG_POSE_FD && !t->def.accept_fd) {
-        return SC_TRK_FD_DISABLED;
-    }
     /* receive times at microsecond resolution, the candump log's: a replayed log then gives
      * every time-dependent decision (speed, timeout) exactly as the live run did */
     const uint64_t ts_ns = (f->ts_ns != 0u ? f->ts_ns : now_ns) / 1000u * 1000u;
+    if (SC_MSG_IS_AUTH(m)) {
+        return on_auth(t, f, m, ts_ns);
+    }
+    if (m == SC_MSG_POSE_FD && !t->def.accept_fd) {
+        return SC_TRK_FD_DISABLED;
+    }
     sc_e2e_rx *rx = &t->rx[m];
     const uint32_t lost_before = rx->lost;
     const sc_e2e_status s = sc_e2e_check(rx, f->data, f->len, ts_ns);
     t->n.e2e_lost += rx->lost - lost_before;
-    if (!sc_e2e_status_usable(s)) {
+    if (s == SC_E2E_REPEATED && !SC_MSG_IS_CMD(m) &&
+        memcmp(t->last_ok[m], f->data, f->len) == 0) {
+        return SC_TRK_DUPLICATE; /* the same frame twice: nothing lost, nothing wrong */
+    }
+    /* Commands come from several senders, each with its own E2E counter: their order and
+     * replay are the freshness value's job (per sender, authenticated), the E2E layer checks
+     * only their CRC. */
+    const int seq_only = SC_MSG_IS_CMD(m) && (s == SC_E2E_REPEATED || s == SC_E2E_WRONG_SEQUENCE);
+    if (!sc_e2e_status_usable(s) && !seq_only) {
         return e2e_outcome(s);
     }
+    memcpy(t->last_ok[m], f->data, f->len);
     const uint8_t counter = (uint8_t)(f->data[1] & 0x0Fu);
     switch (m) {
     case SC_MSG_CMD_CASE:
     case SC_MSG_CMD_METHOD:
     case SC_MSG_CMD_IMAGING:
     case SC_MSG_CMD_RESET:
-        return on_command(t, f);
+    case SC_MSG_CMD_SYNC:
+        return on_command(t, f, m, ts_ns);
     case SC_MSG_POSE_POS:
     case SC_MSG_POSE_QUAT:
     case SC_MSG_POSE_AUX:
@@ -369,6 +485,12 @@ static sc_trk_outcome classify_and_handle(sc_tracker *t, const sc_can_frame *f, 
     case SC_MSG_STATUS:
     case SC_MSG_TIMING:
     case SC_MSG_DIAG:
+    case SC_MSG_AUTH_DIAG:
+    case SC_MSG_AUTH_CASE:
+    case SC_MSG_AUTH_METHOD:
+    case SC_MSG_AUTH_IMAGING:
+    case SC_MSG_AUTH_RESET:
+    case SC_MSG_AUTH_SYNC:
     case SC_MSG_COUNT:
         break;
     }
@@ -387,6 +509,15 @@ int sc_tracker_poll(sc_tracker *t, uint64_t now_ns, sc_pose *out, int *contact)
 {
     for (unsigned i = 0; i < SC_TRK_RX_MSGS; i++) {
         (void)sc_e2e_poll(&t->rx[i], now_ns);
+    }
+    /* commands whose cryptographic PDU did not follow in time are refused */
+    const uint64_t pair_ns = (uint64_t)SC_TRK_AUTH_PAIR_MS * 1000000u;
+    for (unsigned i = 0; i < SC_CMD_MSGS; i++) {
+        sc_trk_pending *p = &t->pending[i];
+        if (p->used && now_ns > p->ts_ns && now_ns - p->ts_ns > pair_ns) {
+            p->used = 0u;
+            inc(&t->n.auth_missing);
+        }
     }
     if (t->have_pose) {
         const uint64_t timeout_ns = (uint64_t)t->def.pose_timeout_ms * 1000000u;
@@ -450,6 +581,24 @@ uint32_t sc_tracker_rejected_implausible(const sc_tracker *t)
             s += t->n.outcome[i];
         }
     }
+    return s > UINT32_MAX ? UINT32_MAX : (uint32_t)s;
+}
+
+uint32_t sc_tracker_rejected_auth(const sc_tracker *t)
+{
+    uint64_t s = t->n.auth_missing;
+    for (unsigned i = 0; i < (unsigned)SC_TRK_OUTCOME_COUNT; i++) {
+        if (sc_trk_outcome_is_auth_reject((sc_trk_outcome)i)) {
+            s += t->n.outcome[i];
+        }
+    }
+    return s > UINT32_MAX ? UINT32_MAX : (uint32_t)s;
+}
+
+uint32_t sc_tracker_authenticated(const sc_tracker *t)
+{
+    const uint64_t s =
+        (uint64_t)t->n.outcome[SC_TRK_COMMAND] + t->n.outcome[SC_TRK_AUTH_SYNCED];
     return s > UINT32_MAX ? UINT32_MAX : (uint32_t)s;
 }
 

@@ -14,8 +14,13 @@
  *  - declares the probe lifted when no valid pose came for pose_timeout_ms (the engine then
  *    removes the collider and lets the tissue relax); the next valid pose ends the lift
  *    without a speed check (the probe may come back anywhere);
- *  - decodes and range-checks commands into a small FIFO (SC_CAN_CMD_QUEUE_MAX) the engine
- *    takes from;
+ *  - decodes and range-checks commands, holds each until its cryptographic PDU arrives
+ *    (sc_secoc.h: the command's MAC and freshness; at most SC_TRK_AUTH_PAIR_MS later), and
+ *    queues only authenticated ones into a small FIFO (SC_CAN_CMD_QUEUE_MAX) the engine takes
+ *    from; a command without its MAC, with a wrong MAC, a stale or replayed freshness value, an
+ *    unknown or unsynchronised sender is refused and counted by reason;
+ *  - counts an exact duplicate of the last accepted frame of a message (same counter, same
+ *    bytes: a bus or gateway artefact, nothing lost) as a duplicate, not as a reject;
  *  - records controller error frames (SC_CAN_ERRF_* classes) for the health state.
  * The send side (status frames) is sc_status_tx.h.
  * Every outcome is counted (saturating uint32). Receive times (frame time stamp, else now_ns)
@@ -24,7 +29,7 @@
  *
  * Thread and memory rules: one sc_tracker object, caller-owned (inside the engine object),
  * used from one thread. Never allocates, never calls the OS; deterministic for a given frame
- * sequence and time stamps. sizeof(sc_tracker) = 1,088 bytes (x86_64, default limits).
+ * sequence and time stamps. sizeof(sc_tracker) = 2,304 bytes (x86_64, default limits).
  */
 #ifndef SC_TRACKER_H
 #define SC_TRACKER_H
@@ -36,6 +41,7 @@
 #include "sc_e2e.h"
 #include "sc_hal_can.h"
 #include "sc_pose.h"
+#include "sc_secoc.h"
 
 typedef struct sc_tracker_def {
     float ws_min_mm[3]; /* workspace box, tracker frame: a pose outside is implausible */
@@ -48,21 +54,24 @@ typedef struct sc_tracker_def {
     uint32_t pose_cycle_ms;    /* nominal pose period: floor of the speed check's dt */
     uint8_t max_delta_counter; /* E2E: counter steps accepted (1 = no loss tolerated) */
     uint8_t accept_fd;         /* accept the CAN FD pose 0x110 */
+    sc_secoc_def secoc;        /* command authentication: key, freshness window, floor */
 } sc_tracker_def;
 
 /* Defaults: workspace x,y in [-400, 400] mm, z in [-100, 500] mm; norm tolerance 0.02;
  * 3000 mm/s (a fast hand stays below 1.5 m/s); 4 pi rad/s; 200 N; timeout 100 ms (10 pose
- * periods, as the DBC); cycle 10 ms; max delta counter 3; FD accepted. */
+ * periods, as the DBC); cycle 10 ms; max delta counter 3; FD accepted; sc_secoc_default_def()
+ * (the bench key). */
 sc_tracker_def sc_tracker_default_def(void);
 /* 0, SC_ERR_NOT_FINITE or SC_ERR_RANGE (an empty box, tolerances or limits <= 0, timeout
- * shorter than the cycle, max_delta_counter outside 1..14). O(1). */
+ * shorter than the cycle, max_delta_counter outside 1..14, a freshness window outside
+ * 1..SC_SECOC_MAX_WINDOW). O(1). */
 int sc_tracker_def_validate(const sc_tracker_def *def);
 
 /* Result of one frame. */
 typedef enum sc_trk_outcome {
     SC_TRK_POSE_ACCEPTED = 0, /* a complete pose passed every check: newest pose now */
     SC_TRK_POSE_PART,         /* a pose part accepted, waiting for the rest of its sample */
-    SC_TRK_COMMAND,           /* a command was queued */
+    SC_TRK_COMMAND,           /* a command was authenticated and queued */
     SC_TRK_NOT_OURS,          /* id not in the protocol, or one of our own outgoing ids */
     SC_TRK_BAD_LENGTH,        /* protocol id with a wrong length or FD flag */
     SC_TRK_FD_DISABLED,       /* FD pose while accept_fd is 0 */
@@ -79,6 +88,14 @@ typedef enum sc_trk_outcome {
     SC_TRK_CMD_REJECTED,   /* a command signal outside its DBC range */
     SC_TRK_CMD_QUEUE_FULL, /* the engine did not take commands fast enough: dropped */
     SC_TRK_BUS_ERROR,      /* an error frame from the controller */
+    SC_TRK_DUPLICATE,      /* the last accepted frame of its message again, byte for byte */
+    SC_TRK_CMD_PENDING,    /* a command held until its cryptographic PDU comes */
+    SC_TRK_AUTH_SYNCED,    /* a CmdFreshnessSync authenticated: the sender is synchronised */
+    SC_TRK_AUTH_ORPHAN,    /* a cryptographic PDU without its command (or another's link) */
+    SC_TRK_AUTH_UNKNOWN_SENDER,
+    SC_TRK_AUTH_NOT_SYNCED, /* the sender has not synchronised its freshness yet */
+    SC_TRK_AUTH_STALE,     /* freshness replayed, older, or past the acceptance window */
+    SC_TRK_AUTH_BAD_MAC,   /* wrong key, altered command, forged */
     SC_TRK_OUTCOME_COUNT
 } sc_trk_outcome;
 
@@ -87,6 +104,9 @@ const char *sc_trk_outcome_name(sc_trk_outcome o);
 int sc_trk_outcome_is_e2e_reject(sc_trk_outcome o);
 /* 1 for the plausibility rejects (norm, workspace, force, speed, angular speed). */
 int sc_trk_outcome_is_implausible(sc_trk_outcome o);
+/* 1 for the refused command authentications of a frame (orphan, unknown sender, not synced,
+ * stale, bad MAC); commands whose MAC never came are sc_trk_counters.auth_missing. */
+int sc_trk_outcome_is_auth_reject(sc_trk_outcome o);
 
 /* The newest valid sample. */
 typedef struct sc_trk_sample {
@@ -103,11 +123,24 @@ typedef struct sc_trk_counters {
     uint32_t incomplete;       /* partial samples dropped (a part lost or rejected) */
     uint32_t lift_events;      /* valid -> lifted transitions */
     uint32_t e2e_lost;         /* messages lost as seen by counter gaps (OK_SOME_LOST) */
+    uint32_t auth_missing;     /* commands whose cryptographic PDU never came (counted when
+                                * SC_TRK_AUTH_PAIR_MS passed or the next command of its id
+                                * came): refused */
     uint32_t bus_err_class[6]; /* error frames per SC_CAN_ERRF_* bit */
 } sc_trk_counters;
 
 #define SC_TRK_ASM_SLOTS 2u
-#define SC_TRK_RX_MSGS   8u /* the 8 messages the engine receives: 4 commands, 4 pose */
+#define SC_TRK_RX_MSGS   9u /* the E2E-protected messages received: 5 commands, 4 pose */
+#define SC_TRK_FRAME_MAX 20u /* longest received payload (the FD pose) */
+/* SC_TRK_AUTH_PAIR_MS (config/sc_config.h): a command waits this long for its MAC */
+
+/* A command waiting for its cryptographic PDU. */
+typedef struct sc_trk_pending {
+    uint8_t used;
+    uint8_t pdu[8];  /* the authentic PDU as received */
+    uint64_t ts_ns;
+    sc_cmd cmd;
+} sc_trk_pending;
 
 typedef struct sc_trk_asm {
     uint8_t used;
@@ -121,6 +154,13 @@ typedef struct sc_trk_asm {
 typedef struct sc_tracker {
     sc_tracker_def def;
     sc_e2e_rx rx[SC_TRK_RX_MSGS]; /* indexed by sc_msg (commands, then pose messages) */
+    uint8_t last_ok[SC_TRK_RX_MSGS][SC_TRK_FRAME_MAX]; /* last usable payload (duplicates) */
+    uint8_t last_auth[SC_CMD_MSGS][SC_SECOC_AUTH_PDU_BYTES]; /* last accepted crypto PDU */
+    uint8_t last_auth_pdu[SC_CMD_MSGS][8];                    /* and its command */
+    uint64_t last_auth_ns[SC_CMD_MSGS];                       /* and when it came */
+    uint8_t have_last_auth[SC_CMD_MSGS];
+    sc_trk_pending pending[SC_CMD_MSGS];
+    sc_secoc_rx secoc;
     sc_trk_asm slot[SC_TRK_ASM_SLOTS];
     uint32_t slot_seq;
     uint8_t have_pose; /* a fresh valid pose exists (not lifted) */
@@ -159,9 +199,13 @@ uint32_t sc_tracker_take_bus_errors(sc_tracker *t);
 
 /* Counters (read-only view). O(1). */
 const sc_trk_counters *sc_tracker_counters(const sc_tracker *t);
-/* Sums of the E2E rejects and of the plausibility rejects. O(SC_TRK_OUTCOME_COUNT). */
+/* Sums of the E2E rejects, the plausibility rejects and the refused authentications (with
+ * auth_missing). O(SC_TRK_OUTCOME_COUNT). */
 uint32_t sc_tracker_rejected_e2e(const sc_tracker *t);
 uint32_t sc_tracker_rejected_implausible(const sc_tracker *t);
+uint32_t sc_tracker_rejected_auth(const sc_tracker *t);
+/* Commands and syncs authenticated. O(1). */
+uint32_t sc_tracker_authenticated(const sc_tracker *t);
 /* E2E receiver state of a received message (commands and pose); NULL for others. */
 const sc_e2e_rx *sc_tracker_e2e(const sc_tracker *t, sc_msg m);
 

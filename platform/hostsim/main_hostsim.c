@@ -25,6 +25,7 @@
 #include "sc_engine.h"
 #include "sc_err.h"
 #include "sc_cpu.h"
+#include "sc_hs_faults.h"
 #include "sc_hs_rig.h"
 #include "sc_labels.h"
 #include "sc_png_write.h"
@@ -53,7 +54,8 @@ typedef struct options {
     int method; /* -1 keep default */
     int fd;
     uint64_t seed;
-    sc_hs_can_faults faults;
+    sc_hs_fault_plan faults;
+    uint64_t rx_cost_ns;
     float point_mm[3];
     int point_set;
     float depth_mm;
@@ -75,8 +77,11 @@ static void usage(FILE *f)
             "  --point X,Y,Z        probe contact point, volume frame mm (default: over the vein)\n"
             "  --depth MM           press depth (default 8)\n"
             "  --fd                 CAN FD pose frames\n"
-            "  --faults LIST        bus faults, e.g. drop=100000,corrupt=10000,dup=5000,reorder=5000\n"
-            "                       (parts per million), delay=NS\n"
+            "  --faults LIST        faults, comma separated (platform/hostsim/sc_hs_faults.h):\n"
+            "                       drop|corrupt|dup|reorder=PPM, delay=NS, random=START:END\n"
+            "                       (the random ones only then); busoff|silence|flood|linkdown=\n"
+            "                       START:DURATION (seconds); bitrate=BPS (flood, 500000)\n"
+            "  --rx-cost-us US      virtual time each CAN frame the engine takes costs (default 0)\n"
             "  --seed N             fault injection seed (default 1)\n"
             "  --record FILE        write every frame the engine received as a candump -l log\n"
             "  --replay FILE        replay a candump -l log instead of the emulator\n"
@@ -111,40 +116,6 @@ static int parse_double(const char *s, double lo, double hi, double *out)
     return 0;
 }
 
-static int parse_faults(const char *s, sc_hs_can_faults *f)
-{
-    char buf[256];
-    if (strlen(s) >= sizeof(buf)) {
-        return -1;
-    }
-    strcpy(buf, s);
-    for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
-        char *eq = strchr(tok, '=');
-        if (!eq) {
-            return -1;
-        }
-        *eq = '\0';
-        uint64_t v;
-        if (parse_u64(eq + 1, strcmp(tok, "delay") == 0 ? 1000000000ull : 1000000ull, &v)) {
-            return -1;
-        }
-        if (strcmp(tok, "drop") == 0) {
-            f->drop_ppm = (uint32_t)v;
-        } else if (strcmp(tok, "corrupt") == 0) {
-            f->corrupt_ppm = (uint32_t)v;
-        } else if (strcmp(tok, "dup") == 0) {
-            f->duplicate_ppm = (uint32_t)v;
-        } else if (strcmp(tok, "reorder") == 0) {
-            f->reorder_ppm = (uint32_t)v;
-        } else if (strcmp(tok, "delay") == 0) {
-            f->delay_ns = v;
-        } else {
-            return -1;
-        }
-    }
-    return 0;
-}
-
 /* The command line into *o (nothing else is touched: tests/fuzz/fuzz_cli_hostsim.c calls it).
  * 0 to go on, -1 after --help or --version (exit 0), 2 for a usage error. */
 static int parse_args(int argc, char **argv, options *o)
@@ -160,9 +131,10 @@ static int parse_args(int argc, char **argv, options *o)
                    .method = -1,
                    .seed = 1,
                    .depth_mm = 8.0f};
+    (void)sc_hs_fault_plan_parse("", &o->faults, NULL, 0);
     enum { O_CASE = 256, O_CASES_DIR, O_OUT, O_SCRIPT, O_CSV, O_SECONDS, O_METHOD, O_POINT,
            O_DEPTH, O_FD, O_FAULTS, O_SEED, O_RECORD, O_REPLAY, O_EVERY, O_PNG, O_RAW, O_QUIET,
-           O_HELP, O_VERSION };
+           O_HELP, O_VERSION, O_RX_COST };
     static const struct option opts[] = {
         {"case", required_argument, 0, O_CASE},     {"cases-dir", required_argument, 0, O_CASES_DIR},
         {"out", required_argument, 0, O_OUT},       {"script", required_argument, 0, O_SCRIPT},
@@ -174,6 +146,7 @@ static int parse_args(int argc, char **argv, options *o)
         {"every", required_argument, 0, O_EVERY},   {"png-size", required_argument, 0, O_PNG},
         {"frame-raw", required_argument, 0, O_RAW}, {"quiet", no_argument, 0, O_QUIET},
         {"help", no_argument, 0, O_HELP},           {"version", no_argument, 0, O_VERSION},
+        {"rx-cost-us", required_argument, 0, O_RX_COST},
         {0, 0, 0, 0}};
     int c;
     opterr = 0;
@@ -219,12 +192,20 @@ static int parse_args(int argc, char **argv, options *o)
             o->depth_mm = (float)d;
             break;
         case O_FD: o->fd = 1; break;
-        case O_FAULTS:
-            if (parse_faults(optarg, &o->faults)) {
-                fprintf(stderr, "sc-hostsim: --faults wants drop|corrupt|dup|reorder=PPM "
-                                "(0..1000000) or delay=NS, comma separated; got '%s'\n", optarg);
+        case O_FAULTS: {
+            char why[160];
+            if (sc_hs_fault_plan_parse(optarg, &o->faults, why, sizeof why)) {
+                fprintf(stderr, "sc-hostsim: --faults '%s': %s\n", optarg, why);
                 return 2;
             }
+            break;
+        }
+        case O_RX_COST:
+            if (parse_u64(optarg, 10000u, &u)) {
+                fprintf(stderr, "sc-hostsim: --rx-cost-us wants 0..10000, got '%s'\n", optarg);
+                return 2;
+            }
+            o->rx_cost_ns = u * 1000u;
             break;
         case O_SEED:
             if (parse_u64(optarg, UINT64_MAX, &o->seed)) {
@@ -355,9 +336,14 @@ static sc_hs_rig rig; /* about 20 MB: static, allocated once */
 static sc_emu emu;
 static sc_emu_row csv_rows[100000];
 
-/* sc_emu_send_fn over a CAN device (the simulated tracker node) */
+static sc_hs_fault_run faults;
+
+/* sc_emu_send_fn over a CAN device (the simulated tracker node); a silence episode discards */
 static int send_peer(void *ctx, const sc_can_frame *f)
 {
+    if (sc_hs_fault_run_silenced(&faults)) {
+        return SC_OK;
+    }
     return sc_can_send((const sc_can_dev *)ctx, f);
 }
 
@@ -398,7 +384,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "sc-hostsim: engine init failed: %s\n", sc_err_str(rc));
         return 1;
     }
-    sc_hs_can_set_faults(&rig.bus, &o.faults);
+    rig.tap.cost_clock = &rig.clock;
+    rig.tap.cost_ns = o.rx_cost_ns;
     static sc_storage_linux storage;
     sc_storage_linux_init(&storage, o.cases_dir);
     rig.hal.storage = sc_storage_linux_dev(&storage);
@@ -514,10 +501,15 @@ int main(int argc, char **argv)
 
     const uint64_t period = sc_engine_get_sched(&rig.engine)->period_ns;
     const uint64_t t0 = rig.clock.now_ns;
+    if (sc_hs_fault_run_init(&faults, &o.faults, &rig) != SC_OK) {
+        fprintf(stderr, "sc-hostsim: no bus node left for the flood\n");
+        return 1;
+    }
     const uint32_t frames = (uint32_t)ceil(o.seconds * 1e9 / (double)period);
     for (uint32_t i = 0; i < frames; i++) {
         /* release time of the frame about to run */
         const uint64_t release = sc_engine_next_release_ns(&rig.engine);
+        sc_hs_fault_run_before(&faults, release);
         if (replay) {
             for (;;) {
                 if (!have_pending) {
@@ -540,6 +532,7 @@ int main(int argc, char **argv)
         const double w0 = mono_s();
         sc_engine_step(&rig.engine, NULL);
         sc_stats_add(&wall, (uint64_t)((mono_s() - w0) * 1e9));
+        sc_hs_fault_run_after(&faults, release);
 
         sc_engine_status st;
         sc_engine_get_status(&rig.engine, &st);
@@ -663,10 +656,40 @@ int main(int argc, char **argv)
                 tc->frames, tc->outcome[SC_TRK_POSE_ACCEPTED],
                 sc_tracker_rejected_e2e(trk), sc_tracker_rejected_implausible(trk),
                 tc->lift_events);
+        fprintf(f, "tracker dups    %u duplicates (not rejects) of %" PRIu64
+                   " the bus duplicated from the tracker; %u commands refused by "
+                   "authentication\n",
+                tc->outcome[SC_TRK_DUPLICATE], rig.bus.by_sender[rig.peer_node].duplicated,
+                sc_tracker_rejected_auth(trk));
+        fprintf(f, "health          raised: tracker data %u, tracker timeout %u, bus-off %u, "
+                   "display link %u, deadline %u\n",
+                rig.engine.health.raised[SC_FAULT_TRACKER_DATA],
+                rig.engine.health.raised[SC_FAULT_TRACKER_TIMEOUT],
+                rig.engine.health.raised[SC_FAULT_CAN_BUS_OFF],
+                rig.engine.health.raised[SC_FAULT_DISPLAY_LINK],
+                rig.engine.health.raised[SC_FAULT_DEADLINE]);
         fprintf(f, "bus faults      injected: %" PRIu64 " dropped, %" PRIu64 " corrupted, %" PRIu64
-                   " duplicated, %" PRIu64 " reordered\n",
+                   " duplicated, %" PRIu64 " reordered; %" PRIu64 " error frames; engine node: "
+                   "%" PRIu64 " filtered, %u overruns\n",
                 rig.bus.injected.dropped, rig.bus.injected.corrupted,
-                rig.bus.injected.duplicated, rig.bus.injected.reordered);
+                rig.bus.injected.duplicated, rig.bus.injected.reordered,
+                rig.bus.injected.error_frames, rig.bus.nodes[rig.engine_node].rx_filtered,
+                rig.bus.nodes[rig.engine_node].rx_overruns);
+        fprintf(f, "deadline        %" PRIu64 " misses on the virtual clock (rx cost %" PRIu64
+                   " ns per CAN frame), %" PRIu64 " frames with the rx drain at its bound\n",
+                rig.engine.sched.misses, o.rx_cost_ns,
+                sc_engine_get_counters(&rig.engine)->can_rx_burst_limited);
+        for (uint32_t ei = 0; ei < faults.plan.n; ei++) {
+            const sc_hs_episode *e = &faults.plan.ep[ei];
+            fprintf(f, "episode %-8s %.3f..%.3f s: fault raised %u times, recovered %d frames "
+                       "after, %u untracked frames, injected %" PRIu64 ", filtered %" PRIu64 "\n",
+                    sc_hs_episode_kind_name(e->kind), (double)e->start_ns * 1e-9,
+                    e->end_ns == UINT64_MAX ? o.seconds : (double)e->end_ns * 1e-9, e->edges,
+                    e->recover_frames, e->untracked_frames, e->injected, e->filtered);
+        }
+        if (faults.silenced) {
+            fprintf(f, "silence         %" PRIu64 " tracker frames not sent\n", faults.silenced);
+        }
         fprintf(f, "host CPU time   per frame mean %.3f ms, p99 %.3f ms, worst %.3f ms "
                    "(wall clock on this host)\n",
                 (double)sc_stats_mean_ns(&wall) * 1e-6,

@@ -66,6 +66,7 @@ static int accepts(const sc_hs_can_node *n, const sc_can_frame *f)
 static void enqueue(sc_hs_can_node *n, const sc_can_frame *f, uint64_t at_ns)
 {
     if (!accepts(n, f)) {
+        n->rx_filtered++; /* the controller's acceptance filter: the owner never sees it */
         return;
     }
     if (n->count >= SC_HS_CAN_QUEUE) {

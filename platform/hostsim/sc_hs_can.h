@@ -61,6 +61,7 @@ typedef struct sc_hs_can_node {
     sc_can_filter filters[SC_HS_CAN_MAX_FILTERS];
     uint32_t filter_count;  /* 0: accept all */
     uint64_t rx_frames, tx_frames;
+    uint64_t rx_filtered;   /* frames its acceptance filters kept out */
     uint32_t rx_overruns;
     uint32_t tx_refused;
 } sc_hs_can_node;

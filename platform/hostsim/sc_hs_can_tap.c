@@ -16,6 +16,9 @@ static int tap_recv(void *ctx, sc_can_frame *out)
     if (rc == SC_OK) {
         out->ts_ns = sc_clock_now_ns(t->clock);
         t->frames++;
+        if (t->cost_clock != NULL && t->cost_ns != 0u) {
+            sc_hs_clock_advance_ns(t->cost_clock, t->cost_ns);
+        }
         if (t->fn) {
             t->fn(t->user, out);
         }

@@ -19,6 +19,11 @@ uint64_t sc_hs_hash64(const void *data, uint64_t size, uint64_t seed)
 static int hs_begin(void *ctx, const sc_display_frame_info *info)
 {
     sc_hs_display *d = ctx;
+    if (d->link_down) {
+        d->calls_refused++;
+        d->in_frame = 0;
+        return SC_ERR_IO;
+    }
     if (d->in_frame) {
         d->frames_incomplete++; /* previous frame never ended */
         d->protocol_errors++;
@@ -41,6 +46,10 @@ static int hs_line(void *ctx, uint32_t frame_no, uint16_t line_index, const uint
                    uint16_t count)
 {
     sc_hs_display *d = ctx;
+    if (d->link_down) {
+        d->calls_refused++;
+        return SC_ERR_IO;
+    }
     d->lines++;
     if (!d->in_frame || frame_no != d->info.frame_no || line_index >= d->info.lines ||
         count != d->info.samples || d->line_seen[line_index]) {
@@ -56,6 +65,10 @@ static int hs_line(void *ctx, uint32_t frame_no, uint16_t line_index, const uint
 static int hs_end(void *ctx, const sc_display_end_info *end)
 {
     sc_hs_display *d = ctx;
+    if (d->link_down) {
+        d->calls_refused++;
+        return SC_ERR_IO;
+    }
     if (!end || !d->in_frame || end->frame_no != d->info.frame_no) {
         d->protocol_errors++;
         return SC_ERR_STATE;
@@ -81,7 +94,8 @@ static int hs_link_state(void *ctx, sc_display_link_state *st)
 {
     sc_hs_display *d = ctx;
     *st = (sc_display_link_state){
-        .up = 1, .lines_sent = (uint32_t)d->lines, .lines_dropped = 0};
+        .up = (uint8_t)!d->link_down, .lines_sent = (uint32_t)d->lines,
+        .lines_dropped = (uint32_t)d->calls_refused};
     return SC_OK;
 }
 

@@ -5,8 +5,9 @@
  * protocol (begin/line/end order, line indices in range, each line once, frame numbers) and
  * counts every violation; keeps the last complete frame with its closing record (the frame's
  * compression measure) and a hash (FNV-1a 64) of every frame
- * in a bounded history, so tests and the replay compare frames bit for bit. Storage is fixed at
- * compile time; nothing allocates.
+ * in a bounded history, so tests and the replay compare frames bit for bit. link_down
+ * models a display link that is down: every call answers SC_ERR_IO (counted) and the link
+ * state says down. Storage is fixed at compile time; nothing allocates.
  */
 #ifndef SC_HS_DISPLAY_H
 #define SC_HS_DISPLAY_H
@@ -36,6 +37,8 @@ typedef struct sc_hs_display {
     uint64_t protocol_errors;    /* line outside a frame, bad index, duplicate, bad length */
     uint64_t hashes[SC_HS_DISPLAY_HISTORY]; /* hash of complete frame i (i < history) */
     uint32_t hash_count;
+    uint8_t link_down;           /* fault injection: the link is down, every call refused */
+    uint64_t calls_refused;      /* begin/line/end refused while down (SC_ERR_IO) */
 } sc_hs_display;
 
 void sc_hs_display_init(sc_hs_display *d);

@@ -22,6 +22,7 @@
 #include <unistd.h>
 
 #include "sc_can_replay.h"
+#include "sc_cmdsign.h"
 #include "sc_engine.h"
 #include "sc_err.h"
 #include "sc_cpu.h"
@@ -180,6 +181,13 @@ static void print_config(FILE *f, const sc_rtcfg *c)
     fprintf(f, "watchdog.device = %s\n", c->watchdog_device);
     fprintf(f, "watchdog.timeout_ms = %u\n", (unsigned)c->watchdog_timeout_ms);
     fprintf(f, "tracker.timeout_ms = %u\n", (unsigned)c->tracker_timeout_ms);
+    /* the key itself is never printed */
+    fprintf(f, "can.auth_key = %s\n",
+            strcmp(c->can_auth_key, "bench") == 0 || strncmp(c->can_auth_key, "file:", 5) == 0
+                ? c->can_auth_key
+                : "(32 hex digits, not shown)");
+    fprintf(f, "can.auth_window = %u\n", (unsigned)c->can_auth_window);
+    fprintf(f, "can.auth_floor_s = %d\n", (int)c->can_auth_floor_s);
     static const char *const levels[] = {"debug", "info", "warn", "error"};
     static const char *const tri[] = {"auto", "on", "off"};
     fprintf(f, "log.level = %s\n", c->log_level < 4u ? levels[c->log_level] : "?");
@@ -266,6 +274,50 @@ static void catalogue(const sc_rtcfg *c, const char *case_dir, sc_engine_def *d)
             d->case_names[d->case_count++] = listed[i];
         }
     }
+}
+
+/* The command key, freshness window and floor of can.auth_*: 0, or EXIT_CONFIG with the
+ * reason logged (an unreadable or malformed key file). */
+static int auth_def_from(const sc_rtcfg *c, sc_secoc_def *out)
+{
+    *out = sc_secoc_default_def();
+    out->window = c->can_auth_window;
+    const char *k = c->can_auth_key;
+    if (strcmp(k, "bench") == 0) {
+        sc_log_linux_msg(&g_log, SC_LOG_WARN, "auth_bench_key",
+                         "action=\"commands authenticated with the documented bench key: set "
+                         "can.auth_key on an appliance\"");
+    } else if (strncmp(k, "file:", 5) == 0) {
+        FILE *f = sc_fopen_regular(k + 5);
+        char text[80] = {0};
+        const size_t n = f ? fread(text, 1, sizeof text - 1u, f) : 0u;
+        if (f) {
+            fclose(f);
+        }
+        size_t a = 0, b = n;
+        while (a < b && (text[a] == ' ' || text[a] == '\t' || text[a] == '\n' || text[a] == '\r')) {
+            a++;
+        }
+        while (b > a && (text[b - 1] == ' ' || text[b - 1] == '\t' || text[b - 1] == '\n' ||
+                         text[b - 1] == '\r')) {
+            b--;
+        }
+        text[b] = '\0';
+        if (!f || sc_cmdsign_parse_key(text + a, out->key) != 0) {
+            sc_log_linux_msg(&g_log, SC_LOG_ERROR, "auth_key_unreadable",
+                             "file=%s why=\"%s\"", k + 5,
+                             !f ? strerror(errno) : "not 32 hex digits");
+            return EXIT_CONFIG;
+        }
+    } else if (sc_cmdsign_parse_key(k, out->key) != 0) {
+        return EXIT_CONFIG; /* unreachable: the configuration checked it */
+    }
+    if (c->can_auth_floor_s >= 0) {
+        const uint64_t now_us = sc_cmdsign_fv_now();
+        const uint64_t back_us = (uint64_t)c->can_auth_floor_s * 1000000u;
+        out->fv_floor = now_us > back_us ? now_us - back_us : 0u;
+    }
+    return 0;
 }
 
 static sc_engine_def engine_def_from(const sc_rtcfg *c, const char *case_dir)
@@ -397,6 +449,16 @@ static void final_report(const sc_engine *e, double wall_s, const char *stop_rea
            (unsigned long long)c->case_loads, (unsigned long long)c->case_load_failures,
            (unsigned long long)c->phys_resets, (unsigned long long)c->imaging_errors,
            (unsigned long long)c->watchdog_kicks);
+    const sc_tracker *t = sc_engine_get_tracker(e);
+    const sc_trk_counters *tc = sc_tracker_counters(t);
+    printf("  command authentication: %u authenticated, %llu refused (bad MAC %u, stale %u, "
+           "not synced %u, unknown sender %u, orphan MAC %u, MAC missing %u), %u duplicates\n",
+           (unsigned)sc_tracker_authenticated(t), (unsigned long long)c->commands_auth_refused,
+           (unsigned)tc->outcome[SC_TRK_AUTH_BAD_MAC], (unsigned)tc->outcome[SC_TRK_AUTH_STALE],
+           (unsigned)tc->outcome[SC_TRK_AUTH_NOT_SYNCED],
+           (unsigned)tc->outcome[SC_TRK_AUTH_UNKNOWN_SENDER],
+           (unsigned)tc->outcome[SC_TRK_AUTH_ORPHAN], (unsigned)tc->auth_missing,
+           (unsigned)tc->outcome[SC_TRK_DUPLICATE]);
     printf("  log records dropped %llu\n", (unsigned long long)sc_log_linux_dropped(&g_log));
     fflush(stdout);
     sc_log_linux_msg(&g_log, SC_LOG_INFO, "final_stats",
@@ -711,8 +773,12 @@ int main(int argc, char **argv)
 
     sc_engine *e = &g_engine;
     int engine_ok = 0;
+    static sc_engine_def def;
     if (exit_code == EXIT_OK) {
-        const sc_engine_def def = engine_def_from(&cfg, a.case_dir);
+        def = engine_def_from(&cfg, a.case_dir);
+        exit_code = auth_def_from(&cfg, &def.tracker.secoc);
+    }
+    if (exit_code == EXIT_OK) {
         int rc = sc_engine_init(e, &def, &hal);
         if (rc != 0) {
             sc_log_linux_msg(&g_log, SC_LOG_ERROR, "engine_init_failed", "err=%s (%s)",

@@ -19,6 +19,7 @@ typedef enum key_kind {
     K_TARGET,  /* display.target */
     K_F32LIST, /* SC_BSCAN_TGC_BANDS numbers */
     K_WDOG,    /* none | soft | /absolute/path */
+    K_AUTHKEY, /* bench | 32 hex digits | file:/absolute/path */
 } key_kind;
 
 typedef struct key_def {
@@ -98,6 +99,17 @@ static const key_def k_keys[] = {
      NUM(100, 60000, 1000)},
     {"tracker.timeout_ms", "no valid pose for this long means the probe is lifted", K_U32,
      F(tracker_timeout_ms), NUM(10, 5000, 100)},
+    {"can.auth_key",
+     "AES-128 key of the commands' MAC (docs/can-protocol.md); bench: the documented bench key",
+     K_AUTHKEY, F(can_auth_key),
+     TXT(SC_RTCFG_PATH_MAX, "bench",
+         "bench | 32 hex digits | file:/absolute/path (a file holding the 32 hex digits)")},
+    {"can.auth_window", "commands of one sender that may be lost between two accepted ones + 1",
+     K_U32, F(can_auth_window), NUM(1, 32768, 1024)},
+    {"can.auth_floor_s",
+     "freshness values older than the engine's start minus this many seconds (wall clock) are "
+     "refused; -1: no floor",
+     K_I32, F(can_auth_floor_s), NUM(-1, 86400, 300)},
     {"log.level", "lowest level of log records written", K_ENUM, F(log_level),
      ENUM("info", "debug | info | warn | error", k_log_names)},
     {"status.line", "live status line once a second (auto: when stderr is a terminal)", K_ENUM,
@@ -618,6 +630,22 @@ static int parse_list(const key_def *k, const char *v, float *out, sc_rtcfg_erro
     return 0;
 }
 
+static int parse_authkey(const key_def *k, char *dst, const char *v, sc_rtcfg_error *e)
+{
+    size_t hex = 0;
+    while (v[hex] && ((v[hex] >= '0' && v[hex] <= '9') || (v[hex] >= 'a' && v[hex] <= 'f') ||
+                      (v[hex] >= 'A' && v[hex] <= 'F'))) {
+        hex++;
+    }
+    const int is_hex = v[hex] == '\0' && hex == 32u;
+    if (strcmp(v, "bench") != 0 && !is_hex && strncmp(v, "file:/", 6) != 0) {
+        why(e, "the key is not ", NULL, NULL);
+        why_range(e, k);
+        return SC_ERR_CFG_VALUE;
+    }
+    return copy_text(dst, k->size, v, e);
+}
+
 static int parse_wdog(const key_def *k, char *dst, const char *v, sc_rtcfg_error *e)
 {
     if (strcmp(v, "none") != 0 && strcmp(v, "soft") != 0 && v[0] != '/') {
@@ -706,6 +734,8 @@ static int apply(sc_rtcfg *cfg, const key_def *k, const char *v, sc_rtcfg_error 
         return parse_list(k, v, (float *)field, e);
     case K_WDOG:
         return parse_wdog(k, (char *)field, v, e);
+    case K_AUTHKEY:
+        return parse_authkey(k, (char *)field, v, e);
     }
     return SC_ERR_CFG_VALUE;
 }

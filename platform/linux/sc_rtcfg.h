@@ -79,6 +79,9 @@ typedef struct sc_rtcfg {
     char watchdog_device[SC_RTCFG_PATH_MAX]; /* "none", "soft" or a device path */
     uint32_t watchdog_timeout_ms;
     uint32_t tracker_timeout_ms;
+    char can_auth_key[SC_RTCFG_PATH_MAX]; /* bench | 32 hex digits | file:/path */
+    uint32_t can_auth_window;
+    int32_t can_auth_floor_s; /* -1: no floor */
     uint32_t log_level;   /* sc_log_level of hal/sc_hal_log.h */
     uint32_t status_line; /* sc_rtcfg_tristate: auto = on when stderr is a terminal */
 } sc_rtcfg;

@@ -18,7 +18,8 @@
  * Faults, each every `period` samples from start_s on (0 = off); counted in injected[]:
  *   bad-crc       one payload bit of one frame of the sample flipped after protection
  *   counter-jump  the counter skips 5 ahead (beyond the receiver's max delta of 3)
- *   repeat        the sample is sent twice with the same counter
+ *   repeat        the sample is sent twice with the same counter (byte for byte: the
+ *                 receiver counts a duplicate, not an error)
  *   silence       nothing sent for silence_ms (longer than the 100 ms timeout by default)
  *   implausible   cycles: quaternion norm 1.5, position outside the workspace, a 100 mm jump
  */

@@ -8,6 +8,7 @@
 
 #include "sc_canproto.h"
 #include "sc_e2e.h"
+#include "sc_secoc.h"
 
 static int print_frame(const sc_can_frame *f)
 {
@@ -32,7 +33,7 @@ static int print_frame(const sc_can_frame *f)
 int main(void)
 {
     int bad = 0;
-    sc_can_frame f[3];
+    sc_can_frame f[SC_STATUS_FRAMES > 3u ? SC_STATUS_FRAMES : 3u];
     size_t n;
     const sc_pose_msg poses[] = {
         {.pos_mm = {12.3f, -45.6f, 78.9f},
@@ -64,17 +65,25 @@ int main(void)
                      .tgc_db_per_cm = 0.8f,
                      .geometry = SC_SCAN_CURVILINEAR}},
         {.kind = SC_CMD_RESET, .reset_target = SC_RESET_FAULTS},
+        {.kind = SC_CMD_SYNC_FRESHNESS, .fv_high = 0x123456789ABCull},
     };
     for (size_t c = 0; c < sizeof cmds / sizeof cmds[0]; c++) {
         if (sc_canproto_encode_cmd(&cmds[c], (uint8_t)c, &f[0]) != 0) {
             return 1;
         }
         bad |= print_frame(&f[0]);
+        /* its cryptographic PDU, signed with the core's CMAC and the bench key */
+        sc_cmac_key k;
+        sc_cmac_key_init(&k, sc_secoc_bench_key);
+        f[1] = (sc_can_frame){.id = f[0].id + SC_CANID_AUTH_OFFSET, .len = 8};
+        sc_secoc_sign(&k, (uint16_t)f[0].id, f[0].data, (uint8_t)c, 0x0123456789ull + c, f[1].data);
+        bad |= print_frame(&f[1]);
     }
-    sc_e2e_tx tx[3];
+    sc_e2e_tx tx[SC_STATUS_FRAMES];
     sc_e2e_tx_init(&tx[0], SC_CANID_STATUS);
     sc_e2e_tx_init(&tx[1], SC_CANID_TIMING);
     sc_e2e_tx_init(&tx[2], SC_CANID_DIAG);
+    sc_e2e_tx_init(&tx[3], SC_CANID_AUTH_DIAG);
     const sc_status_msg st = {.state = 2,
                               .method = 1,
                               .probe_contact = 1,
@@ -87,11 +96,15 @@ int main(void)
                               .poses_accepted = 1234,
                               .rejected_e2e = 5,
                               .rejected_plausibility = 6,
-                              .lift_events = 2};
+                              .lift_events = 2,
+                              .cmds_authenticated = 70000,
+                              .auth_rejected = 300,
+                              .auth_bad_mac = 7,
+                              .auth_stale = 400};
     if (sc_canproto_encode_status(&st, tx, f) != 0) {
         return 1;
     }
-    for (int k = 0; k < 3; k++) {
+    for (int k = 0; k < (int)SC_STATUS_FRAMES; k++) {
         bad |= print_frame(&f[k]);
     }
     /* random raw values in every field of every message */
@@ -111,7 +124,12 @@ int main(void)
                 }
                 sc_canproto_put_raw(g.data, sig, raw);
             }
-            sc_e2e_protect_with(info->data_id, (uint8_t)rep, g.data, g.len);
+            if (info->e2e) {
+                sc_e2e_protect_with(info->data_id, (uint8_t)rep, g.data, g.len);
+            } else {
+                sc_canproto_put_raw(g.data, &info->sigs[0], rep % 16); /* SenderId */
+                sc_canproto_put_raw(g.data, &info->sigs[1], (rep * 7) % 16);
+            }
             bad |= print_frame(&g);
         }
     }

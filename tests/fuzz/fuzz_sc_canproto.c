@@ -84,7 +84,7 @@ size_t sc_fuzz_seed(uint32_t i, uint8_t *buf, size_t cap)
     if (i > 2u || cap < 256u) {
         return 0;
     }
-    sc_can_frame f[3];
+    sc_can_frame f[SC_STATUS_FRAMES > 3 ? SC_STATUS_FRAMES : 3];
     size_t nf = 0;
     if (i < 2u) {
         const sc_pose_msg p = {.pos_mm = {1.0f, -2.0f, 30.0f}, .q = {0.0f, 1.0f, 0.0f, 0.0f},

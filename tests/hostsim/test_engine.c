@@ -14,12 +14,14 @@
 
 #include "sc_assert.h"
 #include "sc_candump.h"
+#include "sc_cmdsign.h"
 #include "sc_canproto.h"
 #include "sc_engine.h"
 #include "sc_err.h"
 #include "sc_hs_rig.h"
 #include "sc_labels.h"
 #include "sc_test_case.h"
+#include "sc_test_cmd.h"
 #include "sc_trkemu.h"
 
 #define MAX_FRAMES 1200u
@@ -497,9 +499,8 @@ static void sustained_misses_are_logged_once_a_second_and_all_counted(void **sta
 
 static void send_cmd(const sc_cmd *c, uint8_t counter)
 {
-    sc_can_frame f;
-    assert_int_equal(sc_canproto_encode_cmd(c, counter, &f), SC_OK);
-    assert_int_equal(sc_can_send(&rig.peer, &f), SC_OK);
+    (void)counter; /* the signer keeps the E2E counters */
+    assert_int_equal(sc_test_send_cmd(&rig.peer, c), SC_OK);
 }
 
 static void commands_over_can_select_case_and_method_and_bad_ones_are_refused(void **state)
@@ -534,6 +535,93 @@ static void commands_over_can_select_case_and_method_and_bad_ones_are_refused(vo
     run(2, 0, -1.0);
     assert_true(fabsf(rig.engine.bscan.def.scan.depth_mm - 40.0f) < 1e-3f);
     assert_false(rig.engine.health.active & (1u << SC_FAULT_CONFIG));
+    assert_int_equal(rig.engine.counters.commands_auth_refused, 0);
+}
+
+/* The same command without its MAC, with a MAC under another key, and the authentic one
+ * replayed: none is applied; each is refused, counted by reason, in the engine's counters
+ * and in the AuthDiag status frame on the bus. */
+static void unauthenticated_forged_and_replayed_commands_are_refused_and_counted(void **state)
+{
+    (void)state;
+    rig_up("block", 5);
+    run(2, 0, -1.0);
+    const sc_tracker *t = sc_engine_get_tracker(&rig.engine);
+    const sc_cmd fem = {.kind = SC_CMD_SET_METHOD, .method = SC_METHOD_FEM};
+    /* 1. the command alone (E2E right, no cryptographic PDU): held, then refused */
+    sc_can_frame f;
+    assert_int_equal(sc_canproto_encode_cmd(&fem, 5, &f), SC_OK);
+    assert_int_equal(sc_can_send(&rig.peer, &f), SC_OK);
+    run(6, 0, -1.0); /* 100 ms > SC_TRK_AUTH_PAIR_MS */
+    assert_int_equal(rig.engine.def.tissue.method, SC_TISSUE_MSDS);
+    assert_int_equal(t->n.auth_missing, 1);
+    /* 2. signed with another key: the MAC does not verify (the sync neither) */
+    uint8_t other[16];
+    memcpy(other, sc_secoc_bench_key, sizeof(other));
+    other[15] ^= 0x01u;
+    sc_cmdsign forger;
+    assert_int_equal(sc_cmdsign_init(&forger, other, 1u, 5000u, 0), SC_OK);
+    sc_can_frame fs[4];
+    assert_int_equal(sc_cmdsign_sync(&forger, &fs[0]), SC_OK);
+    assert_int_equal(sc_cmdsign_command(&forger, &fem, &fs[2]), SC_OK);
+    for (unsigned i = 0; i < 4u; i++) {
+        assert_int_equal(sc_can_send(&rig.peer, &fs[i]), SC_OK);
+    }
+    run(2, 0, -1.0);
+    assert_int_equal(rig.engine.def.tissue.method, SC_TISSUE_MSDS);
+    assert_int_equal(t->n.outcome[SC_TRK_AUTH_BAD_MAC], 1);     /* the sync */
+    assert_int_equal(t->n.outcome[SC_TRK_AUTH_NOT_SYNCED], 1);  /* its command */
+    /* 3. the real sender: applied; the same two frames again 16 commands later (when the E2E
+     *    counter has come round to them) are a replay: stale */
+    sc_cmdsign good;
+    assert_int_equal(sc_cmdsign_init(&good, sc_secoc_bench_key, 2u, 9000u, 0), SC_OK);
+    assert_int_equal(sc_cmdsign_sync(&good, &fs[0]), SC_OK);
+    for (unsigned i = 0; i < 2u; i++) {
+        assert_int_equal(sc_can_send(&rig.peer, &fs[i]), SC_OK);
+    }
+    sc_can_frame rec[2];
+    assert_int_equal(sc_cmdsign_command(&good, &fem, rec), SC_OK);
+    for (unsigned i = 0; i < 2u; i++) {
+        assert_int_equal(sc_can_send(&rig.peer, &rec[i]), SC_OK);
+    }
+    run(2, 0, -1.0);
+    assert_int_equal(rig.engine.def.tissue.method, SC_TISSUE_FEM);
+    const sc_cmd msds = {.kind = SC_CMD_SET_METHOD, .method = SC_METHOD_MSDS};
+    for (unsigned k = 0; k < 15u; k++) {
+        assert_int_equal(sc_cmdsign_command(&good, &msds, fs), SC_OK);
+        for (unsigned i = 0; i < 2u; i++) {
+            assert_int_equal(sc_can_send(&rig.peer, &fs[i]), SC_OK);
+        }
+        run(1, 0, -1.0);
+    }
+    assert_int_equal(rig.engine.def.tissue.method, SC_TISSUE_MSDS);
+    const uint64_t applied = rig.engine.counters.commands_applied;
+    for (unsigned i = 0; i < 2u; i++) {
+        assert_int_equal(sc_can_send(&rig.peer, &rec[i]), SC_OK);
+    }
+    run(2, 0, -1.0);
+    assert_int_equal(rig.engine.def.tissue.method, SC_TISSUE_MSDS);
+    assert_int_equal(rig.engine.counters.commands_applied, applied);
+    assert_int_equal(t->n.outcome[SC_TRK_AUTH_STALE], 1);
+    assert_int_equal(rig.engine.counters.commands_auth_refused, 4);
+    assert_int_equal(sc_tracker_rejected_auth(t), 4);
+    /* on the bus: the newest AuthDiag frame */
+    run(7, 0, -1.0);
+    sc_status_msg s;
+    memset(&s, 0, sizeof(s));
+    int seen = 0;
+    while (sc_can_recv(&rig.peer, &f) == SC_OK) {
+        sc_msg m;
+        if (sc_canproto_classify(&f, &m) == SC_OK && m == SC_MSG_AUTH_DIAG) {
+            assert_int_equal(sc_canproto_decode_status_part(&f, &s), SC_OK);
+            seen = 1;
+        }
+    }
+    assert_true(seen);
+    assert_int_equal(s.auth_rejected, 4);
+    assert_int_equal(s.auth_bad_mac, 1);
+    assert_int_equal(s.auth_stale, 1);
+    assert_int_equal(s.cmds_authenticated, 1u + 1u + 15u); /* a sync and 16 commands */
 }
 
 static void status_frames_report_state_and_compression_with_valid_e2e(void **state)
@@ -544,7 +632,8 @@ static void status_frames_report_state_and_compression_with_valid_e2e(void **sta
     start_emu(&d);
     run(150, 1, -1.0); /* 2.5 s: deep in the hold */
     sc_e2e_rx rx[SC_STATUS_FRAMES];
-    const sc_msg msgs[SC_STATUS_FRAMES] = {SC_MSG_STATUS, SC_MSG_TIMING, SC_MSG_DIAG};
+    const sc_msg msgs[SC_STATUS_FRAMES] = {SC_MSG_STATUS, SC_MSG_TIMING, SC_MSG_DIAG,
+                                           SC_MSG_AUTH_DIAG};
     for (uint32_t i = 0; i < SC_STATUS_FRAMES; i++) {
         sc_e2e_rx_def rd = sc_e2e_rx_default_def(sc_canproto_info(msgs[i])->data_id);
         assert_int_equal(sc_e2e_rx_init(&rx[i], &rd), SC_OK);
@@ -566,8 +655,8 @@ static void status_frames_report_state_and_compression_with_valid_e2e(void **sta
             }
         }
     }
-    /* 2.5 s at 100 ms: 25 periods x 3 frames (the first one at frame 0) */
-    assert_in_range(got, 72, 81);
+    /* 2.5 s at 100 ms: 25 periods x 4 frames (the first one at frame 0) */
+    assert_in_range(got, 96, 108);
     assert_int_equal(s.state, SC_HEALTH_RUNNING);
     assert_int_equal(s.case_id, 0);
     assert_true(s.probe_contact);
@@ -599,6 +688,7 @@ int main(void)
         cmocka_unit_test(bus_off_faults_the_engine_and_recovery_clears_it),
         cmocka_unit_test(a_bad_case_is_refused_and_the_running_case_stays),
         cmocka_unit_test(commands_over_can_select_case_and_method_and_bad_ones_are_refused),
+        cmocka_unit_test(unauthenticated_forged_and_replayed_commands_are_refused_and_counted),
         cmocka_unit_test(status_frames_report_state_and_compression_with_valid_e2e),
         cmocka_unit_test(sustained_misses_are_logged_once_a_second_and_all_counted),
     };

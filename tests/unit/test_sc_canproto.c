@@ -151,6 +151,8 @@ static void every_command_round_trips(void **state)
                      .geometry = SC_SCAN_CURVILINEAR}},
         {.kind = SC_CMD_RESET, .reset_target = SC_RESET_TISSUE},
         {.kind = SC_CMD_RESET, .reset_target = SC_RESET_ALL},
+        {.kind = SC_CMD_SYNC_FRESHNESS, .fv_high = 0},
+        {.kind = SC_CMD_SYNC_FRESHNESS, .fv_high = 0xFEDCBA987654ull}, /* 48 bits, all used */
     };
     for (size_t i = 0; i < sizeof cmds / sizeof cmds[0]; i++) {
         sc_can_frame f;
@@ -162,6 +164,8 @@ static void every_command_round_trips(void **state)
         assert_int_equal(d.case_id, cmds[i].case_id);
         assert_int_equal(d.method, cmds[i].method);
         assert_int_equal(d.reset_target, cmds[i].reset_target);
+        assert_true(d.fv_high == cmds[i].fv_high);
+        assert_int_equal(sc_canproto_info(sc_canproto_cmd_msg(d.kind))->can_id, f.id);
         /* tolerance: half a step of each signal (0.05 mm, 0.25 dB, 0.5 dB, 0.05 dB/cm) */
         assert_true(fabsf(d.imaging.depth_mm - cmds[i].imaging.depth_mm) <= 0.05f);
         assert_true(fabsf(d.imaging.gain_db - cmds[i].imaging.gain_db) <= 0.25f);
@@ -183,6 +187,8 @@ static void commands_outside_their_ranges_are_refused_both_ways(void **state)
     c = (sc_cmd){.kind = SC_CMD_SET_METHOD, .method = 2};
     assert_int_equal(sc_canproto_encode_cmd(&c, 0, &f), SC_ERR_CAN_SIGNAL);
     c = (sc_cmd){.kind = SC_CMD_RESET, .reset_target = 0};
+    assert_int_equal(sc_canproto_encode_cmd(&c, 0, &f), SC_ERR_CAN_SIGNAL);
+    c = (sc_cmd){.kind = SC_CMD_SYNC_FRESHNESS, .fv_high = 1ull << 48};
     assert_int_equal(sc_canproto_encode_cmd(&c, 0, &f), SC_ERR_CAN_SIGNAL);
     c = (sc_cmd){.kind = SC_CMD_SET_IMAGING,
                  .imaging = {.depth_mm = 5.0f, .gain_db = 0.0f, .dyn_range_db = 60.0f}};
@@ -223,10 +229,11 @@ static void commands_outside_their_ranges_are_refused_both_ways(void **state)
 static void status_round_trips_and_saturates(void **state)
 {
     (void)state;
-    sc_e2e_tx tx[3];
+    sc_e2e_tx tx[SC_STATUS_FRAMES];
     sc_e2e_tx_init(&tx[0], SC_CANID_STATUS);
     sc_e2e_tx_init(&tx[1], SC_CANID_TIMING);
     sc_e2e_tx_init(&tx[2], SC_CANID_DIAG);
+    sc_e2e_tx_init(&tx[3], SC_CANID_AUTH_DIAG);
     sc_status_msg s = {.state = 2,
                        .method = 1,
                        .probe_contact = 1,
@@ -240,11 +247,15 @@ static void status_round_trips_and_saturates(void **state)
                        .poses_accepted = 70000,
                        .rejected_e2e = 12,
                        .rejected_plausibility = 300,
-                       .lift_events = 3};
-    sc_can_frame f[3];
+                       .lift_events = 3,
+                       .cmds_authenticated = 65537,
+                       .auth_rejected = 70000,
+                       .auth_bad_mac = 9,
+                       .auth_stale = 256};
+    sc_can_frame f[SC_STATUS_FRAMES];
     assert_int_equal(sc_canproto_encode_status(&s, tx, f), 0);
     sc_status_msg d = {0};
-    for (int i = 0; i < 3; i++) {
+    for (int i = 0; i < (int)SC_STATUS_FRAMES; i++) {
         assert_true(e2e_ok(&f[i]));
         assert_int_equal(sc_canproto_decode_status_part(&f[i], &d), 0);
     }
@@ -262,13 +273,18 @@ static void status_round_trips_and_saturates(void **state)
     assert_int_equal(d.rejected_e2e, 12);
     assert_int_equal(d.rejected_plausibility, 255); /* saturated to its 8-bit field */
     assert_int_equal(d.lift_events, 3);
+    assert_int_equal(d.cmds_authenticated, 1);  /* modulo 65536 */
+    assert_int_equal(d.auth_rejected, 65535);   /* saturated */
+    assert_int_equal(d.auth_bad_mac, 9);
+    assert_int_equal(d.auth_stale, 255);        /* saturated to its 8-bit field */
+    assert_int_equal(f[3].id, SC_CANID_AUTH_DIAG);
     /* the sender counters advanced */
     assert_int_equal(tx[0].counter, 1);
     s.deadline_misses = 1000000u;
     s.worst_frame_us = 1000000u;
     assert_int_equal(sc_canproto_encode_status(&s, tx, f), 0);
     assert_int_equal(f[0].data[1] & 0x0Fu, 1);
-    for (int i = 0; i < 3; i++) {
+    for (int i = 0; i < (int)SC_STATUS_FRAMES; i++) {
         assert_int_equal(sc_canproto_decode_status_part(&f[i], &d), 0);
     }
     assert_int_equal(d.deadline_misses, 65535);
@@ -331,8 +347,18 @@ static void signals_of_a_message_do_not_overlap_and_fit_its_length(void **state)
                 used[b / 8u] = (uint8_t)(used[b / 8u] | (1u << (b % 8u)));
             }
         }
-        assert_string_equal(m->sigs[0].name, "E2E_CRC");
-        assert_string_equal(m->sigs[1].name, "E2E_Counter");
+        if (m->e2e) {
+            assert_string_equal(m->sigs[0].name, "E2E_CRC");
+            assert_string_equal(m->sigs[1].name, "E2E_Counter");
+        } else {
+            /* the cryptographic PDUs: id = their command's + 8, 8 bytes, classic */
+            assert_true(SC_MSG_IS_AUTH(i));
+            assert_int_equal(m->can_id,
+                             sc_canproto_info((sc_msg)(i - (int)SC_MSG_AUTH_CASE))->can_id +
+                                 SC_CANID_AUTH_OFFSET);
+            assert_int_equal(m->len, 8);
+            assert_false(m->fd);
+        }
         assert_int_equal(m->data_id, m->can_id);
     }
 }
@@ -428,7 +454,12 @@ static void dbc_file_defines_exactly_the_codec_tables(void **state)
     }
     assert_int_equal(sigs, total);
     assert_int_equal(cycles, cyclic);
-    assert_int_equal(dids, SC_MSG_COUNT);
+    unsigned with_e2e = 0;
+    for (int i = 0; i < (int)SC_MSG_COUNT; i++) {
+        with_e2e += sc_canproto_info((sc_msg)i)->e2e;
+    }
+    assert_int_equal(with_e2e, SC_MSG_COUNT - SC_CMD_MSGS);
+    assert_int_equal(dids, with_e2e);
     assert_int_equal(touts, timed);
     assert_int_equal(fds, 1);
 }

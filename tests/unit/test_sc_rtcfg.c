@@ -143,6 +143,9 @@ static void every_key_accepts_a_valid_non_default_value(void **state)
                        "watchdog.device = /dev/watchdog0\n"
                        "watchdog.timeout_ms = 250\n"
                        "tracker.timeout_ms = 5000\n"
+                       "can.auth_key = 00112233445566778899AABBCCDDEEFF\n"
+                       "can.auth_window = 16\n"
+                       "can.auth_floor_s = -1\n"
                        "log.level = debug\n"
                        "status.line = off\n";
     sc_rtcfg c;
@@ -178,6 +181,21 @@ static void every_key_accepts_a_valid_non_default_value(void **state)
     assert_string_equal(c.watchdog_device, "/dev/watchdog0");
     assert_int_equal(c.watchdog_timeout_ms, 250);
     assert_int_equal(c.tracker_timeout_ms, 5000);
+    assert_string_equal(c.can_auth_key, "00112233445566778899AABBCCDDEEFF");
+    assert_int_equal(c.can_auth_window, 16);
+    assert_int_equal(c.can_auth_floor_s, -1);
+    assert_int_equal(sc_rtcfg_set(&c, "can.auth_key", "file:/etc/sonocomp/cmd.key", NULL), 0);
+    assert_string_equal(c.can_auth_key, "file:/etc/sonocomp/cmd.key");
+    /* not a key: 31 or 33 digits, a non-hex digit, a relative file */
+    const char *bad[] = {"00112233445566778899AABBCCDDEEF", "00112233445566778899AABBCCDDEEFF0",
+                         "g0112233445566778899AABBCCDDEEFF", "file:cmd.key", "Bench"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        sc_rtcfg_error e;
+        assert_int_equal(sc_rtcfg_set(&c, "can.auth_key", bad[i], &e), SC_ERR_CFG_VALUE);
+        assert_string_equal(c.can_auth_key, "file:/etc/sonocomp/cmd.key");
+    }
+    assert_int_equal(sc_rtcfg_set(&c, "can.auth_window", "0", NULL), SC_ERR_CFG_RANGE);
+    assert_int_equal(sc_rtcfg_set(&c, "can.auth_window", "32769", NULL), SC_ERR_CFG_RANGE);
     assert_int_equal(c.log_level, 0);
     assert_int_equal(c.status_line, SC_RTCFG_OFF);
 }

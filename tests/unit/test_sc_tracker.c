@@ -8,6 +8,7 @@
 #include "sc_err.h"
 #include "sc_status_tx.h"
 #include "sc_tracker.h"
+#include "sc_cmdsign.h"
 
 #define MS UINT64_C(1000000)
 
@@ -154,6 +155,8 @@ static void every_e2e_fault_is_rejected_counted_and_never_used(void **state)
     (void)state;
     sc_pose_msg p = pose_at(0.0f, 0.0f, 0.0f);
     assert_int_equal(send_pose(&p, 0, 1 * MS, 1), SC_TRK_POSE_ACCEPTED);
+    /* the same frame again (a bus duplicate): counted as such, not as a reject */
+    assert_int_equal(send_pose(&p, 0, 2 * MS, 1), SC_TRK_DUPLICATE);
     sc_can_frame f[3];
     size_t n;
     sc_pose_msg q = pose_at(0.5f, 0.0f, 0.0f);
@@ -178,6 +181,7 @@ static void every_e2e_fault_is_rejected_counted_and_never_used(void **state)
     assert_int_equal(k->outcome[SC_TRK_E2E_REPEATED], 1);
     assert_int_equal(k->outcome[SC_TRK_E2E_WRONG_SEQUENCE], 1);
     assert_int_equal(k->e2e_lost, 1);
+    assert_int_equal(k->outcome[SC_TRK_DUPLICATE], 1);
     assert_int_equal(sc_tracker_rejected_e2e(&trk), 3);
 }
 
@@ -309,15 +313,22 @@ static void a_tracker_slower_than_the_frame_rate_never_stalls_and_gives_the_newe
 static void commands_are_queued_in_order_and_overflow_and_bad_values_are_counted(void **s)
 {
     (void)s;
-    sc_can_frame f;
+    /* authenticated commands (sc_secoc.h): a sync, then each command and its MAC */
+    sc_cmdsign snd;
+    assert_int_equal(sc_cmdsign_init(&snd, sc_secoc_bench_key, 0u, 1u, 0), SC_OK);
+    sc_can_frame f[2];
+    assert_int_equal(sc_cmdsign_sync(&snd, f), SC_OK);
+    assert_int_equal(sc_tracker_on_frame(&trk, &f[0], 1), SC_TRK_CMD_PENDING);
+    assert_int_equal(sc_tracker_on_frame(&trk, &f[1], 2), SC_TRK_AUTH_SYNCED);
     for (unsigned i = 0; i < SC_CAN_CMD_QUEUE_MAX + 2u; i++) {
         sc_cmd c = {.kind = SC_CMD_SELECT_CASE, .case_id = (uint8_t)i};
-        assert_int_equal(sc_canproto_encode_cmd(&c, (uint8_t)(i % 16u), &f), 0);
-        assert_int_equal(sc_tracker_on_frame(&trk, &f, i * MS),
+        assert_int_equal(sc_cmdsign_command(&snd, &c, f), 0);
+        assert_int_equal(sc_tracker_on_frame(&trk, &f[0], i * MS), SC_TRK_CMD_PENDING);
+        assert_int_equal(sc_tracker_on_frame(&trk, &f[1], i * MS),
                          i < SC_CAN_CMD_QUEUE_MAX ? SC_TRK_COMMAND : SC_TRK_CMD_QUEUE_FULL);
     }
     sc_cmd m = {.kind = SC_CMD_SET_METHOD, .method = SC_METHOD_FEM};
-    assert_int_equal(sc_canproto_encode_cmd(&m, 0, &f), 0);
+    assert_int_equal(sc_cmdsign_command(&snd, &m, f), 0);
     for (unsigned i = 0; i < SC_CAN_CMD_QUEUE_MAX; i++) {
         sc_cmd c;
         assert_int_equal(sc_tracker_take_command(&trk, &c), 0);
@@ -326,17 +337,19 @@ static void commands_are_queued_in_order_and_overflow_and_bad_values_are_counted
     }
     sc_cmd c;
     assert_int_equal(sc_tracker_take_command(&trk, &c), SC_ERR_WOULD_BLOCK);
-    assert_int_equal(sc_tracker_on_frame(&trk, &f, 20 * MS), SC_TRK_COMMAND);
+    assert_int_equal(sc_tracker_on_frame(&trk, &f[0], 20 * MS), SC_TRK_CMD_PENDING);
+    assert_int_equal(sc_tracker_on_frame(&trk, &f[1], 20 * MS), SC_TRK_COMMAND);
     assert_int_equal(sc_tracker_take_command(&trk, &c), 0);
     assert_int_equal(c.kind, SC_CMD_SET_METHOD);
     assert_int_equal(c.method, SC_METHOD_FEM);
-    /* a method value 3 from a foreign sender, correctly protected */
-    f.data[2] = 3;
-    sc_e2e_protect_with(SC_CANID_CMD_METHOD, 1, f.data, f.len);
-    assert_int_equal(sc_tracker_on_frame(&trk, &f, 21 * MS), SC_TRK_CMD_REJECTED);
+    /* a method value 3 from a foreign sender, correctly protected: refused before any MAC */
+    f[0].data[2] = 3;
+    sc_e2e_protect_with(SC_CANID_CMD_METHOD, 1, f[0].data, f[0].len);
+    assert_int_equal(sc_tracker_on_frame(&trk, &f[0], 21 * MS), SC_TRK_CMD_REJECTED);
     assert_int_equal(sc_tracker_take_command(&trk, &c), SC_ERR_WOULD_BLOCK);
     assert_int_equal(sc_tracker_counters(&trk)->outcome[SC_TRK_CMD_QUEUE_FULL], 2);
     assert_int_equal(sc_tracker_counters(&trk)->outcome[SC_TRK_CMD_REJECTED], 1);
+    assert_int_equal(sc_tracker_rejected_auth(&trk), 0);
 }
 
 static void error_frames_are_reported_to_health_and_foreign_frames_are_ignored(void **s)
@@ -368,19 +381,22 @@ static void status_frames_carry_the_tracker_counters(void **s)
     (void)s;
     sc_pose_msg p = pose_at(0.0f, 0.0f, 0.0f);
     assert_int_equal(send_pose(&p, 0, 1 * MS, 1), SC_TRK_POSE_ACCEPTED);
-    assert_int_equal(send_pose(&p, 0, 11 * MS, 1), SC_TRK_E2E_REPEATED);
+    sc_pose_msg q = pose_at(1.0f, 0.0f, 0.0f); /* same counter, other data: repeated */
+    assert_int_equal(send_pose(&q, 0, 11 * MS, 1), SC_TRK_E2E_REPEATED);
+    assert_int_equal(send_pose(&q, 0, 12 * MS, 1), SC_TRK_E2E_REPEATED);
     sc_status_msg st = {
         .state = 1, .case_id = 3, .vein_area_ratio = 1.0f, .artery_area_ratio = 1.0f};
-    sc_can_frame f[3];
+    sc_can_frame f[SC_STATUS_FRAMES];
     sc_status_tx stx;
     sc_status_tx_init(&stx);
     assert_int_equal(sc_status_tx_encode(&stx, &trk, &st, f), 0);
     sc_status_msg d = {0};
-    for (int i = 0; i < 3; i++) {
+    for (int i = 0; i < (int)SC_STATUS_FRAMES; i++) {
         assert_int_equal(sc_canproto_decode_status_part(&f[i], &d), 0);
     }
     assert_int_equal(d.poses_accepted, 1);
-    assert_int_equal(d.rejected_e2e, 1);
+    assert_int_equal(d.rejected_e2e, 2);
+    assert_int_equal(d.auth_rejected, 0);
     assert_int_equal(d.probe_lifted, 0);
     assert_int_equal(d.case_id, 3);
 }

@@ -116,7 +116,9 @@ static void every_injected_fault_is_counted_by_the_tracker(void **state)
             assert_true(e.injected[f] > 0u);
         }
         assert_int_equal(k->outcome[SC_TRK_E2E_WRONG_CRC], e.injected[SC_EMU_F_BAD_CRC]);
-        assert_int_equal(k->outcome[SC_TRK_E2E_REPEATED], parts * e.injected[SC_EMU_F_REPEAT]);
+        /* a sample sent twice is a duplicate of every frame: counted, not rejected */
+        assert_int_equal(k->outcome[SC_TRK_DUPLICATE], parts * e.injected[SC_EMU_F_REPEAT]);
+        assert_int_equal(k->outcome[SC_TRK_E2E_REPEATED], 0);
         assert_int_equal(k->outcome[SC_TRK_E2E_WRONG_SEQUENCE],
                          parts * e.injected[SC_EMU_F_COUNTER_JUMP]);
         assert_int_equal(sc_tracker_rejected_implausible(&t), e.injected[SC_EMU_F_IMPLAUSIBLE]);

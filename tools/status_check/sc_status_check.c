@@ -28,7 +28,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "sc-status-check: cannot open %s\n", argv[1]);
         return 2;
     }
-    const sc_msg msgs[SC_STATUS_FRAMES] = {SC_MSG_STATUS, SC_MSG_TIMING, SC_MSG_DIAG};
+    const sc_msg msgs[SC_STATUS_FRAMES] = {SC_MSG_STATUS, SC_MSG_TIMING, SC_MSG_DIAG,
+                                           SC_MSG_AUTH_DIAG};
     sc_e2e_rx rx[SC_STATUS_FRAMES];
     for (unsigned i = 0; i < SC_STATUS_FRAMES; i++) {
         sc_e2e_rx_def d = sc_e2e_rx_default_def(sc_canproto_info(msgs[i])->data_id);
@@ -77,11 +78,13 @@ int main(int argc, char **argv)
     printf("status_frames=%u e2e_bad=%u state=%u case_id=%u method=%u contact_frames=%u "
            "lifted_last=%u poses_accepted=%u rejected_e2e=%u rejected_plausibility=%u "
            "lift_events=%u misses=%u worst_frame_us=%u min_vein_pm=%d artery_at_min_pm=%d "
-           "log_rejected=%u\n",
+           "log_rejected=%u cmds_authenticated=%u auth_rejected=%u auth_bad_mac=%u "
+           "auth_stale=%u\n",
            frames, bad, s.state, s.case_id, s.method, contact, s.probe_lifted, s.poses_accepted,
            s.rejected_e2e, s.rejected_plausibility, s.lift_events, s.deadline_misses,
            s.worst_frame_us, min_vein > 1.5f ? -1 : (int)lroundf(1000.0f * min_vein),
            artery_at_min < 0.0f ? -1 : (int)lroundf(1000.0f * artery_at_min),
-           sc_candump_reader_rejected_total(&r));
+           sc_candump_reader_rejected_total(&r), s.cmds_authenticated, s.auth_rejected,
+           s.auth_bad_mac, s.auth_stale);
     return frames > 0u ? 0 : 1;
 }

@@ -170,8 +170,13 @@ int main(int argc, char **argv)
     const sc_can_dev dev = sc_socketcan_dev(&node);
     if (filters) {
         const sc_can_filter f[] = {
+            /* the engine's filters (core/sc_engine.c): exactly the protocol's receive ids */
             {.id = SC_CANID_CMD_CASE, .mask = 0x7FCu, .flags = 0},
-            {.id = SC_CANID_POSE_POS, .mask = 0x7FCu, .flags = 0},
+            {.id = SC_CANID_CMD_SYNC, .mask = 0x7FFu, .flags = 0},
+            {.id = SC_CANID_AUTH_CASE, .mask = 0x7FCu, .flags = 0},
+            {.id = SC_CANID_AUTH_SYNC, .mask = 0x7FFu, .flags = 0},
+            {.id = SC_CANID_POSE_POS, .mask = 0x7FEu, .flags = 0},
+            {.id = SC_CANID_POSE_AUX, .mask = 0x7FFu, .flags = 0},
             {.id = SC_CANID_POSE_FD, .mask = 0x7FFu, .flags = 0},
         };
         rc = sc_can_set_filters(&dev, f, sizeof f / sizeof f[0]);

@@ -8,7 +8,13 @@
  *                  [--fault KIND[:PERIOD[:START_S]]]...  KIND: bad-crc counter-jump repeat
  *                                                        silence implausible
  *                  [--silence-ms 300]
+ *                  [--command KIND=VALUE[@T_S]]... [--auth-key bench|HEX32] [--sender 0..3]
  *                  (--iface vcan0 | --log FILE|- [--log-iface vcan0] [--t0 1700000000])
+ * Commands (the console's messages, docs/can-protocol.md) are authenticated: a freshness sync
+ * before the first, then each command and its cryptographic PDU, signed with Mbed TLS's
+ * AES-CMAC (sc_cmdsign.h) under the given key (default: the bench key). KIND=VALUE:
+ *   case=N  method=msds|fem  reset=tissue|faults|all
+ *   imaging=DEPTH_MM:GAIN_DB:DYN_RANGE_DB:TGC_DB_PER_CM:linear|curvilinear
  * Summary (samples, frames, injected faults) on stderr; exit 0, 2 on a usage error, 1 on an
  * I/O error. */
 #include <errno.h>
@@ -20,11 +26,18 @@
 #include <time.h>
 
 #include "sc_candump.h"
+#include "sc_cmdsign.h"
 #include "sc_err.h"
 #include "sc_socketcan.h"
 #include "sc_trkemu.h"
 
 #define MAX_ROWS 100000u
+#define MAX_CMDS 32u
+
+typedef struct timed_cmd {
+    sc_cmd cmd;
+    uint64_t t_ns;
+} timed_cmd;
 
 static sc_emu_row rows[MAX_ROWS];
 
@@ -35,8 +48,11 @@ static void usage(void)
             "       [--rate-hz HZ] [--duration-s S] [--fd] [--point X,Y,Z] [--depth-mm MM]\n"
             "       [--hover-mm MM] [--length-mm MM] [--period-s S] [--angle-deg DEG]\n"
             "       [--no-force] [--fault KIND[:PERIOD[:START_S]]]... [--silence-ms MS]\n"
+            "       [--command KIND=VALUE[@T_S]]... [--auth-key bench|HEX32] [--sender 0..3]\n"
             "       (--iface IFNAME | --log FILE|- [--log-iface IFNAME] [--t0 SECONDS])\n"
-            "faults: bad-crc counter-jump repeat silence implausible\n");
+            "faults: bad-crc counter-jump repeat silence implausible\n"
+            "commands: case=N method=msds|fem reset=tissue|faults|all\n"
+            "          imaging=DEPTH_MM:GAIN_DB:DYN_RANGE_DB:TGC_DB_PER_CM:linear|curvilinear\n");
 }
 
 /* A whole, finite number (NaN and infinities compare false with every range below). */
@@ -46,6 +62,22 @@ static int parse_double(const char *s, double *out)
     errno = 0;
     const double v = strtod(s, &end);
     if (end == s || *end != '\0' || errno != 0 || !isfinite(v)) {
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+/* A whole decimal number in lo..hi. */
+static int parse_uint(const char *s, unsigned long lo, unsigned long hi, unsigned long *out)
+{
+    char *end;
+    errno = 0;
+    if (*s < '0' || *s > '9') {
+        return -1;
+    }
+    const unsigned long v = strtoul(s, &end, 10);
+    if (*end != '\0' || errno != 0 || v < lo || v > hi) {
         return -1;
     }
     *out = v;
@@ -72,10 +104,90 @@ static int parse_fault(char *arg, sc_emu_fault *f)
     return 0;
 }
 
+/* KIND=VALUE[@T_S] into a command and its time; -1 when malformed (ranges are checked by the
+ * encoder when it is sent). */
+static int parse_command(const char *arg, timed_cmd *out)
+{
+    char buf[128];
+    if (strlen(arg) >= sizeof buf) {
+        return -1;
+    }
+    strcpy(buf, arg);
+    double t_s = 0.0;
+    char *at = strchr(buf, '@');
+    if (at) {
+        *at = '\0';
+        if (parse_double(at + 1, &t_s) != 0 || !(t_s >= 0.0 && t_s < 1e6)) {
+            return -1;
+        }
+    }
+    char *eq = strchr(buf, '=');
+    if (!eq) {
+        return -1;
+    }
+    *eq = '\0';
+    const char *val = eq + 1;
+    sc_cmd c = {0};
+    if (strcmp(buf, "case") == 0) {
+        unsigned long id;
+        if (parse_uint(val, 0u, 254u, &id) != 0) {
+            return -1;
+        }
+        c.kind = SC_CMD_SELECT_CASE;
+        c.case_id = (uint8_t)id;
+    } else if (strcmp(buf, "method") == 0) {
+        c.kind = SC_CMD_SET_METHOD;
+        if (strcmp(val, "msds") == 0) {
+            c.method = SC_METHOD_MSDS;
+        } else if (strcmp(val, "fem") == 0) {
+            c.method = SC_METHOD_FEM;
+        } else {
+            return -1;
+        }
+    } else if (strcmp(buf, "reset") == 0) {
+        c.kind = SC_CMD_RESET;
+        c.reset_target = strcmp(val, "tissue") == 0   ? SC_RESET_TISSUE
+                         : strcmp(val, "faults") == 0 ? SC_RESET_FAULTS
+                         : strcmp(val, "all") == 0    ? SC_RESET_ALL
+                                                      : 0u;
+        if (c.reset_target == 0u) {
+            return -1;
+        }
+    } else if (strcmp(buf, "imaging") == 0) {
+        char geom[16];
+        char tail;
+        c.kind = SC_CMD_SET_IMAGING;
+        if (sscanf(val, "%f:%f:%f:%f:%15[a-z]%c", &c.imaging.depth_mm, &c.imaging.gain_db,
+                   &c.imaging.dyn_range_db, &c.imaging.tgc_db_per_cm, geom, &tail) != 5) {
+            return -1;
+        }
+        if (strcmp(geom, "linear") == 0) {
+            c.imaging.geometry = SC_SCAN_LINEAR;
+        } else if (strcmp(geom, "curvilinear") == 0) {
+            c.imaging.geometry = SC_SCAN_CURVILINEAR;
+        } else {
+            return -1;
+        }
+    } else {
+        return -1;
+    }
+    sc_can_frame probe;
+    if (sc_canproto_encode_cmd(&c, 0, &probe) != 0) {
+        return -1; /* outside the DBC ranges */
+    }
+    out->cmd = c;
+    out->t_ns = (uint64_t)llround(t_s * 1e9);
+    return 0;
+}
+
 typedef struct emu_cli {
     sc_emu_def def;
     const char *iface, *log_path, *log_iface, *csv;
     double t0_s;
+    timed_cmd cmds[MAX_CMDS];
+    uint32_t n_cmds;
+    uint8_t auth_key[16];
+    unsigned long sender;
 } emu_cli;
 
 static void sleep_until(const struct timespec *t0, uint64_t t_ns)
@@ -99,6 +211,7 @@ static int parse_cli(int argc, char **argv, emu_cli *a)
     sc_emu_def *const def = &a->def;
     int have_script = 0;
     optind = 0; /* glibc: a full re-initialisation, so that it can be called again */
+    memcpy(a->auth_key, sc_secoc_bench_key, sizeof a->auth_key);
     static const struct option opts[] = {
         {"script", required_argument, 0, 's'},
         {"csv", required_argument, 0, 'c'},
@@ -118,6 +231,9 @@ static int parse_cli(int argc, char **argv, emu_cli *a)
         {"log", required_argument, 0, 'l'},
         {"log-iface", required_argument, 0, 'I'},
         {"t0", required_argument, 0, 't'},
+        {"command", required_argument, 0, 'C'},
+        {"auth-key", required_argument, 0, 'K'},
+        {"sender", required_argument, 0, 'N'},
         {"help", no_argument, 0, 'h'},
         {0, 0, 0, 0},
     };
@@ -189,6 +305,18 @@ static int parse_cli(int argc, char **argv, emu_cli *a)
         case 't':
             bad = parse_double(optarg, &a->t0_s) != 0 || !(a->t0_s >= 0.0 && a->t0_s < 1e11);
             break;
+        case 'C':
+            bad = a->n_cmds >= MAX_CMDS || parse_command(optarg, &a->cmds[a->n_cmds++]) != 0;
+            break;
+        case 'K':
+            bad = strcmp(optarg, "bench") != 0 && sc_cmdsign_parse_key(optarg, a->auth_key) != 0;
+            if (!bad && strcmp(optarg, "bench") == 0) {
+                memcpy(a->auth_key, sc_secoc_bench_key, sizeof a->auth_key);
+            }
+            break;
+        case 'N':
+            bad = parse_uint(optarg, 0u, SC_SECOC_SENDERS - 1u, &a->sender) != 0;
+            break;
         case 'h':
             usage();
             return 0;
@@ -220,6 +348,10 @@ int main(int argc, char **argv)
     const char *const iface = a.iface, *const log_path = a.log_path, *const log_iface = a.log_iface;
     const char *const csv = a.csv;
     const double t0_s = a.t0_s;
+    timed_cmd *const cmds = a.cmds;
+    const uint32_t n_cmds = a.n_cmds;
+    const uint8_t *const auth_key = a.auth_key;
+    const unsigned long sender = a.sender;
     if (csv) {
         FILE *fp = fopen(csv, "r");
         if (fp == NULL) {
@@ -271,12 +403,46 @@ int main(int argc, char **argv)
     clock_gettime(CLOCK_MONOTONIC, &start);
     const uint64_t t0_us = (uint64_t)llround(t0_s * 1e6);
     uint64_t tx_failed = 0;
-    sc_can_frame fr[SC_EMU_MAX_FRAMES];
+    sc_can_frame fr[SC_EMU_MAX_FRAMES + 4u];
     uint64_t t_ns;
     int n;
+    /* commands in time order (stable: equal times keep their command-line order) */
+    for (uint32_t i = 1; i < n_cmds; i++) {
+        for (uint32_t j = i; j > 0 && cmds[j - 1u].t_ns > cmds[j].t_ns; j--) {
+            const timed_cmd tmp = cmds[j];
+            cmds[j] = cmds[j - 1u];
+            cmds[j - 1u] = tmp;
+        }
+    }
+    sc_cmdsign signer;
+    (void)sc_cmdsign_init(&signer, auth_key, (uint8_t)sender, sc_cmdsign_fv_now(), 1);
+    uint32_t next_cmd = 0, cmds_sent = 0;
     while ((n = sc_emu_next(&emu, fr, SC_EMU_MAX_FRAMES, &t_ns)) >= 0) {
         if (iface) {
             sleep_until(&start, t_ns);
+        }
+        /* a due command goes out before this sample, with a sync before the first one */
+        if (next_cmd < n_cmds && cmds[next_cmd].t_ns <= t_ns) {
+            memmove(&fr[4], &fr[0], (size_t)n * sizeof fr[0]);
+            int extra = 0, rc = 0;
+            if (cmds_sent == 0u) {
+                rc = sc_cmdsign_sync(&signer, &fr[0]);
+                extra = 2;
+            }
+            if (rc == 0) {
+                rc = sc_cmdsign_command(&signer, &cmds[next_cmd].cmd, &fr[extra]);
+                extra += 2;
+            }
+            if (rc != 0) {
+                fprintf(stderr, "sc-tracker-emu: cannot sign a command: %s\n", sc_err_str(rc));
+                return 1;
+            }
+            if (extra < 4) {
+                memmove(&fr[extra], &fr[4], (size_t)n * sizeof fr[0]);
+            }
+            n += extra;
+            next_cmd++;
+            cmds_sent++;
         }
         for (int k = 0; k < n; k++) {
             if (iface) {
@@ -317,10 +483,11 @@ int main(int argc, char **argv)
     }
     fprintf(stderr,
             "sc-tracker-emu: script %s, %.1f Hz, %s: samples_sent=%llu "
-            "samples_silent=%llu frames=%llu tx_failed=%llu",
+            "samples_silent=%llu frames=%llu tx_failed=%llu commands_sent=%u",
             sc_emu_script_name(def.script), def.rate_hz, def.fd ? "fd" : "classic",
             (unsigned long long)emu.samples_sent, (unsigned long long)emu.samples_silent,
-            (unsigned long long)emu.frames_sent, (unsigned long long)tx_failed);
+            (unsigned long long)emu.frames_sent, (unsigned long long)tx_failed,
+            (unsigned)cmds_sent);
     for (int k = 0; k < (int)SC_EMU_F_COUNT; k++) {
         fprintf(stderr, " %s=%llu", sc_emu_fault_name((sc_emu_fault_kind)k),
                 (unsigned long long)emu.injected[k]);

@@ -47,6 +47,9 @@
 
 typedef struct vw_opts {
     const char *bind_addr;
+    const char *sender;      /* accepted source address, "any": every source */
+    int sender_any;
+    struct in_addr sender_ip; /* resolved sender */
     uint16_t port;
     int headless;
     uint64_t frames; /* 0: no limit */
@@ -79,6 +82,10 @@ typedef struct vw_shared {
     double last_packet_s;
     atomic_int stop_rx;
     int fd;
+    int sender_any;
+    struct in_addr sender_ip;
+    uint64_t rej_sender;   /* datagrams from another source: refused, under lock */
+    struct in_addr last_refused;
 } vw_shared;
 
 static vw_shared g_sh;
@@ -130,12 +137,25 @@ static void *rx_main(void *arg)
             continue;
         }
         for (;;) {
-            ssize_t n = recv(sh->fd, buf, sizeof buf, MSG_DONTWAIT);
+            struct sockaddr_in from;
+            socklen_t from_len = sizeof from;
+            memset(&from, 0, sizeof from);
+            ssize_t n = recvfrom(sh->fd, buf, sizeof buf, MSG_DONTWAIT, (struct sockaddr *)&from,
+                                 &from_len);
             if (n < 0) {
                 break;
             }
             const double t = now_s();
             pthread_mutex_lock(&sh->lock);
+            if (!sh->sender_any && (from.sin_family != AF_INET ||
+                                    from.sin_addr.s_addr != sh->sender_ip.s_addr)) {
+                /* only the configured sender's frames: a forged CRC-valid frame from
+                 * anyone else is refused before it reaches the assembler */
+                sh->rej_sender++;
+                sh->last_refused = from.sin_addr;
+                pthread_mutex_unlock(&sh->lock);
+                continue;
+            }
             if (atomic_load(&sh->stop_rx) ||
                 (sh->frames_target && frames_closed(sh) >= sh->frames_target)) {
                 pthread_mutex_unlock(&sh->lock);
@@ -152,6 +172,46 @@ static void *rx_main(void *arg)
         }
     }
     return NULL;
+}
+
+/* An IPv4 address of a name or dotted quad: 0, or -1 when it does not resolve. */
+static int resolve_ipv4(const char *name, struct in_addr *out)
+{
+    struct addrinfo hints, *res = NULL;
+    memset(&hints, 0, sizeof hints);
+    hints.ai_family = AF_INET;
+    hints.ai_socktype = SOCK_DGRAM;
+    if (getaddrinfo(name, NULL, &hints, &res) != 0 || !res) {
+        return -1;
+    }
+    *out = ((const struct sockaddr_in *)(const void *)res->ai_addr)->sin_addr;
+    freeaddrinfo(res);
+    return 0;
+}
+
+/* The accepted sender: --sender, or the loopback engine when the viewer listens on loopback.
+ * 0, or 2 (usage error, printed). */
+static int resolve_sender(vw_opts *o)
+{
+    if (o->sender && strcmp(o->sender, "any") == 0) {
+        o->sender_any = 1;
+        return 0;
+    }
+    if (o->sender == NULL) {
+        struct in_addr b;
+        if (resolve_ipv4(o->bind_addr, &b) != 0 || (ntohl(b.s_addr) >> 24) != 127u) {
+            fprintf(stderr, "sc-viewer: --bind %s is not a loopback address: name the display "
+                            "link's sender with --sender ADDR (or --sender any)\n",
+                    o->bind_addr);
+            return 2;
+        }
+        o->sender = "127.0.0.1";
+    }
+    if (resolve_ipv4(o->sender, &o->sender_ip) != 0) {
+        fprintf(stderr, "sc-viewer: --sender %s: not an IPv4 address or host name\n", o->sender);
+        return 2;
+    }
+    return 0;
 }
 
 static int open_socket(const vw_opts *o)
@@ -268,7 +328,10 @@ static void usage(FILE *f)
     fprintf(f, "usage: sc-viewer [options]\n"
                "Receive the sonocomp display link (docs/display-link.md), show and record it.\n\n"
                "  -p, --port N          UDP port (default 5600)\n"
-               "  -b, --bind ADDR       local address (default 0.0.0.0)\n"
+               "  -b, --bind ADDR       local address (default 127.0.0.1, loopback only)\n"
+               "  -s, --sender ADDR     accept datagrams from this IPv4 address or host only\n"
+               "                        (default 127.0.0.1; needed with a non-loopback --bind;\n"
+               "                        any: from everyone); others are refused and counted\n"
                "      --headless        no window (tests, recording on a server)\n"
                "  -n, --frames N        exit after N closed frames\n"
                "  -t, --seconds S       exit after S seconds\n"
@@ -315,7 +378,8 @@ static int parse_double(const char *s, double *out)
  * Returns -1 to go on, 0 after --help or --version, 2 for a usage error. */
 static int parse_opts(int argc, char **argv, vw_opts *o)
 {
-    *o = (vw_opts){.bind_addr = "0.0.0.0",
+    *o = (vw_opts){.bind_addr = "127.0.0.1",
+                   .sender = NULL,
                    .port = 5600u,
                    .png_every = 1u,
                    .gif_every = 2u,
@@ -335,6 +399,7 @@ static int parse_opts(int argc, char **argv, vw_opts *o)
     };
     static const struct option lo[] = {{"port", required_argument, NULL, 'p'},
                                        {"bind", required_argument, NULL, 'b'},
+                                       {"sender", required_argument, NULL, 's'},
                                        {"headless", no_argument, NULL, OPT_HEADLESS},
                                        {"frames", required_argument, NULL, 'n'},
                                        {"seconds", required_argument, NULL, 't'},
@@ -352,7 +417,7 @@ static int parse_opts(int argc, char **argv, vw_opts *o)
                                        {NULL, 0, NULL, 0}};
     int c;
     uint64_t u;
-    while ((c = getopt_long(argc, argv, "p:b:n:t:qhV", lo, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "p:b:s:n:t:qhV", lo, NULL)) != -1) {
         switch (c) {
         case 'p':
             if (parse_u64(optarg, &u) || u == 0u || u > 65535u) {
@@ -363,6 +428,9 @@ static int parse_opts(int argc, char **argv, vw_opts *o)
             break;
         case 'b':
             o->bind_addr = optarg;
+            break;
+        case 's':
+            o->sender = optarg;
             break;
         case OPT_HEADLESS:
             o->headless = 1;
@@ -461,6 +529,11 @@ int main(int argc, char **argv)
         }
     }
 
+    const int src = resolve_sender(&o);
+    if (src != 0) {
+        return src;
+    }
+
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;
@@ -472,6 +545,8 @@ int main(int argc, char **argv)
     pthread_cond_init(&sh->cond, NULL);
     sc_dlink_asm_init(&sh->rx);
     sh->frames_target = o.frames;
+    sh->sender_any = o.sender_any;
+    sh->sender_ip = o.sender_ip;
     atomic_init(&sh->stop_rx, 0);
     sh->fd = open_socket(&o);
     if (sh->fd < 0) {
@@ -527,12 +602,15 @@ int main(int argc, char **argv)
         return 1;
     }
     if (!o.quiet) {
-        fprintf(stderr, "sc-viewer: listening on %s:%u%s\n", o.bind_addr, (unsigned)o.port,
+        fprintf(stderr, "sc-viewer: listening on %s:%u for %s%s\n", o.bind_addr,
+                (unsigned)o.port, o.sender_any ? "any sender" : o.sender,
                 o.headless ? " (headless)" : "");
     }
 
     const double t0 = now_s();
     double last_status = t0;
+    uint64_t refused_reported = 0;
+    double last_refused_report = 0.0;
     double fps = 0.0;
     double fps_t = t0;
     uint64_t fps_n = 0;
@@ -564,6 +642,8 @@ int main(int argc, char **argv)
             got = 1;
         }
         lost_total = sh->rx.stats.lines_lost;
+        const uint64_t refused = sh->rej_sender;
+        const struct in_addr refused_from = sh->last_refused;
         const uint64_t closed = frames_closed(sh);
         const int queue_empty = sh->q_head == sh->q_tail;
         const double first = sh->first_packet_s, last = sh->last_packet_s;
@@ -628,6 +708,16 @@ int main(int argc, char **argv)
             fprintf(stderr, "sc-viewer: frames=%llu fps=%.1f lines_lost=%llu\n",
                     (unsigned long long)closed, fps, (unsigned long long)lost_total);
         }
+        if (refused != refused_reported && t - last_refused_report >= 1.0) {
+            last_refused_report = t;
+            /* reported even with --quiet: someone else is sending to the display */
+            char ip[INET_ADDRSTRLEN] = "?";
+            (void)inet_ntop(AF_INET, &refused_from, ip, sizeof ip);
+            fprintf(stderr, "sc-viewer: refused %llu datagrams from senders other than %s "
+                            "(last from %s)\n",
+                    (unsigned long long)(refused - refused_reported), o.sender, ip);
+            refused_reported = refused;
+        }
         if (g_signal || (o.frames && closed >= o.frames && queue_empty) ||
             (o.seconds > 0.0 && t - t0 >= o.seconds) ||
             (o.idle_s > 0.0 && first > 0.0 && t - last >= o.idle_s)) {
@@ -644,6 +734,7 @@ int main(int argc, char **argv)
     }
     const sc_dlink_rx_stats st = sh->rx.stats;
     const uint64_t closed = frames_closed(sh), not_shown = sh->frames_not_shown;
+    const uint64_t rej_sender = sh->rej_sender;
     pthread_mutex_unlock(&sh->lock);
 
     if (o.screenshot && have_frame) {
@@ -714,7 +805,7 @@ int main(int argc, char **argv)
     printf("frames=%llu complete=%llu incomplete=%llu lines_received=%llu lines_lost=%llu "
            "lines_late=%llu lines_duplicate=%llu rejected=%llu rej_crc=%llu "
            "sender_dropped=%llu begins_missing=%llu ends_missing=%llu shown=%llu "
-           "not_shown=%llu png=%llu gif_frames=%u seconds=%.2f\n",
+           "not_shown=%llu png=%llu gif_frames=%u seconds=%.2f rej_sender=%llu\n",
            (unsigned long long)closed, (unsigned long long)st.frames_complete,
            (unsigned long long)st.frames_incomplete, (unsigned long long)st.lines_received,
            (unsigned long long)st.lines_lost, (unsigned long long)st.lines_late,
@@ -722,6 +813,7 @@ int main(int argc, char **argv)
            (unsigned long long)st.rej_crc, (unsigned long long)st.lines_sender_dropped,
            (unsigned long long)st.begins_missing, (unsigned long long)st.ends_missing,
            (unsigned long long)shown, (unsigned long long)not_shown,
-           (unsigned long long)png_written, gif_frames, now_s() - t0);
+           (unsigned long long)png_written, gif_frames, now_s() - t0,
+           (unsigned long long)rej_sender);
     return rc;
 }
