@@ -1193,6 +1193,8 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
         .flags = (uint16_t)(contact ? SC_DISPLAY_FLAG_CONTACT : 0u),
         .depth_mm = sd->depth_mm,
         .width_mm = sd->kind == SC_SCAN_GEOM_LINEAR ? sd->width_mm : sd->sector_deg,
+        /* the sinks draw the fan from the probe face's arc, radius_mm in front of the apex */
+        .radius_mm = sd->kind == SC_SCAN_GEOM_LINEAR ? 0.0f : sd->radius_mm,
     };
     int rc = sc_display_frame_begin(display, &info);
     if (rc != SC_OK) {

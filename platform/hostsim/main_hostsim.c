@@ -316,6 +316,11 @@ static int write_frame_raw(const char *path, const sc_display_frame_info *info,
     h[11] = (uint8_t)(info->samples >> 8);
     h[12] = (uint8_t)info->geometry_id;
     h[13] = (uint8_t)(info->geometry_id >> 8);
+    /* probe-face radius in 1/100 mm (0: linear); older files have 0 here */
+    const float r_cmm = info->geometry_id == 1u ? info->radius_mm * 100.0f + 0.5f : 0.0f;
+    const uint16_t r16 = r_cmm > 0.0f && r_cmm < 65535.0f ? (uint16_t)r_cmm : 0u;
+    h[14] = (uint8_t)r16;
+    h[15] = (uint8_t)(r16 >> 8);
     memcpy(h + 16, &info->depth_mm, 4);
     memcpy(h + 20, &info->width_mm, 4);
     size_t n = (size_t)info->lines * info->samples;
