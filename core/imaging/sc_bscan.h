@@ -6,7 +6,12 @@
  * coordinates carry it to the rest configuration, and the case volume is sampled there
  * (trilinear). Pixels outside the mesh are sampled rigidly (at their own position); a pixel whose
  * rest position carries the label SC_LABEL_OUTSIDE (air above the skin) is dark, and without
- * probe contact the whole image is dark, as a real probe in air shows. Then display processing
+ * probe contact the whole image is dark, as a real probe in air shows. Beyond the case volume
+ * (deeper than it, or beside it) the tissue continues: the 6 mm slab along the face the pixel is
+ * beyond, mirrored back and forth (vessels deeper inside are not mirrored out; where the slab
+ * holds bone, the voxel straight across the face is repeated: a shadow stays a shadow), darkened by 0.5 dB per mm outside, so there is no black "no data" band;
+ * above its top face (air) the top voxels are repeated. Such pixels carry the label
+ * SC_LABEL_OUTSIDE, so the compression measure ignores them. Then display processing
  * (gain, 8-band time-gain compensation, dynamic range) and each scan line leaves through the
  * HAL display as soon as it is computed.
  *
