@@ -47,6 +47,8 @@ sc_bscan_def sc_bscan_default_def(void)
     d.volume_range_db = 60.0f;
     d.rest_margin_mm = 60.0f; /* the range's top: deeper than any mesh box the limits allow
                                  a press into (the appliance's 64x32x32 boxes are 30-45 mm) */
+    d.acoustics = 0u;
+    d.acoustic = sc_acoustics_default_def();
     return d;
 }
 
@@ -72,7 +74,7 @@ static int check_def(const sc_bscan_def *d)
     if (d->mapper >= (uint32_t)SC_BSCAN_MAP_COUNT || d->regions_n < 1u ||
         d->regions_n > SC_BSCAN_MAX_REGIONS || !db_ok(d->gain_db, -60.0f, 60.0f) ||
         !db_ok(d->dynamic_range_db, 10.0f, 120.0f) || !db_ok(d->volume_range_db, 10.0f, 120.0f) ||
-        !db_ok(d->rest_margin_mm, 0.0f, 60.0f)) {
+        !db_ok(d->rest_margin_mm, 0.0f, 60.0f) || d->acoustics > 1u) {
         return SC_ERR_RANGE;
     }
     return SC_OK;
@@ -118,6 +120,12 @@ int sc_bscan_set_def(sc_bscan *b, const sc_bscan_def *def)
     if (rc != SC_OK) {
         return rc;
     }
+    sc_acoustics acou;
+    rc = sc_acoustics_init(&acou, &def->acoustic, g_new.sample_mm, def->dynamic_range_db);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    b->acou = acou;
     b->geom = g_new;
     b->def = *def;
     build_lut(b);
@@ -1127,6 +1135,10 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
     }
     if (k < n) {
         sample_span(b, vc, k, n, c->f0, c->fd);
+    }
+    if (b->def.acoustics != 0u) {
+        /* along the beam as it runs now: the labels are this frame's (deformed) ones */
+        sc_acoustics_line(&b->acou, b->line_label, b->line_out, n);
     }
     if (vc->lab == NULL) {
         return;

@@ -47,6 +47,7 @@
 
 #include <stdint.h>
 
+#include "sc_acoustics.h"
 #include "sc_config.h"
 #include "sc_hal_display.h"
 #include "sc_labels.h"
@@ -77,6 +78,10 @@ typedef struct sc_bscan_def {
     float volume_range_db;            /* range the volume's 0..255 stands for, [10, 120] */
     float rest_margin_mm; /* the compression measure's rest reference extends this far above
                              the probe face (tissue pushed into view), [0, 60] */
+    uint32_t acoustics;   /* 1: beam-dependent acoustics along each line (sc_acoustics.h);
+                             0: the volume already holds them (real-patient volumes, the baked
+                             phantoms) */
+    sc_acoustics_def acoustic; /* per-label table, frequency, TGC reference */
 } sc_bscan_def;
 
 /* Labels whose area the compression measure follows (all labels are counted). */
@@ -189,17 +194,19 @@ typedef struct sc_bscan {
     sc_bscan_run runs[SC_MAX_SCAN_SAMPLES];
     uint8_t line_label[SC_MAX_SCAN_SAMPLES];
     uint8_t line_out[SC_MAX_SCAN_SAMPLES];
+    sc_acoustics acou; /* tables of def.acoustic for this geometry and range */
     sc_bscan_status status;
 } sc_bscan;
 
 /* Defaults: the linear probe of sc_scan_default_def(), walker, R = 32, gain 0, TGC 0,
- * 60 dB displayed over a 60 dB volume (the volume shown unchanged). */
+ * 60 dB displayed over a 60 dB volume (the volume shown unchanged), acoustics off with the
+ * table of sc_acoustics_default_def(). */
 sc_bscan_def sc_bscan_default_def(void);
 
 /* Validate def and set up the geometry and display tables; forgets any attached mesh.
  * O(lines + samples). Never allocates.
  * Errors: SC_ERR_INVALID_ARG (NULL), SC_ERR_IMG_GEOMETRY (scan geometry), SC_ERR_RANGE
- * (mapper, regions_n, gain/TGC/range out of range), SC_ERR_NOT_FINITE. On error b is not
+ * (mapper, regions_n, gain/TGC/range, acoustics flag or table out of range), SC_ERR_NOT_FINITE. On error b is not
  * usable (call again with a valid def). */
 int sc_bscan_init(sc_bscan *b, const sc_bscan_def *def);
 

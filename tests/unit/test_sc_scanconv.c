@@ -137,8 +137,8 @@ static void curvilinear_targets_land_on_their_line_sample_and_pixel(void **state
         const float l_exp = (tgt_th[q] + 30.0f * deg) / pitch - 0.5f;
         const float k_exp = tgt_d[q] / dr - 0.5f;
         float l, k;
-        bright_centroid(g_disp.last, s.samples_n, s.lines_n, k_exp + 0.5f, l_exp + 0.5f, 20.0f,
-                        &k, &l);
+        bright_centroid(g_disp.last, s.samples_n, s.lines_n, k_exp + 0.5f, l_exp + 0.5f, 20.0f, &k,
+                        &l);
         assert_float_equal(l - 0.5f, l_exp, 0.6f);
         assert_float_equal(k - 0.5f, k_exp, 1.5f);
     }
