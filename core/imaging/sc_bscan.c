@@ -925,14 +925,14 @@ static void count_labels(const uint8_t *lab, uint32_t n, uint32_t *cnt, uint32_t
 
 typedef struct vol_ctx {
     const uint8_t *vox, *lab;
-    float hi[3];         /* dim - 1/2: the volume's extent in voxel units is [-1/2, hi) */
-    int64_t xmax[3];     /* largest 32.32 position kept: just below the last voxel centre */
-    uint32_t sy32, sz32; /* strides of y and z (a volume has < 2^32 voxels) */
-    size_t stride[3];    /* 1, dim0, dim0 * dim1 */
-    int64_t la;          /* display gain lut_a in 16.16 */
-    float sp_mm[3];          /* voxel spacing */
-    float slab[3];           /* voxels of the slab the continuation beyond a face repeats */
-    float beyond_gl_per_mm;  /* darkening beyond the volume, grey levels per mm */
+    float hi[3];            /* dim - 1/2: the volume's extent in voxel units is [-1/2, hi) */
+    int64_t xmax[3];        /* largest 32.32 position kept: just below the last voxel centre */
+    uint32_t sy32, sz32;    /* strides of y and z (a volume has < 2^32 voxels) */
+    size_t stride[3];       /* 1, dim0, dim0 * dim1 */
+    int64_t la;             /* display gain lut_a in 16.16 */
+    float sp_mm[3];         /* voxel spacing */
+    float slab[3];          /* voxels of the slab the continuation beyond a face repeats */
+    float beyond_gl_per_mm; /* darkening beyond the volume, grey levels per mm */
 } vol_ctx;
 
 /* Positions are 32.32 fixed point (int64): stepping along a span adds exactly, the step's
@@ -1052,7 +1052,8 @@ static void beyond_sample(const vol_ctx *vc, const vol_regs vr, const int64_t *r
     }
     /* the voxel straight across the face first: bone there (and its shadow) continues as
      * itself, and so does a bone the slab would fold into a zigzag */
-    const int64_t sx = clamp_fx(to_fx32(p[0]), vc->xmax[0]), sy = clamp_fx(to_fx32(p[1]), vc->xmax[1]),
+    const int64_t sx = clamp_fx(to_fx32(p[0]), vc->xmax[0]),
+                  sy = clamp_fx(to_fx32(p[1]), vc->xmax[1]),
                   sz = clamp_fx(to_fx32(p[2]), vc->xmax[2]);
     sample_fx(vr, lut, k, sx, sy, sz, out, lab);
     if (lab[k] != (uint8_t)SC_LABEL_BONE) {
