@@ -17,6 +17,7 @@
 #include "sc_bscan.h"
 #include "sc_err.h"
 #include "sc_hs_display.h"
+#include "sc_mesh.h"
 
 #define PH_SP_MM 0.25f
 #define PH_NX    321u /* x -40 .. 40 */
@@ -226,6 +227,50 @@ static void tilting_the_probe_turns_the_shadow_with_the_beam(void **state)
     assert_float_equal(shadow_centre(&on, 28.0f, 30.0f), 3.0f, 0.6f);
 }
 
+static sc_mesh g_mesh;
+static sc_nodes g_nodes;
+
+/* The pass runs along the beam through the deformed tissue: a mesh over the bone moves it 4 mm
+ * sideways and shears it (u_x = 4 + 0.3 (z - 21) mm). The shadow must hang straight down the
+ * beam below the bone where it now is: centred at x = 4 at every depth. Rest labels (no
+ * deformation) would put it at 0; a shadow carried with the tissue (baked into the volume)
+ * would lean with the shear, at 4 + 0.3 (z - 21). */
+static void shadow_hangs_below_the_bone_where_the_deformation_put_it(void **state)
+{
+    (void)state;
+    sc_mesh_def md = sc_mesh_default_def();
+    md.nx = 21u;
+    md.ny = 2u;
+    md.nz = 16u;
+    md.origin_mm[0] = -20.0f;
+    md.origin_mm[1] = -0.9f;
+    md.origin_mm[2] = 0.0f;
+    md.size_mm[0] = 40.0f;
+    md.size_mm[1] = 1.8f;
+    md.size_mm[2] = 40.0f;
+    assert_int_equal(sc_mesh_build(&g_mesh, &md), SC_OK);
+    sc_nodes_reset_to_rest(&g_nodes, &g_mesh);
+    for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+        g_nodes.x[i] += 4.0f + 0.3f * (g_mesh.rest_z[i] - 21.0f);
+    }
+    const sc_bscan_def on = def_with(1u);
+    assert_int_equal(sc_bscan_init(&g_b, &on), SC_OK);
+    assert_int_equal(sc_bscan_attach_mesh(&g_b, &g_mesh), SC_OK);
+    sc_hs_display_init(&g_disp);
+    const sc_display_dev dev = sc_hs_display_dev(&g_disp);
+    const sc_xform probe = probe_at(0.0f, 0.0f, 0.0f);
+    assert_int_equal(sc_bscan_frame(&g_b, &g_mesh, &g_nodes, &g_vol, &probe, 1, &dev, 1u), SC_OK);
+    assert_true(g_b.status.pixels_in_mesh > 1000u);
+    for (int i = 0; i < 2; i++) {
+        const float z0 = 28.0f + 6.0f * (float)i;
+        const float c = shadow_centre(&on, z0, z0 + 2.0f);
+        print_message("depth %.0f mm: shadow at x %.2f mm (beam below the moved bone 4.00, rest "
+                      "labels 0, carried with the tissue %.2f)\n",
+                      (double)(z0 + 1.0f), (double)c, (double)(4.0f + 0.3f * (z0 + 1.0f - 21.0f)));
+        assert_float_equal(c, 4.0f, 0.6f);
+    }
+}
+
 static void table_out_of_range_is_refused(void **state)
 {
     (void)state;
@@ -248,6 +293,7 @@ int main(void)
         cmocka_unit_test(bone_casts_a_shadow_of_at_most_0_3_of_beside),
         cmocka_unit_test(vein_gives_posterior_enhancement_of_at_least_1_2),
         cmocka_unit_test(tilting_the_probe_turns_the_shadow_with_the_beam),
+        cmocka_unit_test(shadow_hangs_below_the_bone_where_the_deformation_put_it),
         cmocka_unit_test(table_out_of_range_is_refused),
     };
     return cmocka_run_group_tests(tests, group_setup, NULL);
