@@ -395,6 +395,8 @@ static int swap_case(sc_engine *e, uint32_t slot)
     const sc_bscan_def running_def = e->bscan.def;
     sc_bscan_def bd = running_def;
     bd.scan.image_to_probe = e->sw.c.image_to_probe;
+    /* the case says whether its volume holds the acoustics or the engine adds them */
+    bd.acoustics = (e->sw.c.imaging_flags & SC_CASE_IMAGING_ENGINE_ACOUSTICS) != 0u ? 1u : 0u;
     /* a method command during the build applies to the new tissue too */
     int rc = sc_tissue_set_method(&e->tissue[slot], e->def.tissue.method);
     if (rc == SC_OK) {

@@ -268,6 +268,7 @@ int sc_case_write(const sc_case_def *def, uint8_t *buf, size_t cap, size_t *out_
             for (int i = 0; i < 9; i++) {
                 wr_f32(p + 40 + 4 * i, def->orientation[i]);
             }
+            wr_u32(p + 76, def->imaging_flags);
             break;
         case 2:
             memcpy(p, def->volume.voxels, n);
@@ -498,9 +499,10 @@ static int parse_case(const section_ref sec[SC_CASE_SECTION_COUNT], uint32_t cas
     if (sec[1].size != SC_CASE_GRID_SIZE) {
         return SC_ERR_CASE_SIZE;
     }
-    if (rd_u32(g + 12) != 0u || rd_u32(g + 76) != 0u) {
+    if (rd_u32(g + 12) != 0u || (rd_u32(g + 76) & ~SC_CASE_IMAGING_KNOWN) != 0u) {
         return SC_ERR_CASE_RESERVED;
     }
+    c.imaging_flags = rd_u32(g + 76);
     for (int a = 0; a < 3; a++) {
         c.volume.dim[a] = rd_u32(g + 4 * a);
         c.volume.spacing_mm[a] = rd_f32(g + 16 + 4 * a);

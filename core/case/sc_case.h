@@ -87,6 +87,13 @@ _Static_assert(SC_MAX_VOLUME_VOXELS <=
                "voxel limit above what the dimension limit allows");
 _Static_assert(SC_CASE_INFO_SIZE == 1024u, "INFO payload size");
 
+/* GRID imaging flags (u32 at GRID offset 76; other bits reserved, zero). */
+#define SC_CASE_IMAGING_ENGINE_ACOUSTICS 1u /* the voxels hold echogenicity only: the engine adds
+                                               attenuation, interfaces and TGC along the beam
+                                               (sc_acoustics.h); clear: the volume holds them
+                                               (real-patient volumes) */
+#define SC_CASE_IMAGING_KNOWN            SC_CASE_IMAGING_ENGINE_ACOUSTICS
+
 /* One material record per label value (index = label, config/sc_labels.h). */
 typedef struct sc_case_material {
     float e_pa;          /* Young's modulus, Pa; finite, > 0 */
@@ -100,6 +107,7 @@ typedef struct sc_case {
     const char *description; /* NUL-terminated, points into the bytes */
     sc_volume volume;        /* voxels and labels point into the bytes; labels never NULL */
     float orientation[9];    /* grid axes in the mannequin frame, row-major, as stored */
+    uint32_t imaging_flags;  /* SC_CASE_IMAGING_* */
     uint32_t material_count; /* 1..SC_MAX_LABELS; every label value is < material_count */
     sc_case_material materials[SC_MAX_LABELS];
     sc_mesh_def mesh;            /* mesh box (volume frame, mm) and node counts */
@@ -118,6 +126,7 @@ typedef struct sc_case_def {
     const char *description; /* < SC_CASE_DESCRIPTION_LEN bytes */
     sc_volume volume;
     float orientation[9];
+    uint32_t imaging_flags; /* SC_CASE_IMAGING_* */
     uint32_t material_count;
     sc_case_material materials[SC_MAX_LABELS];
     sc_mesh_def mesh;

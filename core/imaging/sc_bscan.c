@@ -22,6 +22,15 @@
  * both tets; the rest map is continuous there, so either answer is right. */
 #define SC_BSCAN_LAMBDA_EPS 1e-5f
 
+/* Darkening of the tissue continued beyond the case volume, dB per mm outside it: about half
+ * the uncompensated two-way loss of soft tissue at 7.5 MHz (0.7 dB/cm/MHz x 2 x 7.5 = 1 dB/mm),
+ * so the continuation fades over a few cm instead of ending in a black edge. */
+#define SC_BSCAN_BEYOND_DB_PER_MM 0.5f
+/* Thickness of the slab along a face that the continuation repeats (mirrored back and forth):
+ * thin enough that vessels and bone surfaces inside the volume are not mirrored out, thick
+ * enough that the repetition is not a streak. */
+#define SC_BSCAN_BEYOND_SLAB_MM 6.0f
+
 /* ---- settings --------------------------------------------------------------------------- */
 
 sc_bscan_def sc_bscan_default_def(void)
@@ -38,6 +47,8 @@ sc_bscan_def sc_bscan_default_def(void)
     d.volume_range_db = 60.0f;
     d.rest_margin_mm = 60.0f; /* the range's top: deeper than any mesh box the limits allow
                                  a press into (the appliance's 64x32x32 boxes are 30-45 mm) */
+    d.acoustics = 0u;
+    d.acoustic = sc_acoustics_default_def();
     return d;
 }
 
@@ -63,7 +74,7 @@ static int check_def(const sc_bscan_def *d)
     if (d->mapper >= (uint32_t)SC_BSCAN_MAP_COUNT || d->regions_n < 1u ||
         d->regions_n > SC_BSCAN_MAX_REGIONS || !db_ok(d->gain_db, -60.0f, 60.0f) ||
         !db_ok(d->dynamic_range_db, 10.0f, 120.0f) || !db_ok(d->volume_range_db, 10.0f, 120.0f) ||
-        !db_ok(d->rest_margin_mm, 0.0f, 60.0f)) {
+        !db_ok(d->rest_margin_mm, 0.0f, 60.0f) || d->acoustics > 1u) {
         return SC_ERR_RANGE;
     }
     return SC_OK;
@@ -109,6 +120,12 @@ int sc_bscan_set_def(sc_bscan *b, const sc_bscan_def *def)
     if (rc != SC_OK) {
         return rc;
     }
+    sc_acoustics acou;
+    rc = sc_acoustics_init(&acou, &def->acoustic, g_new.sample_mm, def->dynamic_range_db);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    b->acou = acou;
     b->geom = g_new;
     b->def = *def;
     build_lut(b);
@@ -908,11 +925,14 @@ static void count_labels(const uint8_t *lab, uint32_t n, uint32_t *cnt, uint32_t
 
 typedef struct vol_ctx {
     const uint8_t *vox, *lab;
-    float hi[3];         /* dim - 1/2: the volume's extent in voxel units is [-1/2, hi) */
-    int64_t xmax[3];     /* largest 32.32 position kept: just below the last voxel centre */
-    uint32_t sy32, sz32; /* strides of y and z (a volume has < 2^32 voxels) */
-    size_t stride[3];    /* 1, dim0, dim0 * dim1 */
-    int64_t la;          /* display gain lut_a in 16.16 */
+    float hi[3];            /* dim - 1/2: the volume's extent in voxel units is [-1/2, hi) */
+    int64_t xmax[3];        /* largest 32.32 position kept: just below the last voxel centre */
+    uint32_t sy32, sz32;    /* strides of y and z (a volume has < 2^32 voxels) */
+    size_t stride[3];       /* 1, dim0, dim0 * dim1 */
+    int64_t la;             /* display gain lut_a in 16.16 */
+    float sp_mm[3];         /* voxel spacing */
+    float slab[3];          /* voxels of the slab the continuation beyond a face repeats */
+    float beyond_gl_per_mm; /* darkening beyond the volume, grey levels per mm */
 } vol_ctx;
 
 /* Positions are 32.32 fixed point (int64): stepping along a span adds exactly, the step's
@@ -994,6 +1014,61 @@ static int in_volume(const vol_ctx *vc, const float p[3])
            p[2] >= -0.5f && p[2] < vc->hi[2];
 }
 
+/* Voxel coordinate p folded back into the grid: beyond a face it goes back and forth across
+ * the slab of `slab` voxels next to that face (mirrored at the face and at the slab's inner
+ * side), so the tissue along the face continues and nothing farther inside (a vessel, a bone's
+ * cortex) is mirrored out; with mirror 0 only clamped (above the skin: the top face, air, is not
+ * folded into tissue). Clamped to the voxel centres. Returns how far outside p was, in voxels
+ * (0 inside). */
+static float fold_axis(float p, float dim, float slab, int mirror, float *out)
+{
+    const float lo = -0.5f, hi = dim - 0.5f;
+    float q = p;
+    float outside = 0.0f;
+    if (p < lo || p >= hi) {
+        outside = p < lo ? lo - p : p - hi;
+        float m = fmodf(outside, 2.0f * slab);
+        m = m < slab ? m : 2.0f * slab - m;
+        q = p < lo ? (mirror ? lo + m : 0.0f) : hi - m;
+    }
+    *out = q < 0.0f ? 0.0f : (q > dim - 1.0f ? dim - 1.0f : q);
+    return outside;
+}
+
+/* A sample beyond the case volume: the tissue continues as the slab along the face it left by,
+ * mirrored back and forth (fold_axis), darkened by vc->beyond_gl_per_mm per mm outside (a
+ * real probe shows tissue there, not a black "no data" band). Above the top face (z is depth,
+ * sc_volume.h) the top voxels are repeated, not mirrored: the gel or air there stays dark. Its
+ * label is SC_LABEL_OUTSIDE: the compression measure counts only the case's own tissue. */
+static void beyond_sample(const vol_ctx *vc, const vol_regs vr, const int64_t *restrict lut,
+                          uint32_t k, const float p[3], uint8_t *restrict out,
+                          uint8_t *restrict lab)
+{
+    float q[3], d2_mm2 = 0.0f;
+    for (uint32_t d = 0; d < 3u; d++) {
+        const float o =
+            fold_axis(p[d], vc->hi[d] + 0.5f, vc->slab[d], d != 2u, &q[d]) * vc->sp_mm[d];
+        d2_mm2 += o * o;
+    }
+    /* the voxel straight across the face first: bone there (and its shadow) continues as
+     * itself, and so does a bone the slab would fold into a zigzag */
+    const int64_t sx = clamp_fx(to_fx32(p[0]), vc->xmax[0]),
+                  sy = clamp_fx(to_fx32(p[1]), vc->xmax[1]),
+                  sz = clamp_fx(to_fx32(p[2]), vc->xmax[2]);
+    sample_fx(vr, lut, k, sx, sy, sz, out, lab);
+    if (lab[k] != (uint8_t)SC_LABEL_BONE) {
+        sample_fx(vr, lut, k, clamp_fx(to_fx32(q[0]), vc->xmax[0]),
+                  clamp_fx(to_fx32(q[1]), vc->xmax[1]), clamp_fx(to_fx32(q[2]), vc->xmax[2]), out,
+                  lab);
+        if (lab[k] == (uint8_t)SC_LABEL_BONE) {
+            sample_fx(vr, lut, k, sx, sy, sz, out, lab);
+        }
+    }
+    const float v = (float)out[k] - vc->beyond_gl_per_mm * sqrtf(d2_mm2);
+    out[k] = (uint8_t)(v > 0.0f ? v + 0.5f : 0.0f);
+    lab[k] = (uint8_t)SC_LABEL_OUTSIDE;
+}
+
 /* Samples [k0, k1) at voxel positions a + k b. */
 static void sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1, const float a[3],
                         const float bb[3])
@@ -1037,8 +1112,7 @@ static void sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1
         const float p[3] = {a[0] + (float)k * bb[0], a[1] + (float)k * bb[1],
                             a[2] + (float)k * bb[2]};
         if (!in_volume(vc, p)) {
-            out[k] = 0u; /* outside the case volume: nothing to image */
-            lab[k] = (uint8_t)SC_LABEL_OUTSIDE;
+            beyond_sample(vc, vr, lut, k, p, out, lab);
             continue;
         }
         sample_fx(vr, lut, k, clamp_fx(to_fx32(p[0]), xm0), clamp_fx(to_fx32(p[1]), xm1),
@@ -1062,6 +1136,10 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
     }
     if (k < n) {
         sample_span(b, vc, k, n, c->f0, c->fd);
+    }
+    if (b->def.acoustics != 0u) {
+        /* along the beam as it runs now: the labels are this frame's (deformed) ones */
+        sc_acoustics_line(&b->acou, b->line_label, b->line_out, n);
     }
     if (vc->lab == NULL) {
         return;
@@ -1193,6 +1271,8 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
         .flags = (uint16_t)(contact ? SC_DISPLAY_FLAG_CONTACT : 0u),
         .depth_mm = sd->depth_mm,
         .width_mm = sd->kind == SC_SCAN_GEOM_LINEAR ? sd->width_mm : sd->sector_deg,
+        /* the sinks draw the fan from the probe face's arc, radius_mm in front of the apex */
+        .radius_mm = sd->kind == SC_SCAN_GEOM_LINEAR ? 0.0f : sd->radius_mm,
     };
     int rc = sc_display_frame_begin(display, &info);
     if (rc != SC_OK) {
@@ -1273,6 +1353,13 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
         vc.stride[d] =
             d == 0u ? 1u : (d == 1u ? volume->dim[0] : (size_t)volume->dim[0] * volume->dim[1]);
     }
+    for (uint32_t d = 0; d < 3u; d++) {
+        vc.sp_mm[d] = volume->spacing_mm[d];
+        const float slab = SC_BSCAN_BEYOND_SLAB_MM / volume->spacing_mm[d];
+        const float most = (float)volume->dim[d] - 1.0f;
+        vc.slab[d] = slab < 1.0f ? 1.0f : (slab > most ? most : slab);
+    }
+    vc.beyond_gl_per_mm = 255.0f * SC_BSCAN_BEYOND_DB_PER_MM / b->def.dynamic_range_db;
     vc.sy32 = volume->dim[0];
     vc.sz32 = volume->dim[0] * volume->dim[1];
     area_acc acc;

@@ -6,9 +6,14 @@
  * coordinates carry it to the rest configuration, and the case volume is sampled there
  * (trilinear). Pixels outside the mesh are sampled rigidly (at their own position); a pixel whose
  * rest position carries the label SC_LABEL_OUTSIDE (air above the skin) is dark, and without
- * probe contact the whole image is dark, as a real probe in air shows. Then display processing
- * (gain, 8-band time-gain compensation, dynamic range) and each scan line leaves through the
- * HAL display as soon as it is computed.
+ * probe contact the whole image is dark, as a real probe in air shows. Beyond the case volume
+ * (deeper than it, or beside it) the tissue continues: the 6 mm slab along the face the pixel is
+ * beyond, mirrored back and forth (vessels deeper inside are not mirrored out; where the slab
+ * holds bone, the voxel straight across the face is repeated: a shadow stays a shadow), darkened by
+ * 0.5 dB per mm outside, so there is no black "no data" band; above its top face (air) the top
+ * voxels are repeated. Such pixels carry the label SC_LABEL_OUTSIDE, so the compression measure
+ * ignores them. Then display processing (gain, 8-band time-gain compensation, dynamic range) and
+ * each scan line leaves through the HAL display as soon as it is computed.
  *
  * Three mappers, chosen at run time, that agree up to ties on tet faces:
  * - SC_BSCAN_MAP_ORACLE: per pixel, every tet of the mesh is tried (test oracle; slow).
@@ -42,6 +47,7 @@
 
 #include <stdint.h>
 
+#include "sc_acoustics.h"
 #include "sc_config.h"
 #include "sc_hal_display.h"
 #include "sc_labels.h"
@@ -70,8 +76,12 @@ typedef struct sc_bscan_def {
     float tgc_db[SC_BSCAN_TGC_BANDS]; /* per depth band, shallow first, [-60, 60] */
     float dynamic_range_db;           /* displayed range, [10, 120] */
     float volume_range_db;            /* range the volume's 0..255 stands for, [10, 120] */
-    float rest_margin_mm; /* the compression measure's rest reference extends this far above
-                             the probe face (tissue pushed into view), [0, 60] */
+    float rest_margin_mm;      /* the compression measure's rest reference extends this far above
+                                  the probe face (tissue pushed into view), [0, 60] */
+    uint32_t acoustics;        /* 1: beam-dependent acoustics along each line (sc_acoustics.h);
+                                  0: the volume already holds them (real-patient volumes, the baked
+                                  phantoms) */
+    sc_acoustics_def acoustic; /* per-label table, frequency, TGC reference */
 } sc_bscan_def;
 
 /* Labels whose area the compression measure follows (all labels are counted). */
@@ -184,18 +194,20 @@ typedef struct sc_bscan {
     sc_bscan_run runs[SC_MAX_SCAN_SAMPLES];
     uint8_t line_label[SC_MAX_SCAN_SAMPLES];
     uint8_t line_out[SC_MAX_SCAN_SAMPLES];
+    sc_acoustics acou; /* tables of def.acoustic for this geometry and range */
     sc_bscan_status status;
 } sc_bscan;
 
 /* Defaults: the linear probe of sc_scan_default_def(), walker, R = 32, gain 0, TGC 0,
- * 60 dB displayed over a 60 dB volume (the volume shown unchanged). */
+ * 60 dB displayed over a 60 dB volume (the volume shown unchanged), acoustics off with the
+ * table of sc_acoustics_default_def(). */
 sc_bscan_def sc_bscan_default_def(void);
 
 /* Validate def and set up the geometry and display tables; forgets any attached mesh.
  * O(lines + samples). Never allocates.
  * Errors: SC_ERR_INVALID_ARG (NULL), SC_ERR_IMG_GEOMETRY (scan geometry), SC_ERR_RANGE
- * (mapper, regions_n, gain/TGC/range out of range), SC_ERR_NOT_FINITE. On error b is not
- * usable (call again with a valid def). */
+ * (mapper, regions_n, gain/TGC/range, acoustics flag or table out of range), SC_ERR_NOT_FINITE. On
+ * error b is not usable (call again with a valid def). */
 int sc_bscan_init(sc_bscan *b, const sc_bscan_def *def);
 
 /* Change runtime settings (geometry, depth, mapper, gain, TGC, range, R) between frames,

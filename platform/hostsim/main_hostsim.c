@@ -297,11 +297,48 @@ static int write_frame_raw(const char *path, const sc_display_frame_info *info,
     h[11] = (uint8_t)(info->samples >> 8);
     h[12] = (uint8_t)info->geometry_id;
     h[13] = (uint8_t)(info->geometry_id >> 8);
+    /* probe-face radius in 1/100 mm (0: linear); older files have 0 here */
+    const float r_cmm = info->geometry_id == 1u ? info->radius_mm * 100.0f + 0.5f : 0.0f;
+    const uint16_t r16 = r_cmm > 0.0f && r_cmm < 65535.0f ? (uint16_t)r_cmm : 0u;
+    h[14] = (uint8_t)r16;
+    h[15] = (uint8_t)(r16 >> 8);
     memcpy(h + 16, &info->depth_mm, 4);
     memcpy(h + 20, &info->width_mm, 4);
     size_t n = (size_t)info->lines * info->samples;
     int ok = fwrite(h, 1, sizeof(h), fp) == sizeof(h) && fwrite(image, 1, n, fp) == n;
     return (fclose(fp) == 0 && ok) ? 0 : -1;
+}
+
+/* The sweep script's length, shortened so that the probe's aperture stays over the case
+ * volume: the sweep runs along the tracker's x axis, centred on p_vol (volume frame). */
+static float sweep_length_on_case(const sc_case *cs, const sc_scan_def *scan, const float p_vol[3],
+                                  float length_mm)
+{
+    const float ax_t[3] = {1.0f, 0.0f, 0.0f};
+    float ax[3];
+    sc_xform_rotate(&cs->tracker_to_volume, ax_t, ax);
+    const float half_ap = scan->kind == SC_SCAN_GEOM_LINEAR
+                              ? 0.5f * scan->width_mm
+                              : scan->radius_mm * sinf(scan->sector_deg * (float)M_PI / 360.0f);
+    float room = INFINITY; /* how far the centre may move either way */
+    for (int a = 0; a < 3; a++) {
+        const float c = fabsf(ax[a]);
+        if (c < 1e-3f) {
+            continue;
+        }
+        const sc_volume *v = &cs->volume;
+        const float lo = v->origin_mm[a] - 0.5f * v->spacing_mm[a];
+        const float hi = lo + (float)v->dim[a] * v->spacing_mm[a];
+        const float r = fminf(p_vol[a] - lo, hi - p_vol[a]) - half_ap * c;
+        room = fminf(room, r / c);
+    }
+    const float max_len = room > 0.0f ? 2.0f * room : 0.0f;
+    if (length_mm > max_len) {
+        fprintf(stderr, "sc-hostsim: sweep shortened from %.0f to %.1f mm to stay on the case\n",
+                (double)length_mm, (double)max_len);
+        return max_len;
+    }
+    return length_mm;
 }
 
 static double mono_s(void)
@@ -456,6 +493,9 @@ int main(int argc, char **argv)
         const sc_xform v2t = sc_xform_inverse(&cs->tracker_to_volume);
         sc_xform_apply(&v2t, p_vol, ed.point_mm);
         ed.depth_mm = o.depth_mm;
+        if (ed.script == SC_EMU_SWEEP) {
+            ed.length_mm = sweep_length_on_case(cs, &rig.engine.bscan.def.scan, p_vol, ed.length_mm);
+        }
         ed.duration_s = o.seconds;
         ed.fd = o.fd;
         rc = sc_emu_init(&emu, &ed);

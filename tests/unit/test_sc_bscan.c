@@ -87,17 +87,27 @@ static void rigid_slice(const sc_bscan_def *def, const sc_xform *probe)
             sc_scan_geom_pixel(&g, l, k, img);
             sc_xform_apply(&m, img, w);
             double f[3];
-            int inside = 1;
+            double out2_mm2 = 0.0; /* squared distance outside the volume */
             for (int d = 0; d < 3; d++) {
                 f[d] = ((double)w[d] - v->origin_mm[d]) / v->spacing_mm[d];
-                inside &= f[d] >= -0.5 && f[d] < (double)v->dim[d] - 0.5;
+                /* beyond the volume: back and forth across the 6 mm slab along the face
+                 * (clamped above the top) */
+                const double lo = -0.5, hi = (double)v->dim[d] - 0.5;
+                const double o = f[d] < lo ? lo - f[d] : (f[d] >= hi ? f[d] - hi : 0.0);
+                out2_mm2 += o * o * v->spacing_mm[d] * v->spacing_mm[d];
+                const double slab = 6.0 / v->spacing_mm[d];
+                double back = fmod(o, 2.0 * slab);
+                back = back < slab ? back : 2.0 * slab - back;
+                if (f[d] < lo) {
+                    f[d] = d == 2 ? 0.0 : lo + back;
+                } else if (f[d] >= hi) {
+                    f[d] = hi - back;
+                }
+                f[d] = f[d] < 0.0 ? 0.0 : (f[d] > hi - 0.5 ? hi - 0.5 : f[d]);
             }
+            /* darkened by 0.5 dB/mm outside, in grey levels of the 60 dB display */
+            const double loss = 255.0 * 0.5 / 60.0 * sqrt(out2_mm2);
             const size_t o = (size_t)l * def->scan.samples_n + k;
-            if (!inside) {
-                g_ref[o] = 0;
-                g_ref_i[o] = 0.0f;
-                continue;
-            }
             int i0[3];
             double t[3];
             for (int d = 0; d < 3; d++) {
@@ -125,9 +135,9 @@ static void rigid_slice(const sc_bscan_def *def, const sc_xform *probe)
             const size_t li =
                 (size_t)(int)(f[0] + 0.5) +
                 v->dim[0] * ((size_t)(int)(f[1] + 0.5) + v->dim[1] * (size_t)(int)(f[2] + 0.5));
-            const int dark = v->labels[li] == SC_LABEL_OUTSIDE;
-            g_ref_i[o] = dark ? -1.0f : (float)acc;
-            g_ref[o] = dark ? 0 : (uint8_t)floor(acc + 0.5);
+            const int dark = v->labels[li] == SC_LABEL_OUTSIDE || acc - loss <= 0.0;
+            g_ref_i[o] = dark ? -1.0f : (float)(acc - loss);
+            g_ref[o] = dark ? 0 : (uint8_t)floor(acc - loss + 0.5);
         }
     }
 }

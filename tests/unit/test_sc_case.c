@@ -540,6 +540,25 @@ static void non_finite_or_non_rigid_transforms_are_refused(void **state)
     assert_int_equal(sc_case_load(g_buf, n, &c), SC_ERR_CASE_TRANSFORM);
 }
 
+static void imaging_flags_round_trip_and_unknown_bits_are_refused(void **state)
+{
+    (void)state;
+    sc_case_def d = make_def();
+    sc_case c;
+    size_t n = write_def(&d, g_buf);
+    assert_int_equal(sc_case_load(g_buf, n, &c), SC_OK);
+    assert_int_equal(c.imaging_flags, 0u); /* the volume holds its acoustics */
+    d.imaging_flags = SC_CASE_IMAGING_ENGINE_ACOUSTICS;
+    n = write_def(&d, g_buf);
+    assert_int_equal(sc_case_load(g_buf, n, &c), SC_OK);
+    assert_int_equal(c.imaging_flags, SC_CASE_IMAGING_ENGINE_ACOUSTICS);
+    /* a bit no engine knows yet: refused by name */
+    const size_t grid = payload_of(g_buf, SC_CASE_TAG_GRID);
+    put32(g_buf + grid + 76, SC_CASE_IMAGING_ENGINE_ACOUSTICS | 4u);
+    reseal(g_buf);
+    assert_int_equal(sc_case_load(g_buf, n, &c), SC_ERR_CASE_RESERVED);
+}
+
 static void header_magic_version_and_section_table_errors_are_named(void **state)
 {
     (void)state;
@@ -712,6 +731,7 @@ int main(void)
         cmocka_unit_test(mesh_box_outside_the_volume_is_refused),
         cmocka_unit_test(mesh_node_counts_outside_limits_are_refused),
         cmocka_unit_test(non_finite_or_non_rigid_transforms_are_refused),
+        cmocka_unit_test(imaging_flags_round_trip_and_unknown_bits_are_refused),
         cmocka_unit_test(header_magic_version_and_section_table_errors_are_named),
         cmocka_unit_test(unterminated_or_control_character_text_is_refused),
         cmocka_unit_test(writer_refuses_small_buffers_and_null_volumes),

@@ -1,6 +1,7 @@
 /* sc-casebuild: build, inspect and verify sonocomp case files.
  *
  *   sc-casebuild phantom <neck-ijv|femoral|femoral-dvt> -o OUT.scase [--seed N] [--spacing MM]
+ *                        [--acoustics engine|baked]
  *   sc-casebuild import --volume V.{mha,mhd,nrrd,nhdr,dcm}|DICOMDIR/ [--labels L.{...}] -o
  * OUT.scase
  *                [--name NAME] [--description TEXT] [--spacing MM] [--window LO:HI]
@@ -48,6 +49,8 @@ static int usage(void)
             "usage:\n"
             "  sc-casebuild phantom <neck-ijv|femoral|femoral-dvt> -o OUT.scase [--seed N] "
             "[--spacing MM]\n"
+            "               [--acoustics engine|baked]  (engine: the engine computes shadows and\n"
+            "               enhancement along the beam; baked, the default: in the voxels)\n"
             "  sc-casebuild import --volume FILE [--labels FILE] -o OUT.scase [--name NAME]\n"
             "               [--description TEXT] [--spacing MM] [--window LO:HI]\n"
             "               [--mesh-nodes NX,NY,NZ] [--mesh-box X0,Y0,Z0,SX,SY,SZ]\n"
@@ -331,6 +334,13 @@ static int cmd_phantom(int argc, char **argv)
             if (num_f32("--spacing", argv[++i], 0.1, 2.0, &pd.spacing_mm) != 0) {
                 return 2;
             }
+        } else if (strcmp(argv[i], "--acoustics") == 0 && i + 1 < argc) {
+            const char *a = argv[++i];
+            if (strcmp(a, "engine") != 0 && strcmp(a, "baked") != 0) {
+                fprintf(stderr, "sc-casebuild: --acoustics wants engine or baked, got '%s'\n", a);
+                return 2;
+            }
+            pd.engine_acoustics = strcmp(a, "engine") == 0;
         } else {
             return usage();
         }

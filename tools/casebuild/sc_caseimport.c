@@ -1575,7 +1575,7 @@ static int choose_frame(const sc_image *img, const sc_import_opts *o, int axis[3
     if (rc != SC_OK) {
         return rc;
     }
-    int la, ls;
+    int la = 0, ls = 1; /* set on every path below; GCC 12 -O3 cannot see it */
     snap_axis(img, w, -1, &la, &ls);
     if (la == axis[2]) {
         if (o->lateral_axis != NULL) {

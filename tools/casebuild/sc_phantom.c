@@ -313,7 +313,8 @@ static int interface_label(uint8_t l)
 
 sc_phantom_def sc_phantom_default_def(void)
 {
-    return (sc_phantom_def){.kind = SC_PHANTOM_NECK_IJV, .seed = 1u, .spacing_mm = 0.25f};
+    return (sc_phantom_def){
+        .kind = SC_PHANTOM_NECK_IJV, .seed = 1u, .spacing_mm = 0.25f, .engine_acoustics = 0};
 }
 
 static const char *const kind_names[SC_PHANTOM_KIND_COUNT] = {"neck-ijv", "femoral", "femoral-dvt"};
@@ -465,7 +466,9 @@ int sc_phantom_generate(const sc_phantom_def *pd, sc_phantom *out)
             for (uint32_t k = 0; k < dim[2]; k++) {
                 float z = PH_Z0 + sp * (float)k;
                 size_t idx = i + (size_t)dim[0] * (j + (size_t)dim[1] * k);
-                float gain_db = (z > 0.0f ? PH_TGC_DB_MM * z : 0.0f) - loss_db;
+                /* with the engine's acoustics the voxels hold echogenicity alone */
+                float gain_db =
+                    pd->engine_acoustics ? 0.0f : (z > 0.0f ? PH_TGC_DB_MM * z : 0.0f) - loss_db;
                 float a = fib[idx] * powf(10.0f, gain_db / 20.0f) + 0.004f; /* noise floor */
                 float db = 20.0f * log10f(a / ref_amp);
                 float g = 255.0f * (db + dr_db) / dr_db;
@@ -488,6 +491,7 @@ int sc_phantom_generate(const sc_phantom_def *pd, sc_phantom *out)
     out->vessels[1] = s.v[1];
     sc_case_def *d = &out->def;
     *d = sc_case_default_def();
+    d->imaging_flags = pd->engine_acoustics ? SC_CASE_IMAGING_ENGINE_ACOUSTICS : 0u;
     snprintf(out->name, sizeof out->name, "%s", kind_names[pd->kind]);
     const sc_phantom_vessel *vv = &s.v[0], *va = &s.v[1];
     const char *what =

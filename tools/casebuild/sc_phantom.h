@@ -30,7 +30,10 @@ typedef enum sc_phantom_kind {
 typedef struct sc_phantom_def {
     sc_phantom_kind kind;
     uint64_t seed;
-    float spacing_mm; /* isotropic voxel size, 0.1 .. 2 mm */
+    float spacing_mm;     /* isotropic voxel size, 0.1 .. 2 mm */
+    int engine_acoustics; /* 1: echogenicity only, no attenuation or TGC in the voxels; the
+                             case asks the engine for them (SC_CASE_IMAGING_ENGINE_ACOUSTICS),
+                             so shadows and enhancement follow the beam. 0 (default): baked */
 } sc_phantom_def;
 
 /* A vessel as generated (cross-section at y = 0; the centre drifts by dx_per_mm along y). */
@@ -53,7 +56,7 @@ typedef struct sc_phantom {
     char description[SC_CASE_DESCRIPTION_LEN];
 } sc_phantom;
 
-/* Default definition: neck-ijv, seed 1, 0.25 mm voxels. */
+/* Default definition: neck-ijv, seed 1, 0.25 mm voxels, acoustics baked into the voxels. */
 sc_phantom_def sc_phantom_default_def(void);
 
 /* Kind from its case name ("neck-ijv", "femoral", "femoral-dvt"); -1 when unknown. */

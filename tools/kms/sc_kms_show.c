@@ -10,7 +10,8 @@
  *       by pixel; prints the figures; exit 0 when every pixel is within 1 grey level.
  *   sc-kms-show pattern FRAME
  *       write a synthetic test frame (bands and a disc) to FRAME.
- * FRAME file: "SCFRAME1" magic, u16 lines, u16 samples, u16 geometry_id, u16 0, f32 depth_mm,
+ * FRAME file: "SCFRAME1" magic, u16 lines, u16 samples, u16 geometry_id,
+ * u16 probe-face radius in 1/100 mm (curvilinear; 0 for linear and in older files), f32 depth_mm,
  * f32 width_mm, then lines*samples bytes, line-major (little-endian, as the host runner writes).
  */
 #include <errno.h>
@@ -48,6 +49,7 @@ static int read_frame(const char *path, frame *f)
     f->info.lines = (uint16_t)(h[8] | h[9] << 8);
     f->info.samples = (uint16_t)(h[10] | h[11] << 8);
     f->info.geometry_id = (uint16_t)(h[12] | h[13] << 8);
+    f->info.radius_mm = f->info.geometry_id == 1u ? (float)(h[14] | h[15] << 8) / 100.0f : 0.0f;
     memcpy(&f->info.depth_mm, h + 16, 4);
     memcpy(&f->info.width_mm, h + 20, 4);
     if (f->info.lines == 0u || f->info.lines > SC_MAX_SCAN_LINES || f->info.samples == 0u ||
