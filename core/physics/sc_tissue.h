@@ -23,7 +23,7 @@
  *      node chatter, and a node is released as soon as the probe moves away from it;
  *   4. the skin MSDS (sc_skin.h) with the same collider;
  *   5. stability guard: any non-finite position or velocity, a node displaced by more than
- *      the box diagonal, or (MSDS) kinetic energy above the energy of every spring stretched
+ *      the box diagonal, or (explicit MSDS) kinetic energy above the energy of every spring stretched
  *      by its own length, resets the tissue and the skin to rest, counts the fault and makes
  *      the step return SC_ERR_PHYS_UNSTABLE: the diverged state never reaches the image; the
  *      reason is kept in stats.last_fault (sc_tissue_guard) and the engine logs it. The next
@@ -85,7 +85,7 @@ typedef enum sc_tissue_guard {
     SC_TISSUE_GUARD_OK = 0,
     SC_TISSUE_GUARD_NOT_FINITE = 1,   /* a position or velocity is NaN or infinite */
     SC_TISSUE_GUARD_DISPLACEMENT = 2, /* a node moved further than the box diagonal */
-    SC_TISSUE_GUARD_ENERGY = 3,       /* MSDS kinetic energy above its runaway bound */
+    SC_TISSUE_GUARD_ENERGY = 3,       /* explicit MSDS kinetic energy above its runaway bound */
     SC_TISSUE_GUARD_SOLVER = 4,       /* the implicit solve (FEM or MSDS) was not finite */
     SC_TISSUE_GUARD_SKIN = 5,         /* the skin diverged */
 } sc_tissue_guard;
