@@ -18,8 +18,9 @@
  *               odd, K(t + d1, t + d2) if t is even (the diagonal that joins the odd corners).
  * A block that does not exist (past the grid's edge) is zero. That is 60 floats per node
  * against 6.5 blocks of 13 floats in a block-CSR (the former layout: 84 floats and an index per
- * block), and the mat-vec streams them once: measured 0.07 ms per mat-vec at 32x16x16 on
- * x86-64-v3/v4 against about 0.08 ms for the block-CSR's whole CG iteration's mat-vec.
+ * block), and the mat-vec reads each stored block once from memory (the backward reuse of a
+ * block hits the cache): measured 0.075 ms per mat-vec at 32x16x16 on x86-64-v4, a whole CG
+ * iteration 0.09 ms against 0.11 ms with the former block-CSR.
  *
  * Layout: node t lives at index SC_GRID_HEAD + t of every row, so that a node's neighbours
  * t - nx ny - nx - 1 .. t + nx ny + nx + 1 are in the row for every node (zero past the mesh);

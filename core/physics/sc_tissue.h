@@ -6,8 +6,8 @@
  *   1. place the probe (pose of the probe frame in the volume frame) or lift it (NULL);
  *   2. contacts of the tet mesh's nodes with the probe (sc_collider.h, libccd MPR);
  *   3. MSDS, default (def.msds.integrator SC_MSDS_IMPLICIT): one backward Euler step of the
- *      frame's simulated time (iterations x dt) with `iterations` CG iterations and the probe's
- *      contacts as kinematic nodes, exactly as the FEM below (sc_msds_implicit.h);
+ *      frame's simulated time (iterations x dt) with def.fem.cg_iterations CG iterations and
+ *      the probe's contacts as kinematic nodes, exactly as the FEM below (sc_msds_implicit.h);
  *      MSDS, explicit (SC_MSDS_EXPLICIT, the paper): def.msds.iterations explicit Euler
  *      steps (dt each); after every step each node
  *      that penetrates its contact plane gets the repulsion that removes the penetration in
@@ -17,7 +17,7 @@
  *      the node's mass-equivalent stiffness m / mass_per_stiffness, sc_msds.h; softer, the
  *      tissue sinks into the probe);
  *      FEM: one implicit step of length iterations * dt (the same simulated time per frame
- *      as the MSDS) with `iterations` CG iterations; nodes in the probe or on its surface
+ *      as the MSDS) with def.fem.cg_iterations CG iterations; nodes in the probe or on its surface
  *      (depth > -SC_TISSUE_CONTACT_HOLD_MM) are moved onto the surface as kinematic
  *      (Dirichlet) nodes (sc_fem_step_kinematic), so a static probe does not make a surface
  *      node chatter, and a node is released as soon as the probe moves away from it;
@@ -34,8 +34,9 @@
  * Switching MSDS <-> FEM at run time changes only which solver advances the shared sc_nodes:
  * the shape and the velocities carry over, nothing is reallocated or rebuilt.
  *
- * Memory: one caller-owned sc_tissue (about 13 MB at the default limits, dominated by the
- * FEM's matrix; static storage or locked memory). Never allocates, never calls the OS.
+ * Memory: one caller-owned sc_tissue (about 9.7 MB at the default limits: the MSDS, the
+ * FEM's grid and Algorithm 1's springs; sizeof printed by bench-physics; static storage or
+ * locked memory). Never allocates, never calls the OS.
  * Deterministic: same definition, case and pose sequence give bit-identical states
  * (sc_tissue_state_hash). Threads: one writer; readers (B-scan) read t->nodes between steps.
  */
