@@ -61,6 +61,11 @@
 #ifndef SC_PHYS_ITERATIONS_MAX
 #define SC_PHYS_ITERATIONS_MAX 200u
 #endif
+/* CG iterations per frame of the implicit step (FEM and the stable MSDS; sc_fem.h). The
+ * frame's simulated time stays SC_PHYS_ITERATIONS_DEFAULT x dt. */
+#ifndef SC_PHYS_CG_ITERATIONS_DEFAULT
+#define SC_PHYS_CG_ITERATIONS_DEFAULT 10u
+#endif
 #ifndef SC_PHYS_DT_DEFAULT_S
 #define SC_PHYS_DT_DEFAULT_S 0.01f
 #endif

@@ -52,6 +52,18 @@ typedef struct sc_mesh {
 #define SC_MESH_ROLLER_Z 8u
 #define SC_MESH_FIXED_ALL 1u
 
+/* The five tets of a grid cell in its corner numbering (corner bit 0: +x, bit 1: +y, bit 2: +z),
+ * even cell (i + j + k of its lowest corner even), in sc_mesh_build's order: tet 5 c + q of
+ * cell c has these corners (an odd cell: the corners a ^ 1, the template mirrored in x; the
+ * vertex order within a tet may differ, the set does not): X(q, a, b, c, d). The MSDS kernels
+ * and the grid solver (sc_grid.h) rely on it; sc_msds_init and sc_grid_init check the mesh. */
+#define SC_MESH_CELL_TETS(X)                                                                       \
+    X(0, 0u, 1u, 2u, 4u)                                                                           \
+    X(1, 3u, 2u, 1u, 7u)                                                                           \
+    X(2, 5u, 4u, 7u, 1u)                                                                           \
+    X(3, 6u, 7u, 4u, 2u)                                                                           \
+    X(4, 1u, 2u, 4u, 7u)
+
 /* Deformed state shared by MSDS and FEM so that switching keeps the shape (float32 SoA). */
 typedef struct sc_nodes {
     SC_ALIGN_HOT float x[SC_MAX_NODES]; /* deformed positions, mm */

@@ -7,8 +7,9 @@
  * explicit MSDS (sc_msds.h: k, L0, k_vol, rest 6V), with the physical lumped masses:
  *   (M + dt C + dt^2 K(x)) v+ = M v + dt (f_ext - f_int(x)),   x+ = x + dt v+,
  *   C = beta K(x) + alpha M,  beta = Algorithm 1's gamma / k (0.1 s), alpha = drag_per_s,
- * solved by `iterations` warm-started Jacobi-PCG iterations (sc_fem_step_custom) in the FEM's
- * block-sparse pattern: the springs are exactly the tets' edges, so the pattern is the FEM's.
+ * solved by a fixed number of warm-started Jacobi-PCG iterations on the grid matrix the FEM
+ * uses (sc_grid.h): the springs are exactly the tets' edges, so every spring is one of the
+ * grid's stencil blocks.
  * K(x), per spring (d = x_j - x_i, L = |d|, u = d / L): k u u^T + k max(0, 1 - L0 / L)
  * (I - u u^T) (the transverse term only where the spring is stretched, so K stays positive
  * semi-definite when springs are compressed: a compressed spring's negative transverse
@@ -19,20 +20,22 @@
  * stable (each step solves a symmetric positive definite system; a fixed-count CG from a warm
  * start only slows the relaxation, it cannot amplify it), so no mass scaling, no small step
  * and no stability bound are needed, and any press depth, probe speed or contact set gives a
- * bounded step. It reuses the FEM's matrix storage, solver vectors and CG (the two methods
- * never run in the same frame), so it costs no memory of its own. Probe contacts are
- * kinematic (Dirichlet) nodes, exactly as for the FEM (sc_tissue.c).
+ * bounded step. It reuses the FEM's grid (matrix, solver vectors, CG; the two methods never
+ * run in the same frame), so it costs no memory of its own. Probe contacts are kinematic
+ * (Dirichlet) nodes, exactly as for the FEM (sc_tissue.c); an unloaded frame starts from the
+ * quasi-static step toward rest (sc_grid.h).
  *
  * Floor term (walls that meet do not pass through each other): a tet below floor_volume_ratio
  * of its rest volume gets 1/2 K_f V0 ((V - V_f) / V0)^2 (K_f = floor_pa) with its Gauss-Newton
  * stiffness, the same term as the FEM's (sc_fem.h): a collapsed vein flattens to the floor
  * instead of turning its tets inside out.
  *
- * Cost per frame: O(springs + tets) assembly (6 N springs with one sqrt and one divide each,
- * 10 outer-product blocks per tet) plus (iterations + 1) block mat-vecs of the FEM's CG.
- * Measured (bench-physics, x86-64-v4, shared 2-core VM): 7-8 ms per frame at 32x16x16 with 20
- * CG iterations (38% in the FEM's block mat-vec, 15% in this file's scalar assembly), about
- * twice the linear FEM; the 2 ms target is not met.
+ * Cost per frame: the springs, family by family (9 N with one sqrt and one divide each), and
+ * the volume and floor terms cell by cell (5 tets, their 10 rank-1 blocks each), vectorised
+ * (sc_grid_kern.inc), plus cg_iterations grid mat-vecs; K v0 of r0 is formed in the same
+ * passes. Measured (bench-physics 100 stages, x86-64-v4, shared 2-core VM, minimum of 100
+ * frames): 1.86 ms per tissue frame at 32x16x16 with 10 CG iterations: collision 0.25, step
+ * start 0.07, assembly 0.68, CG 0.87 (the explicit MSDS: 3.7 ms).
  * Memory: none beyond sc_msds and sc_fem (the FEM's blocks are overwritten: the next linear
  * FEM step re-assembles its rest K once). Never allocates, never calls the OS; deterministic
  * (fixed loop orders and counts). Threads: one writer.

@@ -27,16 +27,8 @@
 #define SC_MSDS_IVDEP
 #endif
 
-/* The five tets of a grid cell in its corner numbering (bit 0: +x, bit 1: +y, bit 2: +z),
- * even template, in the mesh's order (sc_mesh_build's tet q of an even cell has these corners,
- * of an odd cell the corners c ^ 1): X(q, a, b, c, d). One list for the kernel's tet loop and
- * for sc_msds_init, which checks it against the mesh. */
-#define SC_MSDS_CELL_TETS(X)                                                                       \
-    X(0, 0u, 1u, 2u, 4u)                                                                           \
-    X(1, 3u, 2u, 1u, 7u)                                                                           \
-    X(2, 5u, 4u, 7u, 1u)                                                                           \
-    X(3, 6u, 7u, 4u, 2u)                                                                           \
-    X(4, 1u, 2u, 4u, 7u)
+/* The five tets of a grid cell (sc_mesh.h), as the kernel's tet loop and sc_msds_init use them. */
+#define SC_MSDS_CELL_TETS SC_MESH_CELL_TETS
 
 /* Node offsets of the 8 corners of the grid cell at its origin node (corner bit 0: +x,
  * bit 1: +y, bit 2: +z), for nx nodes per row and nxy per plane. */

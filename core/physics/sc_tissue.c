@@ -245,10 +245,10 @@ static void step_kinematic(sc_tissue *t, int implicit_msds)
         }
     }
     if (implicit_msds) {
-        sc_msds_implicit_step(&t->msds, &t->fem, &t->mesh, n, dt_frame, t->msds.def.iterations,
+        sc_msds_implicit_step(&t->msds, &t->fem, &t->mesh, n, dt_frame, t->fem.def.cg_iterations,
                               t->kinematic);
     } else {
-        sc_fem_step_kinematic(&t->fem, &t->mesh, n, dt_frame, t->msds.def.iterations,
+        sc_fem_step_kinematic(&t->fem, &t->mesh, n, dt_frame, t->fem.def.cg_iterations,
                               t->kinematic);
     }
     for (uint32_t q = 0; q < t->contacts.count; q++) {
@@ -287,7 +287,10 @@ static sc_tissue_guard guard(sc_tissue *t)
     if (maxd > t->box_diag_mm) {
         return SC_TISSUE_GUARD_DISPLACEMENT;
     }
-    if (t->method == SC_TISSUE_MSDS) {
+    if (t->method == SC_TISSUE_MSDS && t->msds.def.integrator == (uint8_t)SC_MSDS_EXPLICIT) {
+        /* the explicit scheme's runaway (its scaled masses); the implicit step cannot gain
+         * energy (backward Euler on a positive semi-definite K dissipates) and its solve is
+         * checked for finiteness below */
         const float ek = sc_msds_kinetic_energy_j(&t->msds, n);
         if (!isfinite(ek) || ek > t->msds.energy_limit_j) {
             return SC_TISSUE_GUARD_ENERGY;

@@ -6,8 +6,8 @@
  *   1. place the probe (pose of the probe frame in the volume frame) or lift it (NULL);
  *   2. contacts of the tet mesh's nodes with the probe (sc_collider.h, libccd MPR);
  *   3. MSDS, default (def.msds.integrator SC_MSDS_IMPLICIT): one backward Euler step of the
- *      frame's simulated time (iterations x dt) with `iterations` CG iterations and the probe's
- *      contacts as kinematic nodes, exactly as the FEM below (sc_msds_implicit.h);
+ *      frame's simulated time (iterations x dt) with def.fem.cg_iterations CG iterations and
+ *      the probe's contacts as kinematic nodes, exactly as the FEM below (sc_msds_implicit.h);
  *      MSDS, explicit (SC_MSDS_EXPLICIT, the paper): def.msds.iterations explicit Euler
  *      steps (dt each); after every step each node
  *      that penetrates its contact plane gets the repulsion that removes the penetration in
@@ -17,13 +17,13 @@
  *      the node's mass-equivalent stiffness m / mass_per_stiffness, sc_msds.h; softer, the
  *      tissue sinks into the probe);
  *      FEM: one implicit step of length iterations * dt (the same simulated time per frame
- *      as the MSDS) with `iterations` CG iterations; nodes in the probe or on its surface
+ *      as the MSDS) with def.fem.cg_iterations CG iterations; nodes in the probe or on its surface
  *      (depth > -SC_TISSUE_CONTACT_HOLD_MM) are moved onto the surface as kinematic
  *      (Dirichlet) nodes (sc_fem_step_kinematic), so a static probe does not make a surface
  *      node chatter, and a node is released as soon as the probe moves away from it;
  *   4. the skin MSDS (sc_skin.h) with the same collider;
  *   5. stability guard: any non-finite position or velocity, a node displaced by more than
- *      the box diagonal, or (MSDS) kinetic energy above the energy of every spring stretched
+ *      the box diagonal, or (explicit MSDS) kinetic energy above the energy of every spring stretched
  *      by its own length, resets the tissue and the skin to rest, counts the fault and makes
  *      the step return SC_ERR_PHYS_UNSTABLE: the diverged state never reaches the image; the
  *      reason is kept in stats.last_fault (sc_tissue_guard) and the engine logs it. The next
@@ -34,8 +34,9 @@
  * Switching MSDS <-> FEM at run time changes only which solver advances the shared sc_nodes:
  * the shape and the velocities carry over, nothing is reallocated or rebuilt.
  *
- * Memory: one caller-owned sc_tissue (about 13 MB at the default limits, dominated by the
- * FEM's matrix; static storage or locked memory). Never allocates, never calls the OS.
+ * Memory: one caller-owned sc_tissue (about 9.7 MB at the default limits: the MSDS, the
+ * FEM's grid and Algorithm 1's springs; sizeof printed by bench-physics; static storage or
+ * locked memory). Never allocates, never calls the OS.
  * Deterministic: same definition, case and pose sequence give bit-identical states
  * (sc_tissue_state_hash). Threads: one writer; readers (B-scan) read t->nodes between steps.
  */
@@ -85,7 +86,7 @@ typedef enum sc_tissue_guard {
     SC_TISSUE_GUARD_OK = 0,
     SC_TISSUE_GUARD_NOT_FINITE = 1,   /* a position or velocity is NaN or infinite */
     SC_TISSUE_GUARD_DISPLACEMENT = 2, /* a node moved further than the box diagonal */
-    SC_TISSUE_GUARD_ENERGY = 3,       /* MSDS kinetic energy above its runaway bound */
+    SC_TISSUE_GUARD_ENERGY = 3,       /* explicit MSDS kinetic energy above its runaway bound */
     SC_TISSUE_GUARD_SOLVER = 4,       /* the implicit solve (FEM or MSDS) was not finite */
     SC_TISSUE_GUARD_SKIN = 5,         /* the skin diverged */
 } sc_tissue_guard;

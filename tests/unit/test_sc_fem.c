@@ -54,27 +54,11 @@ static void tet_centroid(const sc_mesh *m, uint32_t e, float c[3])
     }
 }
 
-/* y = K x with the FEM's upper-triangle blocks (interleaved xyz; block (i, j) also acts as
- * (j, i)^T), double accumulation: the test's oracle. */
+/* y = K x with the FEM's grid matrix (sc_grid_apply_ref: every stored block, double
+ * accumulation, interleaved xyz): the test's oracle. */
 static void k_times(const sc_fem *f, const double *x, double *y)
 {
-    for (uint32_t k = 0; k < 3u * f->node_count; k++) {
-        y[k] = 0.0;
-    }
-    for (uint32_t i = 0; i < f->node_count; i++) {
-        for (uint32_t b = f->row_start[i]; b < f->row_start[i + 1u]; b++) {
-            const uint32_t c = f->col[b];
-            for (uint32_t r = 0; r < 3u; r++) {
-                for (uint32_t q = 0; q < 3u; q++) {
-                    const double v = (double)f->blk[b][4u * r + q];
-                    y[3u * i + r] += v * x[3u * c + q];
-                    if (c != i) {
-                        y[3u * c + q] += v * x[3u * i + r];
-                    }
-                }
-            }
-        }
-    }
+    sc_grid_apply_ref(&f->grid, 0.0f, 1.0f, x, y);
 }
 
 /* node on the top (skin) layer, k = 0 */
@@ -131,47 +115,55 @@ static void init_rejects_invalid_inputs(void **state)
     assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_OK);
 }
 
-static void pattern_has_diagonal_then_one_block_per_edge_above_it(void **state)
+/* The grid matrix stores exactly one block per mesh edge (either order of the pair) and
+ * none for any other pair of grid neighbours. */
+static void grid_stores_one_block_per_mesh_edge_and_none_elsewhere(void **state)
 {
     (void)state;
-    make_mesh(5, 4, 3);
-    sc_fem_def def = sc_fem_default_def();
-    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_OK);
-    /* brute-force edge set */
-    static uint8_t adj[60][60];
-    memset(adj, 0, sizeof adj);
-    uint32_t edges = 0;
-    for (uint32_t e = 0; e < g_mesh.tet_count; e++) {
-        for (uint32_t a = 0; a < 4u; a++) {
-            for (uint32_t b = 0; b < 4u; b++) {
-                const uint32_t i = g_mesh.tet[e][a], j = g_mesh.tet[e][b];
-                if (i < j && !adj[i][j]) {
-                    adj[i][j] = adj[j][i] = 1u;
-                    edges++;
+    static const uint32_t dims[3][3] = {{5u, 4u, 3u}, {2u, 2u, 2u}, {3u, 2u, 4u}};
+    for (uint32_t dsz = 0; dsz < 3u; dsz++) {
+        make_mesh(dims[dsz][0], dims[dsz][1], dims[dsz][2]);
+        sc_fem_def def = sc_fem_default_def();
+        assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_OK);
+        static uint8_t adj[60][60];
+        memset(adj, 0, sizeof adj);
+        uint32_t edges = 0;
+        assert_true(g_mesh.node_count <= 60u);
+        for (uint32_t e = 0; e < g_mesh.tet_count; e++) {
+            for (uint32_t a = 0; a < 4u; a++) {
+                for (uint32_t b = 0; b < 4u; b++) {
+                    const uint32_t i = g_mesh.tet[e][a], j = g_mesh.tet[e][b];
+                    if (i < j && !adj[i][j]) {
+                        adj[i][j] = adj[j][i] = 1u;
+                        edges++;
+                    }
                 }
             }
         }
-    }
-    assert_int_equal(g_fem.nnz_blocks, g_mesh.node_count + edges);
-    uint32_t found = 0;
-    for (uint32_t i = 0; i < g_mesh.node_count; i++) {
-        assert_true(g_fem.row_start[i] < g_fem.row_start[i + 1u]);
-        assert_int_equal(g_fem.col[g_fem.row_start[i]], i); /* diagonal first */
-        for (uint32_t b = g_fem.row_start[i] + 1u; b < g_fem.row_start[i + 1u]; b++) {
-            const uint32_t c = g_fem.col[b];
-            assert_true(c > i && c > g_fem.col[b - 1u]); /* above the diagonal, sorted */
-            assert_true(adj[i][c]);
-            found++;
+        uint32_t found = 0;
+        for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+            float b[9];
+            assert_int_equal(sc_grid_block(&g_fem.grid, i, i, b), 1);
+            for (uint32_t j = i + 1u; j < g_mesh.node_count; j++) {
+                const int stored = sc_grid_block(&g_fem.grid, i, j, b);
+                assert_int_equal(stored, adj[i][j] ? 1 : 0);
+                found += stored ? 1u : 0u;
+                float bt[9];
+                assert_int_equal(sc_grid_block(&g_fem.grid, j, i, bt), stored);
+                for (uint32_t r = 0; r < 3u; r++) {
+                    for (uint32_t c = 0; c < 3u; c++) {
+                        assert_true(same(b[3u * r + c], bt[3u * c + r])); /* K_ji = K_ij^T */
+                    }
+                }
+            }
         }
-        assert_true(g_fem.row_start[i + 1u] - g_fem.row_start[i] <= 10u);
+        assert_int_equal(found, edges);
     }
-    assert_int_equal(found, edges);
-    /* the configured bound holds for the largest mesh */
     make_mesh(SC_MAX_MESH_NX, SC_MAX_MESH_NY, SC_MAX_MESH_NZ);
+    sc_fem_def def = sc_fem_default_def();
     assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_OK);
-    assert_true(g_fem.nnz_blocks <= SC_MAX_FEM_NNZ_BLOCKS);
-    print_message("blocks at %ux%ux%u: %u (limit %u), sizeof(sc_fem) %zu B\n", g_mesh.nx, g_mesh.ny,
-                  g_mesh.nz, g_fem.nnz_blocks, (unsigned)SC_MAX_FEM_NNZ_BLOCKS, sizeof(sc_fem));
+    print_message("grid at %ux%ux%u: row stride %u floats, sizeof(sc_fem) %zu B\n", g_mesh.nx,
+                  g_mesh.ny, g_mesh.nz, (unsigned)SC_GRID_ROW, sizeof(sc_fem));
 }
 
 /* ---- element stiffness ------------------------------------------------------------------- */
@@ -198,18 +190,20 @@ static void stiffness_annihilates_rigid_motions_and_diagonal_blocks_are_symmetri
     const uint32_t n = g_mesh.node_count;
     double kmax = 0.0;
     for (uint32_t i = 0; i < n; i++) {
-        const float *D = g_fem.blk[g_fem.row_start[i]];
+        float D[9];
+        assert_int_equal(sc_grid_block(&g_fem.grid, i, i, D), 1);
         for (uint32_t r = 0; r < 3u; r++) {
-            assert_true(D[5u * r] > 0.0f);           /* positive diagonal */
-            assert_true(same(D[4u * r + 3u], 0.0f)); /* padding lane */
+            assert_true(D[4u * r] > 0.0f); /* positive diagonal */
             for (uint32_t c = 0; c < 3u; c++) {
-                /* mirrored on assembly: exact */
-                assert_true(same(D[4u * r + c], D[4u * c + r]));
+                assert_true(same(D[3u * r + c], D[3u * c + r])); /* stored symmetric */
             }
         }
-        for (uint32_t b = g_fem.row_start[i]; b < g_fem.row_start[i + 1u]; b++) {
-            for (uint32_t k = 0; k < SC_FEM_BLK_FLOATS; k++) {
-                kmax = fmax(kmax, fabs((double)g_fem.blk[b][k]));
+        for (uint32_t j = 0; j < n; j++) {
+            float b[9];
+            if (sc_grid_block(&g_fem.grid, i, j, b)) {
+                for (uint32_t k = 0; k < 9u; k++) {
+                    kmax = fmax(kmax, fabs((double)b[k]));
+                }
             }
         }
     }
@@ -947,16 +941,17 @@ static void steps_are_bitwise_deterministic(void **state)
     }
     print_message("state hash after 40 frames: linear %016llx corotated %016llx\n",
                   (unsigned long long)h[0][0], (unsigned long long)h[1][0]);
-    /* Stored values: the same in Debug (-O1, sanitizers) and Release (-O3) on x86-64, and with
-     * the scalar fallback of the SIMD loops (-DSC_FEM_SCALAR: one element lane instead of
-     * four), since the core is built with -ffp-contract=off, every reduction has a fixed
-     * order and the element lanes scatter tet by tet. A change here is a change of the
-     * numerics (FEM, mesh, materials or fixed nodes): update the values deliberately, in the
-     * same commit, saying why. Corotated last changed when its residual r0 became
-     * element-wise (the K v0 mat-vec folded into the assembly: same formula, other rounding;
-     * was 0x0c35c8638babdc14). */
-    assert_true(h[0][0] == UINT64_C(0xebcf32bae8caa610));
-    assert_true(h[1][0] == UINT64_C(0x1189f04920bf6f8a));
+    /* Stored values: the same in Debug (-O1, sanitizers) and Release (-O3) on x86-64, with
+     * every instruction-set variant (test_sc_simd) and with one-lane vectors (-DSC_VEC_SCALAR,
+     * the MCU's build of sc_grid_kern.c), since the core is built with -ffp-contract=off,
+     * every reduction has a fixed order and the cell kernels' sums go through fixed passes
+     * (sc_grid.h). A change here is a change of the numerics (FEM, mesh, materials or fixed
+     * nodes): update the values deliberately, in the same commit, saying why. Last changed when
+     * the FEM moved to the grid matrix (template gradients, element-wise r0 for both models,
+     * the grid's PCG and the unloaded warm start toward rest; were 0xebcf32bae8caa610 and
+     * 0x1189f04920bf6f8a). */
+    assert_true(h[0][0] == UINT64_C(0x278682b11d0e4003));
+    assert_true(h[1][0] == UINT64_C(0xc59ad4b441628d65));
 }
 
 /* ---- run-time switches -------------------------------------------------------------------- */
@@ -1114,7 +1109,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(init_rejects_invalid_inputs),
-        cmocka_unit_test(pattern_has_diagonal_then_one_block_per_edge_above_it),
+        cmocka_unit_test(grid_stores_one_block_per_mesh_edge_and_none_elsewhere),
         cmocka_unit_test(stiffness_annihilates_rigid_motions_and_diagonal_blocks_are_symmetric),
         cmocka_unit_test(linear_field_gives_no_interior_force_and_exact_energy),
         cmocka_unit_test(solver_converges_to_the_static_patch_solution),

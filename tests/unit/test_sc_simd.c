@@ -10,10 +10,12 @@
 
 #include "sc_err.h"
 #include "sc_cpu.h"
+#include "sc_fem.h"
 #include "sc_labels.h"
 #include "sc_material.h"
 #include "sc_mesh.h"
 #include "sc_msds.h"
+#include "sc_msds_implicit.h"
 #include "sc_simd.h"
 #include "sc_springs.h"
 
@@ -22,6 +24,8 @@ static sc_nodes g_nodes;
 static sc_springs g_sp;
 static sc_msds g_msds;
 static sc_material_table g_mat;
+static sc_fem g_fem;
+static uint8_t g_kin[SC_MAX_NODES];
 
 static uint64_t fnv_floats(uint64_t h, const float *p, uint32_t n)
 {
@@ -119,6 +123,103 @@ static void variants_give_identical_bits(void **state)
     printf("# %d comparisons (best variant here: %s)\n", compared, sc_simd_name(best));
 }
 
+/* The implicit solvers (sc_grid_kern.inc: FEM linear and corotated, the stable MSDS) on the
+ * mixed block: a press by kinematic nodes deep enough that tets meet the volume floor, with a
+ * sideways force, then the release (the unloaded warm start). Returns the state hash. */
+static uint64_t run_implicit(uint32_t nx, uint32_t ny, uint32_t nz, int method)
+{
+    sc_mesh_def d = sc_mesh_default_def();
+    d.nx = nx;
+    d.ny = ny;
+    d.nz = nz;
+    assert_int_equal(sc_mesh_build(&g_mesh, &d), SC_OK);
+    sc_material_table_default(&g_mat);
+    assert_int_equal(sc_material_assign(&g_mesh, NULL, &g_mat, SC_LABEL_FAT), SC_OK);
+    static const uint8_t mix[] = {SC_LABEL_FAT, SC_LABEL_VEIN, SC_LABEL_MUSCLE, SC_LABEL_ARTERY,
+                                  SC_LABEL_THROMBUS};
+    for (uint32_t t = 0; t < g_mesh.tet_count; t++) {
+        g_mesh.tet_label[t] = mix[(t * 7u + t / 13u) % 5u];
+    }
+    assert_int_equal(sc_springs_from_tets(&g_sp, (const uint32_t(*)[4])g_mesh.tet, g_mesh.tet_label,
+                                          g_mesh.tet_count, &g_mat),
+                     SC_OK);
+    sc_msds_def md = sc_msds_default_def();
+    assert_int_equal(sc_msds_init(&g_msds, &g_mesh, &g_sp, &g_mat, &md), SC_OK);
+    sc_fem_def fd = sc_fem_default_def();
+    fd.corotated = method == 1 ? 1u : 0u;
+    assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &fd), SC_OK);
+    sc_nodes_reset_to_rest(&g_nodes, &g_mesh);
+    uint32_t floor_frames = 0;
+    float dmax = 0.0f;
+    for (uint32_t step = 0; step < 40u; step++) {
+        const int press = step < 25u;
+        for (uint32_t i = 0; i < nx * ny; i++) {
+            const uint32_t ix = i % nx;
+            const int under = ix > nx / 3u && ix < 2u * nx / 3u;
+            g_kin[i] = (uint8_t)(press && under);
+            /* the probe moves 0.6 mm per frame into the block: 15 mm at the end */
+            g_nodes.vz[i] = (press && under) ? 3.0f : g_nodes.vz[i];
+            g_nodes.fx[i] = press && ix == 0u ? 2e-4f * (float)step : 0.0f;
+        }
+        if (method == 2) {
+            sc_msds_implicit_step(&g_msds, &g_fem, &g_mesh, &g_nodes, 0.2f, 10u, g_kin);
+        } else {
+            sc_fem_step_kinematic(&g_fem, &g_mesh, &g_nodes, 0.2f, 10u, g_kin);
+        }
+        for (uint32_t i = 0; i < nx * ny; i++) {
+            if (g_kin[i]) {
+                g_nodes.vx[i] = g_nodes.vy[i] = g_nodes.vz[i] = 0.0f;
+            }
+        }
+        floor_frames += g_fem.rest_k == 0u && method == 0 ? 1u : 0u;
+        for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+            dmax = fmaxf(dmax, fabsf(g_mesh.rest_z[i] - g_nodes.z[i]));
+        }
+    }
+    assert_int_equal(sc_fem_status(&g_fem), SC_OK);
+    uint64_t h = 1469598103934665603ull;
+    h = fnv_floats(h, g_nodes.x, g_mesh.node_count);
+    h = fnv_floats(h, g_nodes.y, g_mesh.node_count);
+    h = fnv_floats(h, g_nodes.z, g_mesh.node_count);
+    h = fnv_floats(h, g_nodes.vx, g_mesh.node_count);
+    h = fnv_floats(h, g_nodes.vy, g_mesh.node_count);
+    h = fnv_floats(h, g_nodes.vz, g_mesh.node_count);
+    printf("# implicit %ux%ux%u method %d: largest vertical displacement %.3f mm, "
+           "%u linear frames assembled (floor)\n",
+           nx, ny, nz, method, (double)dmax, floor_frames);
+    assert_true(dmax > 2.0f);
+    return h;
+}
+
+/* Every variant gives the generic variant's bits for the implicit solvers too. */
+static void implicit_solver_variants_give_identical_bits(void **state)
+{
+    (void)state;
+    const sc_simd best = sc_cpu_best_simd();
+    static const uint32_t shapes[2][3] = {{12u, 8u, 8u}, {11u, 7u, 6u}};
+    int compared = 0;
+    for (uint32_t sh = 0; sh < 2u; sh++) {
+        for (int method = 0; method < 3; method++) {
+            assert_int_equal(sc_simd_select(SC_SIMD_GENERIC), SC_OK);
+            const uint64_t ref = run_implicit(shapes[sh][0], shapes[sh][1], shapes[sh][2], method);
+            for (int v = 1; v < (int)SC_SIMD_COUNT; v++) {
+                if (!sc_simd_built((sc_simd)v) || v > (int)best) {
+                    continue;
+                }
+                assert_int_equal(sc_simd_select((sc_simd)v), SC_OK);
+                const uint64_t h = run_implicit(shapes[sh][0], shapes[sh][1], shapes[sh][2], method);
+                printf("# implicit %ux%ux%u method %d: generic %016llx, %s %016llx\n",
+                       shapes[sh][0], shapes[sh][1], shapes[sh][2], method,
+                       (unsigned long long)ref, sc_simd_name((sc_simd)v), (unsigned long long)h);
+                assert_true(h == ref);
+                compared++;
+            }
+        }
+    }
+    assert_int_equal(sc_simd_select(SC_SIMD_GENERIC), SC_OK);
+    printf("# %d implicit comparisons (best variant here: %s)\n", compared, sc_simd_name(best));
+}
+
 static void selection_refuses_what_is_not_there(void **state)
 {
     (void)state;
@@ -155,6 +256,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(variants_give_identical_bits),
+        cmocka_unit_test(implicit_solver_variants_give_identical_bits),
         cmocka_unit_test(selection_refuses_what_is_not_there),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -266,7 +266,9 @@ static void same_inputs_give_a_bit_identical_state_hash(void **state)
 /* MSDS only (the FEM's numerics belong to its own test): a fixed press-and-lift script gives
  * a stored hash in every build type, so that a change in the MSDS/collider/skin numerics is a
  * visible decision (update the constant with the printed value when it is intended). */
-#define SC_TISSUE_MSDS_HASH UINT64_C(0x788e35cb4030fa42)
+/* last changed: the stable MSDS on the grid matrix (sc_grid.h) with 10 CG iterations per frame
+ * and the unloaded warm start toward rest (was 0x788e35cb4030fa42) */
+#define SC_TISSUE_MSDS_HASH UINT64_C(0xbdf8e7a95468d602)
 static void msds_script_matches_the_stored_state_hash(void **state)
 {
     (void)state;

@@ -11,7 +11,8 @@
  * and best with the mean).
  * Usage: bench-physics [frames]   (default 200)
  *        bench-physics frames stable (the stable MSDS and the FEMs at 32x16x16 only)
- *        bench-physics frames msds   (the MSDS solver alone, see msds_only) */
+ *        bench-physics frames msds   (the MSDS solver alone, see msds_only)
+ *        bench-physics frames stages (32x16x16 per stage, see stages) */
 #include <stdio.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -20,6 +21,7 @@
 
 #include "sc_err.h"
 #include "sc_cpu.h"
+#include "sc_grid_kern.h"
 #include "sc_labels.h"
 #include "sc_simd.h"
 #include "sc_stats.h"
@@ -27,6 +29,7 @@
 #include "sc_tissue.h"
 
 static sc_tissue g_t;
+static sc_pose g_pose; /* the probe pose of the last run_cfg */
 
 /* the explicit MSDS's former default volume term with Algorithm 1's springs (sc_msds.h) */
 #define PAPER_VOLUME_RATIO 6.0f
@@ -102,6 +105,7 @@ static int run_cfg(uint32_t nx, uint32_t ny, uint32_t nz, config c, float volume
         return rc;
     }
     const sc_pose pose = sc_test_scene_probe(&scene, 3.0f);
+    g_pose = pose;
     for (int f = 0; f < 30; f++) { /* press in and settle */
         const sc_pose q = sc_test_scene_probe(&scene, -0.5f + 3.5f * (float)(f + 1) / 30.0f);
         (void)sc_tissue_step(&g_t, &q);
@@ -170,6 +174,96 @@ static int msds_only(int frames, int which)
     return 0;
 }
 
+static uint64_t umin(uint64_t a, uint64_t b)
+{
+    return a < b ? a : b;
+}
+
+/* The 32x16x16 tissue frame per stage, minimum over `frames` frames each (the machine is
+ * shared: the least disturbed frame): the whole frame (sc_tissue_step, skin off), the
+ * collision detection, and for the implicit methods the step's start and assembly
+ * (sc_grid_begin and the method's element or spring and cell passes, timed again on the
+ * frame's state); the CG with the rest of the frame is the frame minus those. */
+static int stages(int frames)
+{
+    const config cs[4] = {CFG_MSDS_STABLE, CFG_MSDS_EXPLICIT, CFG_FEM_LINEAR, CFG_FEM_COROTATED};
+    static const char *const names[4] = {"MSDS stable", "MSDS explicit", "FEM linear",
+                                         "FEM corotated"};
+    printf("32x16x16 per stage, ms, minimum over %d frames (kernels %s); stable MSDS and FEM: "
+           "%u CG iterations; explicit MSDS: %u substeps of %.3f s (Algorithm 1 springs, volume "
+           "ratio 6)\n",
+           frames, sc_simd_name(sc_simd_selected()), (unsigned)SC_PHYS_CG_ITERATIONS_DEFAULT,
+           (unsigned)SC_PHYS_ITERATIONS_DEFAULT, (double)SC_PHYS_DT_DEFAULT_S);
+    printf("%-14s | %8s | %9s | %8s | %8s | %10s\n", "method", "frame", "collision", "start",
+           "assembly", "solve+rest");
+    for (int c = 0; c < 4; c++) {
+        result a;
+        const float ratio =
+            cs[c] == CFG_MSDS_EXPLICIT ? PAPER_VOLUME_RATIO : sc_msds_default_def().volume_stiffness_ratio;
+        if (run_cfg(32u, 16u, 16u, cs[c], ratio, 1, &a) != 0) {
+            return 1;
+        }
+        const sc_pose pose = g_pose;
+        uint64_t best[4] = {UINT64_MAX, UINT64_MAX, UINT64_MAX, UINT64_MAX};
+        const sc_collider_grid gr = {
+            g_t.mesh.nx,
+            g_t.mesh.ny,
+            g_t.mesh.nz,
+            {g_t.mesh.origin_mm[0], g_t.mesh.origin_mm[1], g_t.mesh.origin_mm[2]},
+            {g_t.mesh.cell_mm[0], g_t.mesh.cell_mm[1], g_t.mesh.cell_mm[2]}};
+        static sc_contact_set ccs;
+        const sc_grid_kern *k = sc_grid_kern_selected();
+        sc_grid *g = &g_t.fem.grid;
+        const float dt = g_t.msds.def.dt_s * (float)g_t.msds.def.iterations;
+        for (int f = 0; f < frames; f++) {
+            const uint64_t t0 = now_ns();
+            if (sc_tissue_step(&g_t, &pose) != 0) {
+                return 1;
+            }
+            const uint64_t t1 = now_ns();
+            sc_collider_detect(&g_t.collider, &gr, g_t.nodes.x, g_t.nodes.y, g_t.nodes.z,
+                               g_t.mesh.node_fixed, g_t.stats.max_disp_mm, &ccs);
+            const uint64_t t2 = now_ns();
+            uint64_t t3 = t2, t4 = t2;
+            if (cs[c] != CFG_MSDS_EXPLICIT) {
+                const int msds = cs[c] == CFG_MSDS_STABLE;
+                const float beta = msds ? g_t.msds.gamma_per_k_s : g_t.fem.def.rayleigh_beta_s;
+                const float alpha = msds ? g_t.msds.def.drag_per_s : 0.0f;
+                const float ck = dt * beta + dt * dt;
+                sc_grid_begin(g, &g_t.mesh, &g_t.nodes, dt, beta, alpha, g_t.kinematic);
+                t3 = now_ns();
+                if (msds) {
+                    sc_grid_clear(g, SC_GRID_CLEAR_DIAG);
+                    k->msds_springs(g, &g_t.msds, dt, ck);
+                    k->msds_cells(g, &g_t.msds, dt, ck);
+                } else {
+                    sc_grid_fem_in in = g_t.fem.element;
+                    in.lamv = &g_t.fem.lamv[0][0];
+                    in.muv = &g_t.fem.muv[0][0];
+                    in.corotated = cs[c] == CFG_FEM_COROTATED;
+                    if (in.corotated) {
+                        sc_grid_clear(g, SC_GRID_CLEAR_DIAG | SC_GRID_CLEAR_BLOCKS);
+                        (void)k->fem_cells(g, &in, dt, ck);
+                    } else {
+                        /* the linear step: volume check and the r0 mat-vec on the rest K */
+                        (void)k->fem_below(g, &in);
+                        k->matvec(g, 0.0f, 1.0f);
+                    }
+                }
+                t4 = now_ns();
+            }
+            best[0] = umin(best[0], t1 - t0);
+            best[1] = umin(best[1], t2 - t1);
+            best[2] = umin(best[2], t3 - t2);
+            best[3] = umin(best[3], t4 - t3);
+        }
+        const double rest = ms(best[0]) - ms(best[1]) - ms(best[2]) - ms(best[3]);
+        printf("%-14s | %8.3f | %9.3f | %8.3f | %8.3f | %10.3f\n", names[c], ms(best[0]),
+               ms(best[1]), ms(best[2]), ms(best[3]), rest);
+    }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     const int frames = argc > 1 ? atoi(argv[1]) : 200;
@@ -192,6 +286,9 @@ int main(int argc, char **argv)
                    a.mean_ms, a.p50_ms, a.best_ms);
         }
         return 0;
+    }
+    if (argc > 2 && strcmp(argv[2], "stages") == 0) {
+        return stages(frames);
     }
     if (argc > 2 && strcmp(argv[2], "msds") == 0) {
         const int which = argc > 3 ? (strcmp(argv[3], "springs") == 0 ? 0 : 1) : -1;

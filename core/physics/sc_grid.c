@@ -1,0 +1,552 @@
+/* sc_grid.c: layout, step driver and reference helpers of the grid matrix; see sc_grid.h. The
+ * hot loops (mat-vec, PCG, cell and spring assembly) are in sc_grid_kern.inc. */
+#include "sc_grid.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <string.h>
+
+#include "sc_assert.h"
+#include "sc_err.h"
+#include "sc_grid_kern.h"
+#include "sc_grid_tmpl.h"
+#include "sc_simd.h"
+
+const sc_grid_kern *sc_grid_kern_selected(void)
+{
+    const sc_simd v = sc_simd_selected();
+    (void)v;
+#if defined(SC_SIMD_X86_64_V4_BUILT)
+    if (v == SC_SIMD_X86_64_V4) {
+        return &sc_grid_kern_x86_64_v4;
+    }
+#endif
+#if defined(SC_SIMD_X86_64_V3_BUILT)
+    if (v == SC_SIMD_X86_64_V3) {
+        return &sc_grid_kern_x86_64_v3;
+    }
+#endif
+    return &sc_grid_kern_generic;
+}
+
+/* the even template's tets (sc_mesh.h) */
+#define SC_GRID_TET_ROW(q, a, b, c, d) {a, b, c, d},
+static const uint8_t s_tets[5][4] = {SC_MESH_CELL_TETS(SC_GRID_TET_ROW)};
+#undef SC_GRID_TET_ROW
+
+static uint32_t bits(uint32_t c)
+{
+    return (c & 1u) + ((c >> 1) & 1u) + ((c >> 2) & 1u);
+}
+
+/* Edge slots of the template (corner pairs of its tets, a < b, in order of appearance). */
+static void init_slots(sc_grid *g)
+{
+    memset(g->slot_of, -1, sizeof g->slot_of);
+    uint32_t ns = 0;
+    for (uint32_t q = 0; q < 5u; q++) {
+        for (uint32_t i = 0; i < 4u; i++) {
+            for (uint32_t j = i + 1u; j < 4u; j++) {
+                const uint8_t a = s_tets[q][i] < s_tets[q][j] ? s_tets[q][i] : s_tets[q][j];
+                const uint8_t b = s_tets[q][i] < s_tets[q][j] ? s_tets[q][j] : s_tets[q][i];
+                if (g->slot_of[a][b] < 0) {
+                    SC_ASSERT(ns < 18u);
+                    g->slot[ns].a = a;
+                    g->slot[ns].b = b;
+                    g->slot_of[a][b] = (int8_t)ns;
+                    g->slot_of[b][a] = (int8_t)ns;
+                    ns++;
+                }
+            }
+        }
+    }
+    SC_ASSERT(ns == 18u); /* 12 grid edges and 6 face diagonals */
+    memset(g->corner_n, 0, sizeof g->corner_n);
+    memset(g->slot_n, 0, sizeof g->slot_n);
+    for (uint32_t q = 0; q < 5u; q++) {
+        for (uint32_t i = 0; i < 4u; i++) {
+            const uint8_t c = s_tets[q][i];
+            SC_ASSERT(g->corner_n[c] < 4u);
+            g->corner_tv[c][g->corner_n[c]][0] = (uint8_t)q;
+            g->corner_tv[c][g->corner_n[c]][1] = (uint8_t)i;
+            g->corner_n[c]++;
+            for (uint32_t j = i + 1u; j < 4u; j++) {
+                const uint8_t sl = (uint8_t)g->slot_of[s_tets[q][i]][s_tets[q][j]];
+                const int first = s_tets[q][i] == g->slot[sl].a;
+                SC_ASSERT(g->slot_n[sl] < 3u);
+                uint8_t *tv = g->slot_tv[sl][g->slot_n[sl]];
+                tv[0] = (uint8_t)q;
+                tv[1] = (uint8_t)(first ? i : j);
+                tv[2] = (uint8_t)(first ? j : i);
+                g->slot_n[sl]++;
+            }
+        }
+    }
+}
+
+/* Source slot and transposition of the stored block K(ra, rb) (real corners) in a cell of parity
+ * p: the template corner c sits on the real corner c ^ p. */
+static void edge_source(const sc_grid *g, uint32_t ra, uint32_t rb, uint32_t p, sc_grid_target *t)
+{
+    const uint32_t ta = ra ^ p, tb = rb ^ p;
+    const int8_t s = g->slot_of[ta][tb];
+    SC_ASSERT(s >= 0);
+    t->src[p] = (uint8_t)s;
+    t->tr[p] = (uint8_t)(g->slot[(uint8_t)s].a == ta ? 0u : 1u);
+}
+
+/* The 26 targets of a cell (sc_grid.h). */
+static void init_targets(sc_grid *g)
+{
+    uint32_t nt = 0;
+    for (uint32_t c = 0; c < 8u; c++) {
+        sc_grid_target *t = &g->target[nt++];
+        t->kind = 0u;
+        t->axis = 0u;
+        t->corner = (uint8_t)c;
+        for (uint32_t p = 0; p < 2u; p++) {
+            t->src[p] = (uint8_t)(c ^ p);
+            t->tr[p] = 0u;
+        }
+    }
+    for (uint32_t a = 0; a < 3u; a++) {
+        const uint32_t ab = 1u << a;
+        for (uint32_t c = 0; c < 8u; c++) {
+            if ((c & ab) != 0u) {
+                continue;
+            }
+            sc_grid_target *t = &g->target[nt++];
+            t->kind = 1u;
+            t->axis = (uint8_t)a;
+            t->corner = (uint8_t)c;
+            for (uint32_t p = 0; p < 2u; p++) {
+                edge_source(g, c, c | ab, p, t);
+            }
+        }
+    }
+    /* planes: 0 x-y (fixed z), 1 x-z (fixed y), 2 y-z (fixed x) */
+    static const uint8_t fixed_bit[3] = {4u, 2u, 1u};
+    for (uint32_t w = 0; w < 3u; w++) {
+        const uint32_t fb = fixed_bit[w];
+        const uint32_t b1 = (w == 2u) ? 2u : 1u;            /* lower axis of the plane */
+        const uint32_t b2 = (w == 0u) ? 2u : 4u;            /* upper axis */
+        for (uint32_t side = 0; side < 2u; side++) {
+            const uint32_t fo = side != 0u ? fb : 0u; /* lowest corner of the face */
+            sc_grid_target *t = &g->target[nt++];
+            t->kind = 2u;
+            t->axis = (uint8_t)w;
+            t->corner = (uint8_t)fo;
+            for (uint32_t p = 0; p < 2u; p++) {
+                /* the face's lowest node is odd iff p + bits(fo) is odd: then the diagonal is
+                 * (fo, fo + b1 + b2) ("main"), else (fo + b1, fo + b2) */
+                const uint32_t odd = (p + bits(fo)) & 1u;
+                const uint32_t ra = odd ? fo : (fo | b1);
+                const uint32_t rb = odd ? (fo | b1 | b2) : (fo | b2);
+                edge_source(g, ra, rb, p, t);
+            }
+        }
+    }
+    SC_ASSERT(nt == SC_GRID_TARGETS);
+}
+
+static int same_node_set(const uint32_t a[4], const uint32_t b[4])
+{
+    for (uint32_t i = 0; i < 4u; i++) {
+        int hit = 0;
+        for (uint32_t j = 0; j < 4u; j++) {
+            hit |= a[i] == b[j];
+        }
+        if (!hit) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* zero the used part of `rows` rows of the grid's row stride */
+static void zero_rows(float *rows, uint32_t count, uint32_t used)
+{
+    for (uint32_t k = 0; k < count; k++) {
+        memset(rows + (size_t)k * SC_GRID_ROW, 0, (size_t)used * sizeof(float));
+    }
+}
+
+int sc_grid_init(sc_grid *g, const sc_mesh *m)
+{
+    if (g == NULL || m == NULL || m->nx < 2u || m->ny < 2u || m->nz < 2u ||
+        m->nx > SC_MAX_MESH_NX || m->ny > SC_MAX_MESH_NY || m->nz > SC_MAX_MESH_NZ ||
+        m->node_count != m->nx * m->ny * m->nz ||
+        m->tet_count != 5u * (m->nx - 1u) * (m->ny - 1u) * (m->nz - 1u)) {
+        return SC_ERR_INVALID_ARG;
+    }
+    const uint32_t nx = m->nx, ny = m->ny, nz = m->nz, nxy = nx * ny, nn = m->node_count;
+    g->nx = nx;
+    g->ny = ny;
+    g->nz = nz;
+    g->nxy = nxy;
+    g->node_count = nn;
+    g->node_end = (nn + SC_GRID_CHUNK - 1u) / SC_GRID_CHUNK * SC_GRID_CHUNK;
+    for (uint32_t c = 0; c < 8u; c++) {
+        g->off[c] = ((c & 1u) ? 1u : 0u) + ((c & 2u) ? nx : 0u) + ((c & 4u) ? nxy : 0u);
+    }
+    /* cell origins 0 .. nn - off[7] - 1 (the last plane, row and column have none) */
+    const uint32_t cells = nn - g->off[7];
+    g->cell_end = (cells + SC_GRID_CELL_BLOCK - 1u) / SC_GRID_CELL_BLOCK * SC_GRID_CELL_BLOCK;
+    init_slots(g);
+    init_targets(g);
+    /* the kernels' constant tables are this derivation */
+    for (uint32_t sl = 0; sl < 18u; sl++) {
+        SC_ASSERT(g->slot[sl].a == sc_grid_tmpl_slot[sl][0] &&
+                  g->slot[sl].b == sc_grid_tmpl_slot[sl][1] &&
+                  g->slot_n[sl] == sc_grid_tmpl_slot_n[sl] &&
+                  memcmp(g->slot_tv[sl], sc_grid_tmpl_slot_tv[sl], 3u * g->slot_n[sl]) == 0);
+    }
+    for (uint32_t c = 0; c < 8u; c++) {
+        SC_ASSERT(g->corner_n[c] == sc_grid_tmpl_corner_n[c] &&
+                  memcmp(g->corner_tv[c], sc_grid_tmpl_corner_tv[c], 2u * g->corner_n[c]) == 0);
+    }
+    for (uint32_t ti = 0; ti < SC_GRID_TARGETS; ti++) {
+        const sc_grid_target *t = &g->target[ti];
+        const uint8_t *k = sc_grid_tmpl_target[ti];
+        SC_ASSERT(t->kind == k[0] && t->axis == k[1] && t->corner == k[2] && t->src[0] == k[3] &&
+                  t->src[1] == k[4] && t->tr[0] == k[5] && t->tr[1] == k[6]);
+        (void)t;
+        (void)k;
+    }
+    memset(&g->stats, 0, sizeof g->stats);
+
+    /* every row is zero outside the mesh's nodes: the loops read and add there */
+    const uint32_t used = SC_GRID_HEAD + g->node_end + SC_GRID_PAD;
+    SC_ASSERT(used <= SC_GRID_ROW && g->cell_end + g->off[7] <= g->node_end + SC_GRID_PAD);
+    zero_rows(&g->d[0][0], 6u, used);
+    zero_rows(&g->e[0][0][0], 27u, used);
+    zero_rows(&g->f[0][0][0], 27u, used);
+    zero_rows(g->mass, 1u, used);
+    zero_rows(&g->x[0][0], 3u, used);
+    zero_rows(&g->x0[0][0], 3u, used);
+    zero_rows(&g->v[0][0], 3u, used);
+    zero_rows(&g->r[0][0], 3u, used);
+    zero_rows(&g->z[0][0], 3u, used);
+    zero_rows(&g->p[0][0], 3u, used);
+    zero_rows(&g->q[0][0], 3u, used);
+    zero_rows(&g->pc[0][0], 3u, used);
+    memset(g->odd, 0, (size_t)used * sizeof(int32_t));
+    memset(g->cell_odd, 0, (size_t)used * sizeof(int32_t));
+    memset(g->cell_ok, 0, (size_t)used * sizeof(int32_t));
+    memset(g->con, 1, (size_t)used); /* padding: held */
+    memset(g->used, 0, nn);
+
+    const uint32_t h = SC_GRID_HEAD;
+    for (uint32_t t = 0; t < nn; t++) {
+        const uint32_t i = t % nx, j = (t / nx) % ny, k = t / nxy;
+        g->x0[0][h + t] = m->rest_x[t];
+        g->x0[1][h + t] = m->rest_y[t];
+        g->x0[2][h + t] = m->rest_z[t];
+        g->odd[h + t] = ((i + j + k) & 1u) != 0u ? -1 : 0;
+        if (i + 1u < nx && j + 1u < ny && k + 1u < nz) {
+            const uint32_t par = (i + j + k) & 1u;
+            g->cell_ok[h + t] = -1;
+            g->cell_odd[h + t] = par != 0u ? -1 : 0;
+            const uint32_t cube = i + (nx - 1u) * (j + (ny - 1u) * k);
+            for (uint32_t q = 0; q < 5u; q++) {
+                uint32_t v[4];
+                for (uint32_t a = 0; a < 4u; a++) {
+                    v[a] = t + g->off[s_tets[q][a] ^ par];
+                }
+                if (!same_node_set(v, m->tet[5u * cube + q])) {
+                    return SC_ERR_INVALID_ARG; /* not the mesh of sc_mesh_build */
+                }
+                for (uint32_t a = 0; a < 4u; a++) {
+                    g->used[v[a]] = 1u;
+                }
+            }
+        }
+    }
+    return SC_OK;
+}
+
+static int nonzero(float v)
+{
+    return v < 0.0f || v > 0.0f;
+}
+
+/* 1 if the held DOFs (fixed nodes' and rollers' axes) pin every rigid motion of the mesh, so
+ * that the rest state is the only unloaded equilibrium: the 6 rigid modes (translations, and
+ * rotations about the box centre scaled by its size) restricted to the held DOFs are
+ * independent (their 6x6 Gram matrix is positive definite, Cholesky pivots above 1e-9 of its
+ * trace). O(N). */
+static int rigid_motions_pinned(const sc_grid *g)
+{
+    const uint32_t nn = g->node_count, h = SC_GRID_HEAD;
+    double c[3] = {0.0, 0.0, 0.0}, ext = 0.0;
+    for (uint32_t k = 0; k < 3u; k++) {
+        c[k] = 0.5 * ((double)g->x0[k][h] + (double)g->x0[k][h + nn - 1u]);
+        ext = fmax(ext, fabs((double)g->x0[k][h + nn - 1u] - (double)g->x0[k][h]));
+    }
+    ext = ext > 0.0 ? ext : 1.0;
+    double G[6][6];
+    memset(G, 0, sizeof G);
+    for (uint32_t i = 0; i < nn; i++) {
+        const uint8_t con = g->con[h + i];
+        if (con == 0u || con == 2u) {
+            continue;
+        }
+        const double X[3] = {((double)g->x0[0][h + i] - c[0]) / ext,
+                             ((double)g->x0[1][h + i] - c[1]) / ext,
+                             ((double)g->x0[2][h + i] - c[2]) / ext};
+        for (uint32_t a = 0; a < 3u; a++) {
+            if (con != 1u && (con & (2u << a)) == 0u) {
+                continue; /* a roller's free axis */
+            }
+            /* DOF a of the node under the 6 modes: e_a, and (w x X)_a for w = e_0, e_1, e_2 */
+            double r[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+            r[a] = 1.0;
+            r[3u + (a + 1u) % 3u] = -X[(a + 2u) % 3u];
+            r[3u + (a + 2u) % 3u] = X[(a + 1u) % 3u];
+            for (uint32_t p = 0; p < 6u; p++) {
+                for (uint32_t q = 0; q < 6u; q++) {
+                    G[p][q] += r[p] * r[q];
+                }
+            }
+        }
+    }
+    double tr = 0.0;
+    for (uint32_t p = 0; p < 6u; p++) {
+        tr += G[p][p];
+    }
+    for (uint32_t p = 0; p < 6u; p++) {
+        for (uint32_t k = 0; k < p; k++) {
+            G[p][p] -= G[p][k] * G[p][k];
+        }
+        if (!(G[p][p] > 1e-9 * tr)) {
+            return 0;
+        }
+        const double d = sqrt(G[p][p]);
+        G[p][p] = d;
+        for (uint32_t q = p + 1u; q < 6u; q++) {
+            for (uint32_t k = 0; k < p; k++) {
+                G[q][p] -= G[q][k] * G[p][k];
+            }
+            G[q][p] /= d;
+        }
+    }
+    return 1;
+}
+
+void sc_grid_begin(sc_grid *g, const sc_mesh *m, const sc_nodes *n, float dt_s, float beta_s,
+                   float alpha_per_s, const uint8_t *kinematic)
+{
+    SC_ASSERT(g != NULL && m != NULL && n != NULL && g->node_count == m->node_count);
+    SC_ASSERT(isfinite(dt_s) && dt_s > 0.0f && isfinite(beta_s) && beta_s >= 0.0f &&
+              isfinite(alpha_per_s) && alpha_per_s >= 0.0f);
+    const uint32_t nn = g->node_count, h = SC_GRID_HEAD;
+    const float dta = dt_s * alpha_per_s;
+    /* unloaded: no kinematic node and no external force (the probe is off the skin); the release
+     * warm start needs the rest state to be the only unloaded equilibrium (checked below, after
+     * the flags) */
+    int loaded = 0;
+    for (uint32_t i = 0; i < nn && !loaded; i++) {
+        loaded = (kinematic != NULL && kinematic[i] != 0u) || nonzero(n->fx[i]) ||
+                 nonzero(n->fy[i]) || nonzero(n->fz[i]);
+    }
+    const float warm = beta_s / (beta_s + dt_s);
+    const float pull = -1.0f / (beta_s + dt_s);
+    for (uint32_t i = 0; i < nn; i++) {
+        uint8_t con = 0u;
+        const uint8_t fixed = m->node_fixed[i];
+        if (fixed == SC_MESH_FIXED_ALL || g->used[i] == 0u) {
+            con = 1u;
+        } else if (kinematic != NULL && kinematic[i] != 0u) {
+            con = 2u;
+        } else if (fixed != 0u) {
+            const uint32_t axes = SC_MESH_ROLLER_X | SC_MESH_ROLLER_Y | SC_MESH_ROLLER_Z;
+            con = (uint8_t)(0x80u | (fixed & axes));
+        }
+        g->con[h + i] = con;
+    }
+    const int release = !loaded && rigid_motions_pinned(g);
+    g->stats.unloaded_steps += release ? 1u : 0u;
+    const float *const nv[3] = {n->vx, n->vy, n->vz};
+    const float *const nx[3] = {n->x, n->y, n->z};
+    const float *const nf[3] = {n->fx, n->fy, n->fz};
+    for (uint32_t i = 0; i < nn; i++) {
+        const uint8_t con = g->con[h + i];
+        for (uint32_t c = 0; c < 3u; c++) {
+            const float xc = nx[c][i];
+            g->x[c][h + i] = xc;
+            float v0 = 0.0f;
+            const int held = con == 1u || (con >= 0x80u && (con & (2u << c)) != 0u);
+            if (con == 2u) {
+                v0 = nv[c][i]; /* kinematic: moves with its velocity */
+            } else if (!held) {
+                v0 = release ? pull * (xc - g->x0[c][h + i]) : warm * nv[c][i];
+            }
+            g->v[c][h + i] = v0;
+            g->r[c][h + i] = dt_s * nf[c][i] - dta * g->mass[h + i] * v0;
+        }
+    }
+}
+
+void sc_grid_clear(sc_grid *g, uint32_t which)
+{
+    SC_ASSERT(g != NULL);
+    const uint32_t used = SC_GRID_HEAD + g->node_end + SC_GRID_PAD;
+    if ((which & SC_GRID_CLEAR_DIAG) != 0u) {
+        zero_rows(&g->d[0][0], 6u, used);
+    }
+    if ((which & SC_GRID_CLEAR_BLOCKS) != 0u) {
+        zero_rows(&g->e[0][0][0], 27u, used);
+        zero_rows(&g->f[0][0][0], 27u, used);
+    }
+}
+
+int sc_grid_solve(sc_grid *g, sc_nodes *n, float dt_s, float beta_s, float alpha_per_s,
+                  uint32_t cg_iterations)
+{
+    SC_ASSERT(g != NULL && n != NULL);
+    SC_ASSERT(cg_iterations >= 1u && cg_iterations <= SC_PHYS_ITERATIONS_MAX);
+    const uint32_t nn = g->node_count, h = SC_GRID_HEAD;
+    const float cm = 1.0f + dt_s * alpha_per_s;
+    const float ck = dt_s * beta_s + dt_s * dt_s;
+    /* Jacobi preconditioner, zero on Dirichlet DOFs (projects the CG onto the free DOFs) */
+    static const uint32_t diag_entry[3] = {0u, 3u, 5u};
+    for (uint32_t i = 0; i < nn; i++) {
+        const uint8_t con = g->con[h + i];
+        for (uint32_t c = 0; c < 3u; c++) {
+            const float a = cm * g->mass[h + i] + ck * g->d[diag_entry[c]][h + i];
+            const int free_dof = con == 0u || (con >= 0x80u && (con & (2u << c)) == 0u);
+            g->pc[c][h + i] = (free_dof && a > 0.0f) ? 1.0f / a : 0.0f;
+        }
+    }
+    sc_grid_cg_out out;
+    sc_grid_kern_selected()->cg(g, cm, ck, cg_iterations, &out);
+    g->stats.cg_iterations_run = out.iterations;
+    g->stats.residual_ratio = (out.rz0 > 0.0f && out.rz >= 0.0f) ? sqrtf(out.rz / out.rz0) : 0.0f;
+    /* refuse a non-finite solution: the shared state stays as it was */
+    float vsum = 0.0f;
+    for (uint32_t c = 0; c < 3u; c++) {
+        for (uint32_t i = 0; i < nn; i++) {
+            vsum += g->v[c][h + i] * g->v[c][h + i];
+        }
+    }
+    if (!isfinite(vsum)) {
+        g->stats.unstable_steps++;
+        return SC_ERR_PHYS_UNSTABLE;
+    }
+    float *const nv[3] = {n->vx, n->vy, n->vz};
+    float *const nx[3] = {n->x, n->y, n->z};
+    for (uint32_t c = 0; c < 3u; c++) {
+        for (uint32_t i = 0; i < nn; i++) {
+            const float v = g->v[c][h + i];
+            nv[c][i] = v;
+            nx[c][i] = g->x[c][h + i] + dt_s * v;
+        }
+    }
+    return SC_OK;
+}
+
+/* the face of plane w with lowest node m exists (its far corner is inside the grid) */
+static int face_exists(const sc_grid *g, uint32_t m, uint32_t w)
+{
+    const uint32_t i = m % g->nx, j = (m / g->nx) % g->ny, k = m / g->nxy;
+    const int in_x = i + 1u < g->nx, in_y = j + 1u < g->ny, in_z = k + 1u < g->nz;
+    return w == 0u ? (in_x && in_y) : w == 1u ? (in_x && in_z) : (in_y && in_z);
+}
+
+/* The stored block of the node pair (a, b), a < b, or NULL. */
+static const float *pair_block(const sc_grid *g, uint32_t a, uint32_t b)
+{
+    const uint32_t h = SC_GRID_HEAD;
+    const uint32_t ai = a % g->nx, aj = (a / g->nx) % g->ny, ak = a / g->nxy;
+    const uint32_t dist = b - a;
+    if (dist == 1u && ai + 1u < g->nx) {
+        return &g->e[0][0][h + a];
+    }
+    if (dist == g->nx && aj + 1u < g->ny) {
+        return &g->e[1][0][h + a];
+    }
+    if (dist == g->nxy && ak + 1u < g->nz) {
+        return &g->e[2][0][h + a];
+    }
+    if (g->odd[h + a] == 0) {
+        return NULL; /* face diagonals join odd nodes */
+    }
+    const uint32_t d1s[3] = {1u, 1u, g->nx}, d2s[3] = {g->nx, g->nxy, g->nxy};
+    for (uint32_t w = 0; w < 3u; w++) {
+        const uint32_t d1 = d1s[w], d2 = d2s[w];
+        if (dist == d1 + d2 && face_exists(g, a, w)) {
+            return &g->f[w][0][h + a]; /* main diagonal of the (odd) face at a */
+        }
+        if (dist == d2 - d1 && a >= d1 && face_exists(g, a - d1, w)) {
+            return &g->f[w][0][h + a - d1]; /* anti diagonal of the (even) face at a - d1 */
+        }
+    }
+    return NULL;
+}
+
+int sc_grid_block(const sc_grid *g, uint32_t i, uint32_t j, float out[9])
+{
+    SC_ASSERT(g != NULL && out != NULL);
+    for (uint32_t k = 0; k < 9u; k++) {
+        out[k] = 0.0f;
+    }
+    if (i >= g->node_count || j >= g->node_count) {
+        return 0;
+    }
+    const uint32_t h = SC_GRID_HEAD;
+    if (i == j) {
+        static const uint8_t sym[9] = {0u, 1u, 2u, 1u, 3u, 4u, 2u, 4u, 5u};
+        for (uint32_t k = 0; k < 9u; k++) {
+            out[k] = g->d[sym[k]][h + i];
+        }
+        return 1;
+    }
+    const int swap = i > j;
+    const float *blk = swap ? pair_block(g, j, i) : pair_block(g, i, j);
+    if (blk == NULL) {
+        return 0;
+    }
+    for (uint32_t r = 0; r < 3u; r++) {
+        for (uint32_t c = 0; c < 3u; c++) {
+            const float val = blk[(size_t)(3u * r + c) * SC_GRID_ROW];
+            out[swap ? 3u * c + r : 3u * r + c] = val;
+        }
+    }
+    return 1;
+}
+
+void sc_grid_apply_ref(const sc_grid *g, float cm, float ck, const double *p, double *q)
+{
+    SC_ASSERT(g != NULL && p != NULL && q != NULL);
+    const uint32_t nn = g->node_count;
+    for (uint32_t i = 0; i < 3u * nn; i++) {
+        q[i] = (double)cm * (double)g->mass[SC_GRID_HEAD + i / 3u] * p[i];
+    }
+    const uint32_t nbr[13] = {0u, 1u, g->nx, g->nxy, g->nx + 1u, g->nx - 1u, g->nxy + 1u,
+                              g->nxy - 1u, g->nxy + g->nx, g->nxy - g->nx, 0u, 0u, 0u};
+    for (uint32_t i = 0; i < nn; i++) {
+        for (uint32_t k = 0; k < 10u; k++) {
+            const uint32_t j = i + nbr[k];
+            int dup = 0; /* offsets coincide on the smallest grids (nx = 2: nx - 1 = 1) */
+            for (uint32_t k2 = 0; k2 < k; k2++) {
+                dup |= nbr[k2] == nbr[k];
+            }
+            if (dup || j >= nn) {
+                continue;
+            }
+            float b[9];
+            if (!sc_grid_block(g, i, j, b)) {
+                continue;
+            }
+            for (uint32_t r = 0; r < 3u; r++) {
+                for (uint32_t c = 0; c < 3u; c++) {
+                    const double v = (double)ck * (double)b[3u * r + c];
+                    q[3u * i + r] += v * p[3u * j + c];
+                    if (j != i) {
+                        q[3u * j + c] += v * p[3u * i + r];
+                    }
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,211 @@
+/*
+ * sc_grid.h: the stiffness matrix of the regular 5-tet grid (sc_mesh.h) stored by stencil
+ * family, and the implicit step both solvers run on it: the FEM (sc_fem.h) and the stable MSDS
+ * (sc_msds_implicit.h) assemble their K(x) and residual into one sc_grid, which then solves
+ *   (M (1 + dt alpha) + (dt beta + dt^2) K) v+ = M v + dt (f_ext - f_int(x)),  x+ = x + dt v+
+ * with a fixed number of warm-started Jacobi-preconditioned conjugate-gradient iterations.
+ *
+ * Why a grid matrix and not a general sparse one: the mesh is a regular grid, so every node has
+ * the same neighbours at the same index offsets: +-1 (x), +-nx (y), +-nx ny (z) along the grid
+ * edges, and, for the nodes of odd i + j + k only, the 12 face diagonals (sc_mesh.c: a face's
+ * diagonal joins its two odd corners). The matrix is stored as float rows indexed by node (SoA),
+ * one row per block entry and family, so every loop over it is a straight vector loop with no
+ * index arrays and no gathers:
+ *   d[6][.]     diagonal block of node t (symmetric: xx xy xz yy yz zz);
+ *   e[a][9][.]  block K(t, t + o_a) of the grid edge along axis a (o = 1, nx, nx ny), row-major;
+ *   f[w][9][.]  the face diagonal of the face with lowest corner t in plane w (w = 0: x-y,
+ *               1: x-z, 2: y-z; d1 < d2 the offsets of its two axes): K(t, t + d1 + d2) if t is
+ *               odd, K(t + d1, t + d2) if t is even (the diagonal that joins the odd corners).
+ * A block that does not exist (past the grid's edge) is zero. That is 60 floats per node
+ * against 6.5 blocks of 13 floats in a block-CSR (the former layout: 84 floats and an index per
+ * block), and the mat-vec reads each stored block once from memory (the backward reuse of a
+ * block hits the cache): measured 0.075 ms per mat-vec at 32x16x16 on x86-64-v4, a whole CG
+ * iteration 0.09 ms against 0.11 ms with the former block-CSR.
+ *
+ * Layout: node t lives at index SC_GRID_HEAD + t of every row, so that a node's neighbours
+ * t - nx ny - nx - 1 .. t + nx ny + nx + 1 are in the row for every node (zero past the mesh);
+ * the row stride SC_GRID_ROW is an odd multiple of 16 floats, so that the 80-odd rows a loop
+ * streams fall into different cache sets (with a stride that is a multiple of 4 KiB every row
+ * maps to the same L1 set: measured 5x slower). Node loops run over SC_GRID_CHUNK-aligned
+ * ranges (the padding lanes compute on zeros).
+ *
+ * Assembly by cell: a cell's five tets (SC_MSDS_CELL_TETS, an odd cell mirrored in x) give
+ * the blocks of its 8 corners, 12 grid edges and 6 face diagonals; the cell kernels compute a
+ * block of SC_GRID_CELL_BLOCK cells into sc_grid.buf in the template's (mirrored) frame, 9
+ * rows per template corner (6 diagonal entries, 3 residual) and per template edge slot, and
+ * then add each of the 26 real targets to the matrix and the residual with one straight pass
+ * per target that picks, per cell, the template slot of its parity (transposed where the
+ * mirror reverses the edge). Those passes fix the order in which a node's sums are formed, so
+ * the result does not depend on the vector width (every instruction-set variant of
+ * sc_grid_kern.inc gives the same bits) nor on anything but SC_GRID_CELL_BLOCK.
+ *
+ * The step (sc_grid_begin, the caller's assembly, sc_grid_solve):
+ * - Dirichlet DOFs: fixed nodes (mesh node_fixed 1, nodes of no tet), the held axes of roller
+ *   nodes and the caller's kinematic nodes (moved with their current velocity); the
+ *   preconditioner is zero there, which projects the CG onto the free DOFs.
+ * - Warm start: v0 = v beta / (beta + dt), the exact one-step decay of an over-damped,
+ *   stiffness-damped mode (sc_fem.h). Unloaded (no kinematic node and no external force:
+ *   the probe is off the skin), the equilibrium is the rest state and the warm start is the
+ *   quasi-static answer toward it, v0 = -(x - X) / (beta + dt) (exact for the linear model when
+ *   the masses are negligible, as they are: m << dt^2 k): the fixed-count CG starts from the
+ *   release's solution instead of having to find it, so a released tissue is back at rest in a
+ *   few frames on every mesh (with the plain warm start the 32x16x16 mesh took 2 s).
+ * - r0 = b - A v0 is formed by the caller's assembly (element-wise: no extra mat-vec).
+ * - A non-finite solution is refused: the node state is left unchanged and the step fails.
+ *
+ * Memory (R = SC_GRID_ROW floats, ~SC_MAX_NODES + 2 (nx ny + nx) + 48): matrix 60 rows, mass,
+ * positions and rest 6, solver vectors v r z p q and the preconditioner 18, masks 2 (int32),
+ * flags: 87 rows of 4 B and 1 B: 3.4 MB at 32x16x16 (sizeof(sc_fem) printed by bench-fem), and
+ * the cell buffer (234 x 16 floats, 15 KB). Never allocates, never calls the OS. Deterministic.
+ * Threads: one writer.
+ */
+#ifndef SC_GRID_H
+#define SC_GRID_H
+
+#include <stdint.h>
+
+#include "sc_config.h"
+#include "sc_mesh.h"
+
+/* node loops run over multiples of this many nodes (the widest vector of any variant) */
+#define SC_GRID_CHUNK 16u
+/* leading and trailing padding of every row: the farthest neighbour offset, nx ny + nx + 1,
+ * plus a chunk, rounded to a chunk */
+#define SC_GRID_PAD                                                                                \
+    (((SC_MAX_MESH_NX * SC_MAX_MESH_NY + SC_MAX_MESH_NX + 1u + 2u * SC_GRID_CHUNK) /               \
+      SC_GRID_CHUNK) *                                                                             \
+     SC_GRID_CHUNK)
+#define SC_GRID_HEAD SC_GRID_PAD
+/* row stride: an odd multiple of 16 floats (see above) */
+#define SC_GRID_ROW ((((SC_GRID_HEAD + SC_MAX_NODES + SC_GRID_PAD) / 32u) + 1u) * 32u + 16u)
+_Static_assert(SC_MAX_NODES % SC_GRID_CHUNK == 0u, "node capacity a multiple of the chunk");
+_Static_assert((SC_GRID_ROW / 16u) % 2u == 1u, "row stride an odd multiple of 16 floats");
+
+/* cells per assembly block (a multiple of every variant's vector width); part of what makes
+ * a state hash, so it is the same on every target (the MCU's SRAM sets it: the buffer is
+ * 234 x 16 floats, 15 KB; 32 measured no faster on x86-64) */
+#define SC_GRID_CELL_BLOCK 16u
+/* assembly targets of a cell: 8 corners, 12 grid edges, 6 face diagonals */
+#define SC_GRID_TARGETS 26u
+/* buffer rows of a cell: 8 template corners x (6 diagonal + 3 residual), then the 18 template
+ * edge slots x 9 */
+#define SC_GRID_BUF_ROWS (8u * 9u + 18u * 9u)
+
+/* what a target of a cell is, where it lives and where its block comes from (sc_grid_init) */
+typedef struct sc_grid_target {
+    uint8_t kind;     /* 0: corner (d and r), 1: grid edge (e[axis]), 2: face diagonal (f[plane]) */
+    uint8_t axis;     /* axis (kind 1) or plane (kind 2) */
+    uint8_t corner;   /* corner (kind 0), else the corner whose node the block is stored at */
+    uint8_t src[2];   /* template slot per cell parity: corner 0..7 or edge slot 0..17 */
+    uint8_t tr[2];    /* 1: the template block is the transpose of the stored one */
+} sc_grid_target;
+
+/* the template's edge slots: corner pairs (a < b) of the even template's tets */
+typedef struct sc_grid_slot {
+    uint8_t a, b;
+} sc_grid_slot;
+
+/* Diagnostics of the last step. */
+typedef struct sc_grid_stats {
+    uint32_t cg_iterations_run; /* <= requested (early only on r.z = 0 or p.Ap <= 0) */
+    float residual_ratio;       /* sqrt(r.z) after / before the CG of the last step */
+    uint32_t unloaded_steps;    /* steps that started from the release warm start */
+    uint32_t unstable_steps;    /* steps refused because the solution was not finite */
+} sc_grid_stats;
+
+typedef struct sc_grid {
+    /* ---- layout (sc_grid_init) ---- */
+    uint32_t nx, ny, nz, nxy;
+    uint32_t node_count;
+    uint32_t node_end;  /* node_count rounded up to SC_GRID_CHUNK */
+    uint32_t cell_end;  /* cell origins 0 .. cell_end - 1 are visited (rounded up to a block) */
+    uint32_t off[8];    /* node offset of cell corner c (bit 0 +x, bit 1 +y, bit 2 +z) */
+    sc_grid_slot slot[18];
+    int8_t slot_of[8][8]; /* edge slot of a template corner pair, -1 if none */
+    /* the template's tets at each corner (tet, vertex; 1 or 4 of them) and at each edge slot
+     * (tet, vertex of slot.a, vertex of slot.b; 1 or 3), for the cell kernels' sums */
+    uint8_t corner_n[8];
+    uint8_t corner_tv[8][4][2];
+    uint8_t slot_n[18];
+    uint8_t slot_tv[18][3][3];
+    sc_grid_target target[SC_GRID_TARGETS];
+    sc_grid_stats stats;
+
+    /* ---- hot: matrix rows (node t at SC_GRID_HEAD + t) ---- */
+    SC_ALIGN_HOT float d[6][SC_GRID_ROW];
+    SC_ALIGN_HOT float e[3][9][SC_GRID_ROW];
+    SC_ALIGN_HOT float f[3][9][SC_GRID_ROW];
+    SC_ALIGN_HOT float mass[SC_GRID_ROW]; /* lumped mass, N s^2 / mm (the owner fills it) */
+    /* ---- hot: positions at the start of the step, rest positions, solver vectors (SoA) ---- */
+    SC_ALIGN_HOT float x[3][SC_GRID_ROW];  /* mm */
+    SC_ALIGN_HOT float x0[3][SC_GRID_ROW]; /* rest, mm */
+    SC_ALIGN_HOT float v[3][SC_GRID_ROW];  /* unknown v+ (warm start v0), mm/s */
+    SC_ALIGN_HOT float r[3][SC_GRID_ROW];  /* residual, N s */
+    SC_ALIGN_HOT float z[3][SC_GRID_ROW];  /* preconditioned residual */
+    SC_ALIGN_HOT float p[3][SC_GRID_ROW];  /* search direction */
+    SC_ALIGN_HOT float q[3][SC_GRID_ROW];  /* A p */
+    SC_ALIGN_HOT float pc[3][SC_GRID_ROW]; /* Jacobi, 0 on Dirichlet DOFs and padding */
+    SC_ALIGN_HOT int32_t odd[SC_GRID_ROW];     /* -1: node of odd i + j + k (face diagonals) */
+    SC_ALIGN_HOT int32_t cell_odd[SC_GRID_ROW]; /* -1: the cell at this origin is odd (mirrored) */
+    SC_ALIGN_HOT int32_t cell_ok[SC_GRID_ROW];  /* -1: a cell has this origin */
+    uint8_t con[SC_GRID_ROW]; /* this step: 1 fixed, 2 kinematic, 0 free, 0x80 | roller bits */
+    uint8_t used[SC_MAX_NODES]; /* node belongs to at least one tet */
+    /* ---- scratch of the cell kernels: one block of cells, rows of SC_GRID_CELL_BLOCK ---- */
+    SC_ALIGN_HOT float buf[SC_GRID_BUF_ROWS][SC_GRID_CELL_BLOCK];
+} sc_grid;
+
+/* The FEM's element data for the cell kernel (sc_fem.c fills it at init). Tet q of the cell with
+ * lowest node t (template order, SC_MESH_CELL_TETS) has lambda V and mu V at
+ * lamv[q * SC_GRID_ROW + SC_GRID_HEAD + t] (0 where no cell is); its rest shape gradients and
+ * volume are those of the template (every cell of the grid is the same box, an odd one
+ * mirrored in x), per cell parity. */
+typedef struct sc_grid_fem_in {
+    const float *lamv;            /* [5][SC_GRID_ROW], N mm (N/mm^2 x mm^3) */
+    const float *muv;             /* [5][SC_GRID_ROW] */
+    float grad[2][5][4][3];       /* rest grad N_a of template corner a of tet q, 1/mm */
+    float vol_mm3[5];             /* rest volume of tet q */
+    float sign[2][5];             /* sign of the template order's 6V (the floor's volume) */
+    float floor_ratio;            /* a tet below this fraction of its rest volume meets the
+                                     floor term; 0: off */
+    float floor_nmm2;             /* the floor's modulus, N/mm^2 */
+    int corotated;                /* 1: R = polar(F); 0: R = I (linear) */
+} sc_grid_fem_in;
+
+/* Layout for the mesh (which must be sc_mesh_build's regular grid: checked against its tets),
+ * rest positions, masks; matrix, masses and vectors zero. O(N + tets). Never allocates.
+ * Errors: SC_ERR_INVALID_ARG (NULL, counts above the limits or not the grid of sc_mesh_build). */
+int sc_grid_init(sc_grid *g, const sc_mesh *m);
+
+/* Start a step of length dt_s: the Dirichlet flags (kinematic may be NULL), positions, the
+ * warm start v0 (above) and r = dt f_ext - dt alpha M v0; the matrix is left as it is. The
+ * caller then sets the matrix to K(x) (sc_grid_clear and an assembly that adds, or a matrix
+ * kept from an earlier step) and subtracts dt f_int(x) + (dt beta + dt^2) K(x) v0 from r.
+ * O(N). Preconditions (SC_ASSERT): g initialised with m; dt_s > 0, beta, alpha >= 0, finite. */
+void sc_grid_begin(sc_grid *g, const sc_mesh *m, const sc_nodes *n, float dt_s, float beta_s,
+                   float alpha_per_s, const uint8_t *kinematic);
+
+/* Zero the diagonal blocks (SC_GRID_CLEAR_DIAG) and/or the edge and face blocks
+ * (SC_GRID_CLEAR_BLOCKS). O(N). */
+#define SC_GRID_CLEAR_DIAG   1u
+#define SC_GRID_CLEAR_BLOCKS 2u
+void sc_grid_clear(sc_grid *g, uint32_t which);
+
+/* Finish the step begun with the same dt, beta and alpha: the preconditioner, cg_iterations
+ * PCG iterations (fewer only if r.z is exactly 0 or p.Ap <= 0), and n->x, n->v from the
+ * solution; fixed DOFs keep their position with zero velocity. A non-finite solution leaves n
+ * unchanged, counts stats.unstable_steps and returns SC_ERR_PHYS_UNSTABLE; else 0.
+ * Cost: cg_iterations mat-vecs, O(N) each (bounded by SC_MAX_NODES), plus O(N).
+ * Preconditions (SC_ASSERT): 1 <= cg_iterations <= SC_PHYS_ITERATIONS_MAX. */
+int sc_grid_solve(sc_grid *g, sc_nodes *n, float dt_s, float beta_s, float alpha_per_s,
+                  uint32_t cg_iterations);
+
+/* The 3x3 block K(i, j) (row-major) of the assembled matrix: the diagonal block (i == j), a grid
+ * edge or face diagonal between i and j in either order, else zeros (returns 0; 1 if the
+ * pair is a stored block). For tests and tools. O(1). */
+int sc_grid_block(const sc_grid *g, uint32_t i, uint32_t j, float out[9]);
+
+/* q = A p over node-interleaved double vectors (3 per node) with the current matrix, A = cm M +
+ * ck K: the tests' oracle of the kernels' mat-vec. O(N). */
+void sc_grid_apply_ref(const sc_grid *g, float cm, float ck, const double *p, double *q);
+
+#endif /* SC_GRID_H */
