@@ -238,7 +238,7 @@ static int parse_cli(int argc, char **argv, emu_cli *a)
         {0, 0, 0, 0},
     };
     int c;
-    double v;
+    double v = 0.0;
     while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
         int bad = 0;
         switch (c) {
