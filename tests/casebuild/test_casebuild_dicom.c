@@ -4,6 +4,7 @@
  * an independent writer (Debian's python3-pydicom, tests/casebuild/write_dicom_pydicom.py),
  * with and without the optional Rescale Slope / Intercept. */
 #include "sc_test.h"
+#include "sc_test_tmpdir.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -274,16 +275,13 @@ static void dicom_without_dcmtk_is_not_supported(void **state)
 static int setup(void **state)
 {
     (void)state;
-    snprintf(g_dir, sizeof g_dir, "/tmp/sc_dicom_XXXXXX");
-    return mkdtemp(g_dir) == NULL ? -1 : 0;
+    return sc_test_tmpdir_make(g_dir, sizeof g_dir, "sc_dicom");
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    char cmd[200];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_dir);
-    return system(cmd) == 0 ? 0 : -1;
+    return sc_test_tmpdir_remove(g_dir);
 }
 
 int main(void)

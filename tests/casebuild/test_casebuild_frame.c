@@ -3,6 +3,7 @@
  * frame), label maps (--label-map, refusals by name) and the mesh box derived from the labels.
  * Fixtures are written at test time into a temporary directory. */
 #include "sc_test.h"
+#include "sc_test_tmpdir.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -396,16 +397,13 @@ static void mesh_box_is_derived_from_skin_to_bone(void **state)
 static int setup(void **state)
 {
     (void)state;
-    snprintf(g_dir, sizeof g_dir, "/tmp/sc_frame_XXXXXX");
-    return mkdtemp(g_dir) == NULL ? -1 : 0;
+    return sc_test_tmpdir_make(g_dir, sizeof g_dir, "sc_frame");
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    char cmd[300];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_dir);
-    return system(cmd) == 0 ? 0 : -1;
+    return sc_test_tmpdir_remove(g_dir);
 }
 
 int main(void)

@@ -2,6 +2,7 @@
  * type, compared voxel by voxel; geometry; resampling; named refusals. The fixtures are
  * written at test time into a temporary directory (no committed blobs). */
 #include "sc_test.h"
+#include "sc_test_tmpdir.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -669,16 +670,13 @@ static void hostile_headers_are_refused_naming_the_field(void **state)
 static int setup(void **state)
 {
     (void)state;
-    snprintf(g_dir, sizeof g_dir, "/tmp/sc_import_XXXXXX");
-    return mkdtemp(g_dir) == NULL ? -1 : 0;
+    return sc_test_tmpdir_make(g_dir, sizeof g_dir, "sc_import");
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    char cmd[300];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_dir);
-    return system(cmd) == 0 ? 0 : -1;
+    return sc_test_tmpdir_remove(g_dir);
 }
 
 int main(void)

@@ -4,6 +4,7 @@
  * reconstructed with nearest and trilinear splatting, compared with the field; a sparse sweep
  * exercises hole filling; `import` refuses the sequence by pointing to `reconstruct`. */
 #include "sc_test.h"
+#include "sc_test_tmpdir.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -311,16 +312,13 @@ static void import_refuses_a_sequence_and_the_volume_imports(void **state)
 static int setup(void **state)
 {
     (void)state;
-    snprintf(g_dir, sizeof g_dir, "/tmp/sc_recon_XXXXXX");
-    return mkdtemp(g_dir) == NULL ? -1 : 0;
+    return sc_test_tmpdir_make(g_dir, sizeof g_dir, "sc_recon");
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    char cmd[300];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_dir);
-    return system(cmd) == 0 ? 0 : -1;
+    return sc_test_tmpdir_remove(g_dir);
 }
 
 int main(void)

@@ -3,6 +3,7 @@
  * when its file is truncated underneath, and a corrupt file on disk is refused by the loader
  * through it; the case folder listing. */
 #include "sc_test.h"
+#include "sc_test_tmpdir.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -224,16 +225,13 @@ static void corrupt_file_on_disk_is_refused_through_storage(void **state)
 static int setup(void **state)
 {
     (void)state;
-    snprintf(g_dir, sizeof g_dir, "/tmp/sc_storage_XXXXXX");
-    return mkdtemp(g_dir) == NULL ? -1 : 0;
+    return sc_test_tmpdir_make(g_dir, sizeof g_dir, "sc_storage");
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    char cmd[200];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_dir);
-    return system(cmd) == 0 ? 0 : -1;
+    return sc_test_tmpdir_remove(g_dir);
 }
 
 int main(void)
