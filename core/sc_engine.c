@@ -33,6 +33,7 @@ sc_engine_def sc_engine_default_def(void)
     d.tracker = sc_tracker_default_def();
     d.tissue = sc_tissue_default_def();
     d.bscan = sc_bscan_default_def();
+    d.assess = sc_assess_default_def();
     d.case_count = 0u;
     return d;
 }
@@ -197,6 +198,40 @@ static void stage_imaging(sc_engine *e, const sc_probe_in *probe, const sc_tissu
     }
 }
 
+/* ==== the assessment: what the frame showed -> the exam's record (sc_assess.h) =========== */
+
+static void assess_frame(sc_engine *e, const sc_tissue_out *tissue, const sc_image_out *img)
+{
+    sc_assess_in in = {.contact = tissue->contact,
+                       .area_ratio = {img->vein_area_ratio, img->artery_area_ratio,
+                                      SC_AREA_RATIO_NOT_AVAILABLE},
+                       .force_n = SC_FORCE_NOT_AVAILABLE};
+    if (e->case_loaded && tissue->contact) {
+        const sc_bscan_status *b = sc_bscan_status_get(&e->bscan);
+        if (b->areas_valid && b->area_ratio[SC_LABEL_THROMBUS] >= 0.0f) {
+            in.area_ratio[SC_ASSESS_THROMBUS] = b->area_ratio[SC_LABEL_THROMBUS];
+        }
+        in.force_n = sc_tissue_probe_force_n(running_tissue(e), NULL);
+    }
+    sc_assess_update(&e->assess, &in);
+}
+
+static void send_assessment(sc_engine *e)
+{
+    sc_assess_msg m;
+    sc_assess_to_msg(sc_assess_get(&e->assess), &m);
+    sc_can_frame out[SC_ASSESS_FRAMES];
+    if (sc_status_tx_encode_assess(&e->status_tx, &m, out) != SC_OK) {
+        e->counters.can_tx_failed += SC_ASSESS_FRAMES;
+        return;
+    }
+    for (uint32_t i = 0; i < SC_ASSESS_FRAMES; i++) {
+        if (sc_can_send(&e->hal->can, &out[i]) != SC_OK) {
+            e->counters.can_tx_failed++;
+        }
+    }
+}
+
 /* ==== stage status: what the frame did -> CAN ============================================ */
 
 static void stage_status(sc_engine *e, uint64_t now, const sc_probe_in *probe,
@@ -232,6 +267,7 @@ static void stage_status(sc_engine *e, uint64_t now, const sc_probe_in *probe,
             e->counters.can_tx_failed++;
         }
     }
+    send_assessment(e);
 }
 
 /* ==== control step: commands and case switches, between frames ========================== */
@@ -313,6 +349,16 @@ static void apply_command(sc_engine *e, const sc_cmd *c)
         break;
     case SC_CMD_SYNC_FRESHNESS: /* consumed by the tracker, never queued */
         break;
+    case SC_CMD_ASSESS:
+        if (c->assess_action == SC_ASSESS_ACTION_RESET) {
+            sc_assess_reset(&e->assess);
+            sc_log(&e->hal->log, SC_LOG_INFO, "assess_reset", SC_OK, 0, 0);
+        } else {
+            rc = sc_assess_set_call(&e->assess, c->assess_call);
+            sc_log(&e->hal->log, SC_LOG_INFO, "assess_call", rc, (int64_t)c->assess_call,
+                   (int64_t)sc_assess_get(&e->assess)->score);
+        }
+        break;
     case SC_CMD_RESET:
         if ((c->reset_target & SC_RESET_TISSUE) && e->case_loaded) {
             sc_tissue_reset(running_tissue(e));
@@ -389,6 +435,17 @@ static int build_begin(sc_engine *e, uint32_t slot)
     return sc_tissue_build_begin(&e->tissue[slot], &td, &c->volume, &mat, (uint8_t)SC_LABEL_FAT);
 }
 
+/* The case's truth for the assessment: DVT when a tet of its mesh is thrombus. O(tets). */
+static uint8_t case_finding(const sc_mesh *m)
+{
+    for (uint32_t t = 0; t < m->tet_count; t++) {
+        if (m->tet_label[t] == (uint8_t)SC_LABEL_THROMBUS) {
+            return SC_ASSESS_CALL_DVT;
+        }
+    }
+    return SC_ASSESS_CALL_NORMAL;
+}
+
 /* Between two frames: the new case becomes the running one. */
 static int swap_case(sc_engine *e, uint32_t slot)
 {
@@ -428,6 +485,7 @@ static int swap_case(sc_engine *e, uint32_t slot)
     e->case_loaded = 1;
     e->case_id = e->sw.case_id;
     e->counters.case_loads++;
+    (void)sc_assess_begin_case(&e->assess, case_finding(&e->tissue[slot].mesh));
     sc_health_clear(&e->health, SC_FAULT_NO_CASE);
     sc_log(&e->hal->log, SC_LOG_INFO, "case_loaded", SC_OK, (int64_t)e->sw.c.case_id,
            (int64_t)e->tissue[slot].mesh.tet_count);
@@ -554,13 +612,14 @@ static void control_step(sc_engine *e)
 static int set_filters(sc_engine *e)
 {
     /* exactly the protocol's receive ids, so that foreign traffic (a flood at full bus load
-     * included) stays in the controller: commands 0x080..0x084, their cryptographic PDUs
-     * 0x088..0x08C, classic pose 0x100..0x102, FD pose 0x110 */
+     * included) stays in the controller: commands 0x080..0x084 and 0x087, their cryptographic
+     * PDUs 0x088..0x08C and 0x08F, classic pose 0x100..0x102, FD pose 0x110 */
     const sc_can_filter f[] = {
         {.id = SC_CANID_CMD_CASE, .mask = 0x7FCu, .flags = 0},  /* 0x080..0x083 */
         {.id = SC_CANID_CMD_SYNC, .mask = 0x7FFu, .flags = 0},  /* 0x084 */
         {.id = SC_CANID_AUTH_CASE, .mask = 0x7FCu, .flags = 0}, /* 0x088..0x08B */
         {.id = SC_CANID_AUTH_SYNC, .mask = 0x7FFu, .flags = 0}, /* 0x08C */
+        {.id = SC_CANID_CMD_ASSESS, .mask = 0x7F7u, .flags = 0}, /* 0x087 and 0x08F */
         {.id = SC_CANID_POSE_POS, .mask = 0x7FEu, .flags = 0},  /* 0x100..0x101 */
         {.id = SC_CANID_POSE_AUX, .mask = 0x7FFu, .flags = 0},  /* 0x102 */
         {.id = SC_CANID_POSE_FD, .mask = 0x7FFu, .flags = 0},
@@ -614,6 +673,9 @@ int sc_engine_init(sc_engine *e, const sc_engine_def *def, const sc_hal *hal)
     sc_status_tx_init(&e->status_tx);
     if (rc == SC_OK) {
         rc = sc_bscan_init(&e->bscan, &def->bscan);
+    }
+    if (rc == SC_OK) {
+        rc = sc_assess_init(&e->assess, &def->assess);
     }
     if (rc == SC_OK) {
         rc = set_filters(e);
@@ -712,6 +774,7 @@ void sc_engine_step(sc_engine *e, sc_frame_result *out)
     sc_sched_stage_done(s, SC_ENGINE_STAGE_PHYSICS);
 
     stage_imaging(e, &e->probe, &e->tissue_out, &e->image);
+    assess_frame(e, &e->tissue_out, &e->image);
     sc_sched_stage_done(s, SC_ENGINE_STAGE_IMAGING);
 
     stage_status(e, now_ns(e), &e->probe, &e->tissue_out, &e->image);
@@ -806,4 +869,9 @@ uint64_t sc_engine_next_release_ns(const sc_engine *e)
 const sc_probe_in *sc_engine_get_probe(const sc_engine *e)
 {
     return &e->probe;
+}
+
+const sc_assess_report *sc_engine_assessment(const sc_engine *e)
+{
+    return sc_assess_get(&e->assess);
 }

@@ -68,6 +68,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "sc_assess.h"
 #include "sc_bscan.h"
 #include "sc_case.h"
 #include "sc_config.h"
@@ -133,6 +134,7 @@ typedef struct sc_engine_def {
     sc_tracker_def tracker;
     sc_tissue_def tissue;          /* mesh region and materials come from the case */
     sc_bscan_def bscan;            /* calibration comes from the case */
+    sc_assess_def assess;          /* the compression exam's assessment (sc_assess.h) */
     /* Case catalogue: catalogue index i (CmdSelectCase) names case_names[i] in storage. */
     const char *case_names[SC_ENGINE_MAX_CASES];
     uint32_t case_count;
@@ -258,6 +260,7 @@ typedef struct sc_engine {
     uint32_t misses_unlogged; /* misses since then that got no line of their own */
     sc_engine_hook_fn hook;
     void *hook_user;
+    sc_assess assess;         /* the compression exam's assessment, updated every frame */
     sc_bscan bscan;
     sc_tissue tissue[SC_ENGINE_TISSUE_SLOTS]; /* the large ones last */
 } sc_engine;
@@ -313,5 +316,11 @@ const sc_bscan_status *sc_engine_get_bscan_status(const sc_engine *e);
 uint64_t sc_engine_next_release_ns(const sc_engine *e);
 /* This frame's probe as the rx stage produced it. */
 const sc_probe_in *sc_engine_get_probe(const sc_engine *e);
+/* The compression exam's assessment (sc_assess.h; layout in docs/assessment.md): per vessel
+ * the deepest compression, coaptation and force there, the peak force, the artery check, the
+ * trainee's call (CAN CmdAssessment) and the scored criteria. Updated every frame after the
+ * imaging stage (O(1) plus sc_tissue_probe_force_n, O(contacts)); reset by CmdAssessment's
+ * reset and at every case swap (with the new case's finding). Never NULL. O(1). */
+const sc_assess_report *sc_engine_assessment(const sc_engine *e);
 
 #endif /* SC_ENGINE_H */

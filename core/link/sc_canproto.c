@@ -55,6 +55,11 @@ static const sc_can_sig sigs_cmd_sync[] = {
     {"FreshnessMid", 16, 24, 0, 1.0f, 0.0f, 0.0f, 16777215.0f, ""},
     {"FreshnessHigh", 40, 24, 0, 1.0f, 0.0f, 0.0f, 16777215.0f, ""},
 };
+static const sc_can_sig sigs_cmd_assess[] = {
+    E2E_SIGS,
+    {"AssessAction", 16, 2, 0, 1.0f, 0.0f, 1.0f, 2.0f, ""},
+    {"AssessCall", 18, 2, 0, 1.0f, 0.0f, 0.0f, 2.0f, ""},
+};
 /* The cryptographic PDU (sc_secoc.h); the 40-bit MAC as two integer signals so that every
  * signal stays exact in float32 (MacA = MAC bytes 0..2, MacB = bytes 3..4, little-endian). */
 static const sc_can_sig sigs_auth[] = {
@@ -119,6 +124,40 @@ static const sc_can_sig sigs_auth_diag[] = {
     {"AuthStale", 56, 8, 0, 1.0f, 0.0f, 0.0f, 255.0f, ""},
 };
 
+#define SIG_RATIO(n, sb)                                                                           \
+    {                                                                                              \
+        n, sb, 16, 0, 0.001f, 0.0f, 0.0f, 65.534f, ""                                              \
+    }
+#define SIG_AFORCE(n, sb)                                                                          \
+    {                                                                                              \
+        n, sb, 16, 0, 0.01f, 0.0f, 0.0f, 655.34f, "N"                                              \
+    }
+static const sc_can_sig sigs_assess_vessels[] = {
+    E2E_SIGS,
+    SIG_RATIO("VeinMinRatio", 16),
+    SIG_RATIO("ArteryMinRatio", 32),
+    SIG_RATIO("ThrombusMinRatio", 48),
+};
+static const sc_can_sig sigs_assess_force[] = {
+    E2E_SIGS,
+    SIG_AFORCE("VeinForce", 16),
+    SIG_AFORCE("ArteryForce", 32),
+    SIG_AFORCE("ThrombusForce", 48),
+};
+static const sc_can_sig sigs_assess_score[] = {
+    E2E_SIGS,
+    SIG_AFORCE("PeakForce", 16),
+    {"VeinCoapted", 32, 1, 0, 1.0f, 0.0f, 0.0f, 1.0f, ""},
+    {"ArteryCoapted", 33, 1, 0, 1.0f, 0.0f, 0.0f, 1.0f, ""},
+    {"ThrombusCoapted", 34, 1, 0, 1.0f, 0.0f, 0.0f, 1.0f, ""},
+    {"ArteryOverCompressed", 35, 1, 0, 1.0f, 0.0f, 0.0f, 1.0f, ""},
+    {"TraineeCall", 36, 2, 0, 1.0f, 0.0f, 0.0f, 2.0f, ""},
+    {"CaseFinding", 38, 2, 0, 1.0f, 0.0f, 0.0f, 2.0f, ""},
+    {"CriteriaMet", 40, 8, 0, 1.0f, 0.0f, 0.0f, 255.0f, ""},
+    {"Score", 48, 8, 0, 1.0f, 0.0f, 0.0f, 255.0f, ""},
+    {"ScoreMax", 56, 8, 0, 1.0f, 0.0f, 0.0f, 255.0f, ""},
+};
+
 #define MSG(n, id, len, fd, cyc, to, sigs)                                                         \
     {                                                                                              \
         n, id, id, len, fd, cyc, to, 1u, (uint8_t)(sizeof(sigs) / sizeof((sigs)[0])), sigs         \
@@ -134,6 +173,7 @@ static const sc_can_msg_info msg_table[SC_MSG_COUNT] = {
     [SC_MSG_CMD_IMAGING] = MSG("CmdSetImaging", SC_CANID_CMD_IMAGING, 8, 0, 0, 0, sigs_cmd_imaging),
     [SC_MSG_CMD_RESET] = MSG("CmdReset", SC_CANID_CMD_RESET, 8, 0, 0, 0, sigs_cmd_reset),
     [SC_MSG_CMD_SYNC] = MSG("CmdFreshnessSync", SC_CANID_CMD_SYNC, 8, 0, 0, 0, sigs_cmd_sync),
+    [SC_MSG_CMD_ASSESS] = MSG("CmdAssessment", SC_CANID_CMD_ASSESS, 8, 0, 0, 0, sigs_cmd_assess),
     [SC_MSG_POSE_POS] = MSG("ProbePosePos", SC_CANID_POSE_POS, 8, 0, 10, 100, sigs_pose_pos),
     [SC_MSG_POSE_QUAT] = MSG("ProbePoseQuat", SC_CANID_POSE_QUAT, 8, 0, 10, 100, sigs_pose_quat),
     [SC_MSG_POSE_AUX] = MSG("ProbePoseAux", SC_CANID_POSE_AUX, 8, 0, 10, 100, sigs_pose_aux),
@@ -147,12 +187,24 @@ static const sc_can_msg_info msg_table[SC_MSG_COUNT] = {
     [SC_MSG_AUTH_IMAGING] = MSG_AUTH("CmdAuthSetImaging", SC_CANID_AUTH_CASE + 2),
     [SC_MSG_AUTH_RESET] = MSG_AUTH("CmdAuthReset", SC_CANID_AUTH_CASE + 3),
     [SC_MSG_AUTH_SYNC] = MSG_AUTH("CmdAuthFreshnessSync", SC_CANID_AUTH_SYNC),
+    [SC_MSG_AUTH_ASSESS] = MSG_AUTH("CmdAuthAssessment", SC_CANID_AUTH_ASSESS),
+    [SC_MSG_ASSESS_VESSELS] =
+        MSG("AssessVessels", SC_CANID_ASSESS_VESSELS, 8, 0, 100, 0, sigs_assess_vessels),
+    [SC_MSG_ASSESS_FORCE] =
+        MSG("AssessForce", SC_CANID_ASSESS_FORCE, 8, 0, 100, 0, sigs_assess_force),
+    [SC_MSG_ASSESS_SCORE] =
+        MSG("AssessScore", SC_CANID_ASSESS_SCORE, 8, 0, 100, 0, sigs_assess_score),
 };
+_Static_assert(SC_CANID_AUTH_ASSESS == SC_CANID_CMD_ASSESS + SC_CANID_AUTH_OFFSET, "auth ids");
+_Static_assert(SC_MSG_AUTH_ASSESS - SC_MSG_AUTH_CASE == SC_MSG_CMD_ASSESS - SC_MSG_CMD_CASE,
+               "one cryptographic PDU per command (assessment)");
 _Static_assert(SC_CANID_AUTH_SYNC == SC_CANID_CMD_SYNC + SC_CANID_AUTH_OFFSET, "auth ids");
 _Static_assert(SC_MSG_AUTH_SYNC - SC_MSG_AUTH_CASE == SC_MSG_CMD_SYNC - SC_MSG_CMD_CASE,
                "one cryptographic PDU per command");
 
 _Static_assert(sizeof(sigs_pose_fd) / sizeof(sigs_pose_fd[0]) <= SC_CANPROTO_MAX_SIGS,
+               "raise SC_CANPROTO_MAX_SIGS");
+_Static_assert(sizeof(sigs_assess_score) / sizeof(sigs_assess_score[0]) <= SC_CANPROTO_MAX_SIGS,
                "raise SC_CANPROTO_MAX_SIGS");
 
 const sc_can_msg_info *sc_canproto_info(sc_msg m)
@@ -424,6 +476,7 @@ int sc_canproto_decode_pose_part(const sc_can_frame *f, sc_pose_msg *p)
     case SC_MSG_CMD_IMAGING:
     case SC_MSG_CMD_RESET:
     case SC_MSG_CMD_SYNC:
+    case SC_MSG_CMD_ASSESS:
     case SC_MSG_STATUS:
     case SC_MSG_TIMING:
     case SC_MSG_DIAG:
@@ -433,6 +486,10 @@ int sc_canproto_decode_pose_part(const sc_can_frame *f, sc_pose_msg *p)
     case SC_MSG_AUTH_IMAGING:
     case SC_MSG_AUTH_RESET:
     case SC_MSG_AUTH_SYNC:
+    case SC_MSG_AUTH_ASSESS:
+    case SC_MSG_ASSESS_VESSELS:
+    case SC_MSG_ASSESS_FORCE:
+    case SC_MSG_ASSESS_SCORE:
     case SC_MSG_COUNT:
         break;
     }
@@ -454,8 +511,18 @@ sc_msg sc_canproto_cmd_msg(sc_cmd_kind k)
         return SC_MSG_CMD_RESET;
     case SC_CMD_SYNC_FRESHNESS:
         return SC_MSG_CMD_SYNC;
+    case SC_CMD_ASSESS:
+        return SC_MSG_CMD_ASSESS;
     }
     return SC_MSG_COUNT;
+}
+
+/* CmdAssessment: a reset carries no call, a call carries normal or DVT. */
+static int assess_pair_ok(uint32_t action, uint32_t call)
+{
+    return (action == SC_ASSESS_ACTION_RESET && call == SC_ASSESS_CALL_NONE) ||
+           (action == SC_ASSESS_ACTION_CALL &&
+            (call == SC_ASSESS_CALL_NORMAL || call == SC_ASSESS_CALL_DVT));
 }
 
 int sc_canproto_encode_cmd(const sc_cmd *c, uint8_t counter, sc_can_frame *out)
@@ -511,6 +578,13 @@ int sc_canproto_encode_cmd(const sc_cmd *c, uint8_t counter, sc_can_frame *out)
         put_u(out, m, 2u, (uint32_t)(c->fv_high & 0xFFFFFFu));
         put_u(out, m, 3u, (uint32_t)((c->fv_high >> 24) & 0xFFFFFFu));
         break;
+    case SC_CMD_ASSESS:
+        m = SC_MSG_CMD_ASSESS;
+        frame_begin(out, m);
+        rc = assess_pair_ok(c->assess_action, c->assess_call) ? 0 : SC_ERR_CAN_SIGNAL;
+        put_u(out, m, 2u, c->assess_action & 3u);
+        put_u(out, m, 3u, c->assess_call & 3u);
+        break;
     default:
         return SC_ERR_INVALID_ARG;
     }
@@ -559,6 +633,15 @@ int sc_canproto_decode_cmd(const sc_can_frame *f, sc_cmd *out)
         c.fv_high = (uint64_t)get_u(f, m, 2u) | ((uint64_t)get_u(f, m, 3u) << 24);
         nsig = 0;
         break;
+    case SC_MSG_CMD_ASSESS:
+        c.kind = SC_CMD_ASSESS;
+        c.assess_action = (uint8_t)get_u(f, m, 2u);
+        c.assess_call = (uint8_t)get_u(f, m, 3u);
+        if (!assess_pair_ok(c.assess_action, c.assess_call)) {
+            return SC_ERR_CAN_SIGNAL;
+        }
+        nsig = 2;
+        break;
     case SC_MSG_POSE_POS:
     case SC_MSG_POSE_QUAT:
     case SC_MSG_POSE_AUX:
@@ -572,6 +655,10 @@ int sc_canproto_decode_cmd(const sc_can_frame *f, sc_cmd *out)
     case SC_MSG_AUTH_IMAGING:
     case SC_MSG_AUTH_RESET:
     case SC_MSG_AUTH_SYNC:
+    case SC_MSG_AUTH_ASSESS:
+    case SC_MSG_ASSESS_VESSELS:
+    case SC_MSG_ASSESS_FORCE:
+    case SC_MSG_ASSESS_SCORE:
     case SC_MSG_COUNT:
         return SC_ERR_CAN_ID;
     }
@@ -693,6 +780,7 @@ int sc_canproto_decode_status_part(const sc_can_frame *f, sc_status_msg *s)
     case SC_MSG_CMD_IMAGING:
     case SC_MSG_CMD_RESET:
     case SC_MSG_CMD_SYNC:
+    case SC_MSG_CMD_ASSESS:
     case SC_MSG_POSE_POS:
     case SC_MSG_POSE_QUAT:
     case SC_MSG_POSE_AUX:
@@ -702,8 +790,98 @@ int sc_canproto_decode_status_part(const sc_can_frame *f, sc_status_msg *s)
     case SC_MSG_AUTH_IMAGING:
     case SC_MSG_AUTH_RESET:
     case SC_MSG_AUTH_SYNC:
+    case SC_MSG_AUTH_ASSESS:
+    case SC_MSG_ASSESS_VESSELS:
+    case SC_MSG_ASSESS_FORCE:
+    case SC_MSG_ASSESS_SCORE:
     case SC_MSG_COUNT:
         break;
+    }
+    return SC_ERR_CAN_ID;
+}
+
+/* ---- assessment ---------------------------------------------------------------------------- */
+
+/* A ratio or force field: negative = not available (0xFFFF), else clamped to the field. */
+static int put_avail(sc_can_frame *f, sc_msg m, unsigned idx, float v)
+{
+    return put_ratio(f, m, idx, v);
+}
+
+int sc_canproto_encode_assess(const sc_assess_msg *a, sc_e2e_tx tx[SC_ASSESS_FRAMES],
+                              sc_can_frame out[SC_ASSESS_FRAMES])
+{
+    if (a->call > SC_ASSESS_CALL_DVT || a->finding > SC_ASSESS_CALL_DVT) {
+        return SC_ERR_CAN_SIGNAL;
+    }
+    int rc = 0;
+    sc_msg m = SC_MSG_ASSESS_VESSELS;
+    frame_begin(&out[0], m);
+    for (unsigned v = 0; v < SC_ASSESS_VESSELS && rc == 0; v++) {
+        rc = put_avail(&out[0], m, 2u + v, a->min_ratio[v]);
+    }
+    m = SC_MSG_ASSESS_FORCE;
+    frame_begin(&out[1], m);
+    for (unsigned v = 0; v < SC_ASSESS_VESSELS && rc == 0; v++) {
+        rc = put_avail(&out[1], m, 2u + v, a->force_at_min_n[v]);
+    }
+    m = SC_MSG_ASSESS_SCORE;
+    frame_begin(&out[2], m);
+    if (rc == 0) {
+        rc = put_avail(&out[2], m, 2u, a->peak_force_n);
+    }
+    if (rc != 0) {
+        return rc;
+    }
+    for (unsigned v = 0; v < SC_ASSESS_VESSELS; v++) {
+        put_u(&out[2], m, 3u + v, a->coapted[v] ? 1u : 0u);
+    }
+    put_u(&out[2], m, 6u, a->artery_over ? 1u : 0u);
+    put_u(&out[2], m, 7u, a->call);
+    put_u(&out[2], m, 8u, a->finding);
+    put_u(&out[2], m, 9u, a->criteria_met);
+    put_u(&out[2], m, 10u, a->score);
+    put_u(&out[2], m, 11u, a->score_max);
+    for (unsigned i = 0; i < SC_ASSESS_FRAMES; i++) {
+        rc = sc_e2e_protect(&tx[i], out[i].data, out[i].len);
+        if (rc != 0) {
+            return rc;
+        }
+    }
+    return 0;
+}
+
+int sc_canproto_decode_assess_part(const sc_can_frame *f, sc_assess_msg *a)
+{
+    sc_msg m;
+    int rc = sc_canproto_classify(f, &m);
+    if (rc != 0) {
+        return rc;
+    }
+    if (m == SC_MSG_ASSESS_VESSELS) {
+        for (unsigned v = 0; v < SC_ASSESS_VESSELS; v++) {
+            a->min_ratio[v] = get_ratio(f, m, 2u + v);
+        }
+        return 0;
+    }
+    if (m == SC_MSG_ASSESS_FORCE) {
+        for (unsigned v = 0; v < SC_ASSESS_VESSELS; v++) {
+            a->force_at_min_n[v] = get_ratio(f, m, 2u + v);
+        }
+        return 0;
+    }
+    if (m == SC_MSG_ASSESS_SCORE) {
+        a->peak_force_n = get_ratio(f, m, 2u);
+        for (unsigned v = 0; v < SC_ASSESS_VESSELS; v++) {
+            a->coapted[v] = (uint8_t)get_u(f, m, 3u + v);
+        }
+        a->artery_over = (uint8_t)get_u(f, m, 6u);
+        a->call = (uint8_t)get_u(f, m, 7u);
+        a->finding = (uint8_t)get_u(f, m, 8u);
+        a->criteria_met = (uint8_t)get_u(f, m, 9u);
+        a->score = (uint8_t)get_u(f, m, 10u);
+        a->score_max = (uint8_t)get_u(f, m, 11u);
+        return 0;
     }
     return SC_ERR_CAN_ID;
 }

@@ -4,11 +4,13 @@
  *
  * Messages (11-bit ids, Intel byte order, E2E header in bytes 0-1, see sc_e2e.h):
  *   0x080 CmdSelectCase  0x081 CmdSetMethod  0x082 CmdSetImaging  0x083 CmdReset
- *   0x084 CmdFreshnessSync                                                         (in, event)
- *   0x088..0x08C CmdAuth*: the cryptographic PDU of command id - 8 (sc_secoc.h)    (in, event)
+ *   0x084 CmdFreshnessSync  0x087 CmdAssessment                                  (in, event)
+ *   0x088..0x08C, 0x08F CmdAuth*: the cryptographic PDU of command id - 8 (sc_secoc.h) (in)
  *   0x100 ProbePosePos   0x101 ProbePoseQuat 0x102 ProbePoseAux                    (in, 10 ms)
  *   0x110 ProbePoseFD    (in, 10 ms, CAN FD 20 bytes: the three above in one frame)
  *   0x200 EngineStatus   0x201 EngineTiming  0x202 TrackerDiag  0x203 AuthDiag    (out, 100 ms)
+ *   0x210 AssessVessels  0x211 AssessForce   0x212 AssessScore: the compression exam's
+ *         assessment (core/imaging/sc_assess.h)                                    (out, 100 ms)
  * A classic pose spans the three 0x10x frames, tied by one E2E counter value shared by the
  * three frames of a sample. E2E data ID = CAN id. Every message but the CmdAuth* frames
  * carries the E2E header (their integrity is their MAC's).
@@ -35,6 +37,7 @@ typedef enum sc_msg {
     SC_MSG_CMD_IMAGING,
     SC_MSG_CMD_RESET,
     SC_MSG_CMD_SYNC,
+    SC_MSG_CMD_ASSESS, /* CmdAssessment 0x087: reset the assessment, the trainee's call */
     SC_MSG_POSE_POS,
     SC_MSG_POSE_QUAT,
     SC_MSG_POSE_AUX,
@@ -48,15 +51,20 @@ typedef enum sc_msg {
     SC_MSG_AUTH_IMAGING,
     SC_MSG_AUTH_RESET,
     SC_MSG_AUTH_SYNC,
+    SC_MSG_AUTH_ASSESS,
+    SC_MSG_ASSESS_VESSELS, /* the assessment's status frames (out) */
+    SC_MSG_ASSESS_FORCE,
+    SC_MSG_ASSESS_SCORE,
     SC_MSG_COUNT
 } sc_msg;
 
-#define SC_CMD_MSGS 5u /* commands SC_MSG_CMD_CASE..SC_MSG_CMD_SYNC; SC_MSG_AUTH_* likewise */
+#define SC_CMD_MSGS 6u /* commands SC_MSG_CMD_CASE..SC_MSG_CMD_ASSESS; SC_MSG_AUTH_* likewise */
 /* 1 for the secured commands (authentic PDUs), 1 for their cryptographic PDUs. */
-#define SC_MSG_IS_CMD(m)  ((unsigned)(m) <= (unsigned)SC_MSG_CMD_SYNC)
-#define SC_MSG_IS_AUTH(m) ((unsigned)(m) >= (unsigned)SC_MSG_AUTH_CASE && (m) < SC_MSG_COUNT)
+#define SC_MSG_IS_CMD(m)  ((unsigned)(m) <= (unsigned)SC_MSG_CMD_ASSESS)
+#define SC_MSG_IS_AUTH(m)                                                                          \
+    ((unsigned)(m) >= (unsigned)SC_MSG_AUTH_CASE && (unsigned)(m) <= (unsigned)SC_MSG_AUTH_ASSESS)
 
-#define SC_CANPROTO_MAX_SIGS 11u
+#define SC_CANPROTO_MAX_SIGS 12u /* AssessScore */
 
 enum {
     SC_CANID_CMD_CASE = 0x080,
@@ -64,9 +72,11 @@ enum {
     SC_CANID_CMD_IMAGING = 0x082,
     SC_CANID_CMD_RESET = 0x083,
     SC_CANID_CMD_SYNC = 0x084,
+    SC_CANID_CMD_ASSESS = 0x087, /* 0x085, 0x086 left free for other commands */
     SC_CANID_AUTH_OFFSET = 0x008, /* CmdAuth id = command id + 8 */
     SC_CANID_AUTH_CASE = 0x088,
     SC_CANID_AUTH_SYNC = 0x08C,
+    SC_CANID_AUTH_ASSESS = 0x08F,
     SC_CANID_POSE_POS = 0x100,
     SC_CANID_POSE_QUAT = 0x101,
     SC_CANID_POSE_AUX = 0x102,
@@ -75,6 +85,9 @@ enum {
     SC_CANID_TIMING = 0x201,
     SC_CANID_DIAG = 0x202,
     SC_CANID_AUTH_DIAG = 0x203,
+    SC_CANID_ASSESS_VESSELS = 0x210, /* the assessment block 0x210..0x212 */
+    SC_CANID_ASSESS_FORCE = 0x211,
+    SC_CANID_ASSESS_SCORE = 0x212,
 };
 
 /* One signal as in the DBC: raw little-endian bit field, phys = raw * factor + offset. */
@@ -152,11 +165,16 @@ typedef enum sc_cmd_kind {
     SC_CMD_SET_IMAGING = 3,
     SC_CMD_RESET = 4,
     SC_CMD_SYNC_FRESHNESS = 5, /* CmdFreshnessSync: the sender's freshness bits 16..63 */
+    SC_CMD_ASSESS = 6,         /* CmdAssessment: reset the assessment, or the trainee's call */
 } sc_cmd_kind;
 
 enum { SC_METHOD_MSDS = 0, SC_METHOD_FEM = 1 };
 enum { SC_SCAN_LINEAR = 0, SC_SCAN_CURVILINEAR = 1 };
 enum { SC_RESET_TISSUE = 1, SC_RESET_FAULTS = 2, SC_RESET_ALL = 3 };
+/* CmdAssessment: Action 1 resets the assessment (Call 0), 2 enters the trainee's call (Call 1
+ * normal, 2 DVT). Any other pair is refused (SC_ERR_CAN_SIGNAL). */
+enum { SC_ASSESS_ACTION_RESET = 1, SC_ASSESS_ACTION_CALL = 2 };
+enum { SC_ASSESS_CALL_NONE = 0, SC_ASSESS_CALL_NORMAL = 1, SC_ASSESS_CALL_DVT = 2 };
 
 typedef struct sc_imaging_cmd {
     float depth_mm;      /* 10..250 */
@@ -174,6 +192,8 @@ typedef struct sc_cmd {
     sc_imaging_cmd imaging; /* SET_IMAGING */
     uint64_t fv_high;       /* SYNC_FRESHNESS: freshness value >> 16, 0..2^48-1 */
     uint8_t sender;         /* the authenticated sender (set by the receiver; sc_secoc.h) */
+    uint8_t assess_action;  /* ASSESS: SC_ASSESS_ACTION_* */
+    uint8_t assess_call;    /* ASSESS: SC_ASSESS_CALL_* (NONE with the reset) */
 } sc_cmd;
 
 /* The message of a command kind (SC_MSG_COUNT for an unknown kind). O(1). */
@@ -220,5 +240,36 @@ int sc_canproto_encode_status(const sc_status_msg *s, sc_e2e_tx tx[SC_STATUS_FRA
  * available" decode to SC_AREA_RATIO_NOT_AVAILABLE). Errors of sc_canproto_classify,
  * SC_ERR_CAN_ID for a frame that is not a status frame. */
 int sc_canproto_decode_status_part(const sc_can_frame *f, sc_status_msg *s);
+
+/* ---- assessment (out): AssessVessels, AssessForce, AssessScore --------------------------------
+ * The compression exam's assessment (core/imaging/sc_assess.h) in three frames. Ratios and
+ * forces that are "not available" (vessel never in view, no force) are negative here and
+ * 0xFFFF on the bus. */
+#define SC_ASSESS_FRAMES  3u
+#define SC_ASSESS_VESSELS 3u /* vein, artery, thrombosed vein (sc_assess_vessel) */
+#define SC_FORCE_NOT_AVAILABLE (-1.0f)
+
+typedef struct sc_assess_msg {
+    float min_ratio[SC_ASSESS_VESSELS]; /* deepest compression: smallest area ratio; < 0 n/a */
+    float force_at_min_n[SC_ASSESS_VESSELS]; /* force when it was reached; < 0 n/a */
+    float peak_force_n;                 /* largest force of the exam; < 0 n/a */
+    uint8_t coapted[SC_ASSESS_VESSELS]; /* min ratio <= the coaptation threshold */
+    uint8_t artery_over;                /* artery compressed below its limit */
+    uint8_t call;                       /* SC_ASSESS_CALL_* entered by the trainee */
+    uint8_t finding;                    /* the case's truth: SC_ASSESS_CALL_NORMAL / _DVT */
+    uint8_t criteria_met;               /* bit per criterion (sc_assess_criterion) */
+    uint8_t score;                      /* points of the met criteria */
+    uint8_t score_max;                  /* points of every criterion */
+} sc_assess_msg;
+
+/* Encodes AssessVessels, AssessForce, AssessScore into out[0..2], each protected with the
+ * counter of its sender state tx[0..2] (advanced). Ratios clamp to the field's range (a ratio
+ * above 65.534 is sent as 65.534), forces likewise to 655.34 N. O(1). Errors:
+ * SC_ERR_NOT_FINITE (a NaN or infinite value), SC_ERR_CAN_SIGNAL (call or finding above 2). */
+int sc_canproto_encode_assess(const sc_assess_msg *a, sc_e2e_tx tx[SC_ASSESS_FRAMES],
+                              sc_can_frame out[SC_ASSESS_FRAMES]);
+/* Writes the fields one of the three frames carries into *a ("not available" decodes to a
+ * negative value). Errors of sc_canproto_classify, SC_ERR_CAN_ID for another message. O(1). */
+int sc_canproto_decode_assess_part(const sc_can_frame *f, sc_assess_msg *a);
 
 #endif /* SC_CANPROTO_H */

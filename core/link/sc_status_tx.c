@@ -7,6 +7,16 @@ void sc_status_tx_init(sc_status_tx *s)
     sc_e2e_tx_init(&s->tx[1], sc_canproto_info(SC_MSG_TIMING)->data_id);
     sc_e2e_tx_init(&s->tx[2], sc_canproto_info(SC_MSG_DIAG)->data_id);
     sc_e2e_tx_init(&s->tx[3], sc_canproto_info(SC_MSG_AUTH_DIAG)->data_id);
+    for (unsigned i = 0; i < SC_ASSESS_FRAMES; i++) {
+        sc_e2e_tx_init(&s->assess_tx[i],
+                       sc_canproto_info((sc_msg)((unsigned)SC_MSG_ASSESS_VESSELS + i))->data_id);
+    }
+}
+
+int sc_status_tx_encode_assess(sc_status_tx *s, const sc_assess_msg *msg,
+                               sc_can_frame out[SC_ASSESS_FRAMES])
+{
+    return sc_canproto_encode_assess(msg, s->assess_tx, out);
 }
 
 int sc_status_tx_encode(sc_status_tx *s, const sc_tracker *t, sc_status_msg *msg,

@@ -18,6 +18,7 @@
 
 typedef struct sc_status_tx {
     sc_e2e_tx tx[SC_STATUS_FRAMES]; /* EngineStatus, EngineTiming, TrackerDiag, AuthDiag */
+    sc_e2e_tx assess_tx[SC_ASSESS_FRAMES]; /* AssessVessels, AssessForce, AssessScore */
 } sc_status_tx;
 
 /* Counters start at 0 with the protocol's data ids. O(1), cannot fail. */
@@ -28,5 +29,11 @@ void sc_status_tx_init(sc_status_tx *s);
  * state or method out of range or a non-finite ratio). */
 int sc_status_tx_encode(sc_status_tx *s, const sc_tracker *t, sc_status_msg *msg,
                         sc_can_frame out[SC_STATUS_FRAMES]);
+
+/* Encode the assessment's three frames (AssessVessels, AssessForce, AssessScore) into out,
+ * sent in the same status period after the four status frames; each sender counter advances.
+ * O(1). Errors of sc_canproto_encode_assess. */
+int sc_status_tx_encode_assess(sc_status_tx *s, const sc_assess_msg *msg,
+                               sc_can_frame out[SC_ASSESS_FRAMES]);
 
 #endif /* SC_STATUS_TX_H */

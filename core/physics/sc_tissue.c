@@ -369,3 +369,49 @@ uint64_t sc_tissue_state_hash(const sc_tissue *t)
     h = fnv(h, t->skin.z, t->skin.count);
     return h;
 }
+
+float sc_tissue_probe_force_n(const sc_tissue *t, float out[3])
+{
+    float f[3] = {0.0f, 0.0f, 0.0f};
+    if (out != NULL) {
+        out[0] = out[1] = out[2] = 0.0f;
+    }
+    if (t == NULL || t->build_phase != (uint8_t)SC_TISSUE_BUILD_DONE || t->mesh.node_count == 0u ||
+        (t->method == SC_TISSUE_MSDS && t->msds.def.integrator == (uint8_t)SC_MSDS_EXPLICIT)) {
+        return -1.0f;
+    }
+    const sc_mesh *m = &t->mesh;
+    const sc_nodes *n = &t->nodes;
+    const uint32_t nx = m->nx, ny = m->ny, nz = m->nz;
+    for (uint32_t q = 0; q < t->contacts.count; q++) {
+        const uint32_t i = t->contacts.c[q].node;
+        const uint32_t ix = i % nx, iy = (i / nx) % ny, iz = i / (nx * ny);
+        for (int dz = -1; dz <= 1; dz++) {
+            for (int dy = -1; dy <= 1; dy++) {
+                for (int dx = -1; dx <= 1; dx++) {
+                    const int jx = (int)ix + dx, jy = (int)iy + dy, jz = (int)iz + dz;
+                    if (jx < 0 || jy < 0 || jz < 0 || jx >= (int)nx || jy >= (int)ny ||
+                        jz >= (int)nz) {
+                        continue;
+                    }
+                    const uint32_t j = (uint32_t)jx + nx * ((uint32_t)jy + ny * (uint32_t)jz);
+                    float k[9];
+                    if (!sc_grid_block(&t->fem.grid, i, j, k)) {
+                        continue;
+                    }
+                    const float u[3] = {n->x[j] - m->rest_x[j], n->y[j] - m->rest_y[j],
+                                        n->z[j] - m->rest_z[j]};
+                    for (uint32_t r = 0; r < 3u; r++) {
+                        f[r] += k[3u * r] * u[0] + k[3u * r + 1u] * u[1] + k[3u * r + 2u] * u[2];
+                    }
+                }
+            }
+        }
+    }
+    if (out != NULL) {
+        out[0] = f[0];
+        out[1] = f[1];
+        out[2] = f[2];
+    }
+    return sqrtf(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+}

@@ -183,4 +183,14 @@ void sc_tissue_reset(sc_tissue *t);
 /* FNV-1a 64 over positions and velocities of the nodes and the skin. O(N). */
 uint64_t sc_tissue_state_hash(const sc_tissue *t);
 
+/* The force the tissue pushes back on the probe after the last step (N, volume frame, out[3]
+ * may be NULL), as its magnitude: the elastic force K (x - X) of the tissue at the nodes in
+ * contact with the probe, summed (the implicit methods hold those nodes on the probe, so that
+ * force is the probe's reaction; on the free nodes it is balanced). K is the matrix the last
+ * implicit step assembled (for the corotated FEM its rotated blocks: an estimate that is exact
+ * for the linear FEM at equilibrium); the skin layer's share is not included. Returns 0 with no
+ * contact, -1 (not available) for the explicit MSDS (it has no assembled K) or an unbuilt
+ * tissue. O(contacts x 27) block reads, bounded by SC_MAX_CONTACTS. Never allocates. */
+float sc_tissue_probe_force_n(const sc_tissue *t, float out[3]);
+
 #endif /* SC_TISSUE_H */

@@ -1,0 +1,215 @@
+/* sc_assess.c: the assessment of a compression exam; see sc_assess.h. */
+#include "sc_assess.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "sc_err.h"
+
+sc_assess_def sc_assess_default_def(void)
+{
+    return (sc_assess_def){
+        .coapt_ratio = 0.05f,
+        .artery_min_ratio = 0.75f,
+        .firm_force_n = 4.0f,
+        .force_max_n = 60.0f,
+        .min_view_frames = 6u,
+        .points = {1u, 2u, 1u, 1u, 3u},
+    };
+}
+
+int sc_assess_def_validate(const sc_assess_def *d)
+{
+    if (d == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    if (!isfinite(d->coapt_ratio) || !isfinite(d->artery_min_ratio) ||
+        !isfinite(d->firm_force_n) || !isfinite(d->force_max_n)) {
+        return SC_ERR_NOT_FINITE;
+    }
+    uint32_t total = 0;
+    for (uint32_t c = 0; c < SC_ASSESS_CRITERIA; c++) {
+        total += d->points[c];
+    }
+    if (!(d->coapt_ratio > 0.0f && d->coapt_ratio <= 1.0f) ||
+        !(d->artery_min_ratio > 0.0f && d->artery_min_ratio <= 1.0f) ||
+        !(d->firm_force_n > 0.0f) || !(d->force_max_n >= d->firm_force_n) || total > 255u ||
+        d->min_view_frames > 100000u) {
+        return SC_ERR_RANGE;
+    }
+    return SC_OK;
+}
+
+static void clear_record(sc_assess_report *r)
+{
+    const uint32_t resets = r->resets;
+    const uint8_t finding = r->finding;
+    memset(r, 0, sizeof(*r));
+    r->version = SC_ASSESS_REPORT_VERSION;
+    r->resets = resets;
+    r->finding = finding;
+    r->call = SC_ASSESS_CALL_NONE;
+    r->peak_force_n = -1.0f;
+    r->venous_force_max_n = -1.0f;
+    for (uint32_t v = 0; v < SC_ASSESS_VESSELS; v++) {
+        r->vessel[v].min_ratio = -1.0f;
+        r->vessel[v].force_at_min_n = -1.0f;
+    }
+}
+
+int sc_assess_init(sc_assess *a, const sc_assess_def *def)
+{
+    if (a == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    const int rc = sc_assess_def_validate(def);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    memset(a, 0, sizeof(*a));
+    a->def = *def;
+    a->r.finding = SC_ASSESS_CALL_NORMAL;
+    clear_record(&a->r);
+    sc_assess_score(&a->def, &a->r);
+    return SC_OK;
+}
+
+int sc_assess_begin_case(sc_assess *a, uint8_t finding)
+{
+    if (finding != SC_ASSESS_CALL_NORMAL && finding != SC_ASSESS_CALL_DVT) {
+        return SC_ERR_RANGE;
+    }
+    a->r.finding = finding;
+    clear_record(&a->r);
+    sc_assess_score(&a->def, &a->r);
+    return SC_OK;
+}
+
+void sc_assess_reset(sc_assess *a)
+{
+    a->r.resets++;
+    clear_record(&a->r);
+    sc_assess_score(&a->def, &a->r);
+}
+
+int sc_assess_set_call(sc_assess *a, uint8_t call)
+{
+    if (call != SC_ASSESS_CALL_NORMAL && call != SC_ASSESS_CALL_DVT) {
+        return SC_ERR_RANGE;
+    }
+    a->r.call = call;
+    a->r.calls++;
+    sc_assess_score(&a->def, &a->r);
+    return SC_OK;
+}
+
+static float avail(float v)
+{
+    return isfinite(v) && v >= 0.0f ? v : -1.0f;
+}
+
+void sc_assess_update(sc_assess *a, const sc_assess_in *in)
+{
+    sc_assess_report *r = &a->r;
+    const uint32_t frame = r->frames;
+    r->frames++;
+    if (!in->contact) {
+        return;
+    }
+    r->contact_frames++;
+    const float force = avail(in->force_n);
+    if (force > r->peak_force_n) {
+        r->peak_force_n = force;
+    }
+    for (uint32_t v = 0; v < SC_ASSESS_VESSELS; v++) {
+        const float ratio = avail(in->area_ratio[v]);
+        if (ratio < 0.0f) {
+            continue;
+        }
+        sc_assess_vessel_rec *x = &r->vessel[v];
+        x->frames_in_view++;
+        if (x->min_ratio < 0.0f || ratio < x->min_ratio) {
+            x->min_ratio = ratio;
+            x->force_at_min_n = force;
+            x->min_frame = frame;
+        }
+        x->coapted = (uint8_t)(x->min_ratio <= a->def.coapt_ratio);
+        if (v != SC_ASSESS_ARTERY && force > r->venous_force_max_n) {
+            r->venous_force_max_n = force;
+        }
+        if (v == SC_ASSESS_ARTERY && ratio < a->def.artery_min_ratio) {
+            r->artery_over = 1u;
+        }
+    }
+    sc_assess_score(&a->def, r);
+}
+
+void sc_assess_score(const sc_assess_def *def, sc_assess_report *r)
+{
+    const sc_assess_vessel_rec *vein = &r->vessel[SC_ASSESS_VEIN];
+    const sc_assess_vessel_rec *thr = &r->vessel[SC_ASSESS_THROMBUS];
+    const int imaged = vein->frames_in_view >= def->min_view_frames ||
+                       thr->frames_in_view >= def->min_view_frames;
+    uint8_t met[SC_ASSESS_CRITERIA];
+    met[SC_ASSESS_CRIT_VEIN_IMAGED] = (uint8_t)imaged;
+    met[SC_ASSESS_CRIT_COMPRESSED] =
+        (uint8_t)(imaged && (vein->coapted || r->venous_force_max_n >= def->firm_force_n));
+    met[SC_ASSESS_CRIT_ARTERY_SPARED] = (uint8_t)(imaged && !r->artery_over);
+    met[SC_ASSESS_CRIT_FORCE_SAFE] = (uint8_t)(imaged && r->peak_force_n <= def->force_max_n);
+    met[SC_ASSESS_CRIT_CALL_CORRECT] =
+        (uint8_t)(r->call != SC_ASSESS_CALL_NONE && r->call == r->finding);
+    uint32_t score = 0, max = 0;
+    uint8_t bits = 0;
+    for (uint32_t c = 0; c < SC_ASSESS_CRITERIA; c++) {
+        r->points[c] = def->points[c];
+        max += def->points[c];
+        if (met[c]) {
+            bits = (uint8_t)(bits | (1u << c));
+            score += def->points[c];
+        }
+    }
+    r->criteria_met = bits;
+    r->score = (uint8_t)score; /* <= 255: checked by sc_assess_def_validate */
+    r->score_max = (uint8_t)max;
+}
+
+const sc_assess_report *sc_assess_get(const sc_assess *a)
+{
+    return &a->r;
+}
+
+void sc_assess_to_msg(const sc_assess_report *r, sc_assess_msg *out)
+{
+    memset(out, 0, sizeof(*out));
+    for (uint32_t v = 0; v < SC_ASSESS_VESSELS; v++) {
+        out->min_ratio[v] = r->vessel[v].min_ratio;
+        out->force_at_min_n[v] = r->vessel[v].force_at_min_n;
+        out->coapted[v] = r->vessel[v].coapted;
+    }
+    out->peak_force_n = r->peak_force_n;
+    out->artery_over = r->artery_over;
+    out->call = r->call;
+    out->finding = r->finding;
+    out->criteria_met = r->criteria_met;
+    out->score = r->score;
+    out->score_max = r->score_max;
+}
+
+const char *sc_assess_criterion_name(sc_assess_criterion c)
+{
+    switch (c) {
+    case SC_ASSESS_CRIT_VEIN_IMAGED:
+        return "vein_imaged";
+    case SC_ASSESS_CRIT_COMPRESSED:
+        return "compressed";
+    case SC_ASSESS_CRIT_ARTERY_SPARED:
+        return "artery_spared";
+    case SC_ASSESS_CRIT_FORCE_SAFE:
+        return "force_safe";
+    case SC_ASSESS_CRIT_CALL_CORRECT:
+        return "call_correct";
+    case SC_ASSESS_CRITERIA:
+        break;
+    }
+    return "?";
+}
