@@ -9,3 +9,7 @@ if(TARGET test_press_sweep_fine)
   # six sweeps on the 32x16x16 mesh: minutes under ASan on a shared machine
   set_tests_properties(test_press_sweep_fine PROPERTIES TIMEOUT 2400)
 endif()
+# test_assess presses the phantom cases too
+if(TARGET test_assess AND TARGET cases)
+  add_dependencies(test_assess cases)
+endif()

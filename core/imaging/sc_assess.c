@@ -11,7 +11,7 @@ sc_assess_def sc_assess_default_def(void)
     return (sc_assess_def){
         .coapt_ratio = 0.05f,
         .artery_min_ratio = 0.75f,
-        .firm_force_n = 4.0f,
+        .firm_force_n = 8.0f, /* neck-ijv: the vein coapts by 12 N (tests/hostsim/test_assess) */
         .force_max_n = 60.0f,
         .min_view_frames = 6u,
         .points = {1u, 2u, 1u, 1u, 3u},

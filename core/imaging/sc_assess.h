@@ -105,7 +105,7 @@ typedef struct sc_assess {
     sc_assess_report r;
 } sc_assess;
 
-/* coapt 0.05, artery 0.75, firm press 4 N, unsafe above 60 N, 6 frames (0.1 s) in view;
+/* coapt 0.05, artery 0.75, firm press 8 N, unsafe above 60 N, 6 frames (0.1 s) in view;
  * points: imaged 1, compressed 2, artery spared 1, force safe 1, call correct 3 (8 in all). */
 sc_assess_def sc_assess_default_def(void);
 /* SC_ERR_INVALID_ARG (NULL), SC_ERR_NOT_FINITE, SC_ERR_RANGE (ratios outside (0, 1], forces

@@ -464,9 +464,160 @@ static void dbc_file_defines_exactly_the_codec_tables(void **state)
     assert_int_equal(fds, 1);
 }
 
+/* ---- assessment (0x087, 0x210..0x212) ---------------------------------------------------- */
+
+static void assessment_command_round_trips_and_bad_pairs_are_refused(void **state)
+{
+    (void)state;
+    const uint8_t ok[3][2] = {{SC_ASSESS_ACTION_RESET, SC_ASSESS_CALL_NONE},
+                              {SC_ASSESS_ACTION_CALL, SC_ASSESS_CALL_NORMAL},
+                              {SC_ASSESS_ACTION_CALL, SC_ASSESS_CALL_DVT}};
+    for (int i = 0; i < 3; i++) {
+        const sc_cmd c = {.kind = SC_CMD_ASSESS, .assess_action = ok[i][0], .assess_call = ok[i][1]};
+        sc_can_frame f;
+        assert_int_equal(sc_canproto_encode_cmd(&c, (uint8_t)i, &f), 0);
+        assert_int_equal(f.id, 0x087);
+        assert_true(e2e_ok(&f));
+        sc_cmd d;
+        assert_int_equal(sc_canproto_decode_cmd(&f, &d), 0);
+        assert_int_equal(d.kind, SC_CMD_ASSESS);
+        assert_int_equal(d.assess_action, ok[i][0]);
+        assert_int_equal(d.assess_call, ok[i][1]);
+        /* the DBC's signals (table-driven decode): AssessAction, AssessCall */
+        float phys[SC_CANPROTO_MAX_SIGS];
+        sc_msg m;
+        assert_int_equal(sc_canproto_decode_phys(&f, &m, phys, SC_CANPROTO_MAX_SIGS), 0);
+        assert_int_equal(m, SC_MSG_CMD_ASSESS);
+        assert_float_equal(phys[2], (float)ok[i][0], 0.0f);
+        assert_float_equal(phys[3], (float)ok[i][1], 0.0f);
+    }
+    /* every other pair: refused by the encoder and, built by hand, by the decoder */
+    for (uint8_t a = 0; a < 4u; a++) {
+        for (uint8_t k = 0; k < 4u; k++) {
+            const int good = (a == 1u && k == 0u) || (a == 2u && (k == 1u || k == 2u));
+            if (good) {
+                continue;
+            }
+            const sc_cmd c = {.kind = SC_CMD_ASSESS, .assess_action = a, .assess_call = k};
+            sc_can_frame f;
+            assert_int_equal(sc_canproto_encode_cmd(&c, 0, &f), SC_ERR_CAN_SIGNAL);
+            f = (sc_can_frame){.id = 0x087, .len = 8};
+            f.data[2] = (uint8_t)(a | (k << 2));
+            assert_int_equal(sc_e2e_protect_with(0x087, 0, f.data, f.len), 0);
+            sc_cmd d;
+            assert_int_equal(sc_canproto_decode_cmd(&f, &d), SC_ERR_CAN_SIGNAL);
+        }
+    }
+    /* its cryptographic PDU classifies at 0x08F */
+    sc_can_frame pdu = {.id = 0x08F, .len = 8};
+    sc_msg m;
+    assert_int_equal(sc_canproto_classify(&pdu, &m), 0);
+    assert_int_equal(m, SC_MSG_AUTH_ASSESS);
+    assert_true(SC_MSG_IS_AUTH(m));
+    assert_true(SC_MSG_IS_CMD(SC_MSG_CMD_ASSESS));
+    assert_false(SC_MSG_IS_AUTH(SC_MSG_ASSESS_VESSELS));
+}
+
+static void assessment_frames_decode_as_the_dbc_says(void **state)
+{
+    (void)state;
+    sc_e2e_tx tx[SC_ASSESS_FRAMES];
+    for (unsigned i = 0; i < SC_ASSESS_FRAMES; i++) {
+        sc_e2e_tx_init(&tx[i], (uint16_t)(0x210u + i));
+    }
+    for (int it = 0; it < 500; it++) {
+        sc_assess_msg a = {0};
+        for (unsigned v = 0; v < SC_ASSESS_VESSELS; v++) {
+            a.min_ratio[v] = (it + (int)v) % 7 == 0 ? -1.0f : rndf(0.0f, 1.3f);
+            a.force_at_min_n[v] = (it + (int)v) % 5 == 0 ? -1.0f : rndf(0.0f, 200.0f);
+            a.coapted[v] = (uint8_t)(rnd() & 1u);
+        }
+        a.peak_force_n = it % 11 == 0 ? -1.0f : rndf(0.0f, 650.0f);
+        a.artery_over = (uint8_t)(rnd() & 1u);
+        a.call = (uint8_t)(rnd() % 3u);
+        a.finding = (uint8_t)(1u + rnd() % 2u);
+        a.criteria_met = (uint8_t)(rnd() & 0x1Fu);
+        a.score = (uint8_t)(rnd() % 9u);
+        a.score_max = 8u;
+        sc_can_frame f[SC_ASSESS_FRAMES];
+        assert_int_equal(sc_canproto_encode_assess(&a, tx, f), 0);
+        sc_assess_msg d;
+        memset(&d, 0x55, sizeof d);
+        for (unsigned i = 0; i < SC_ASSESS_FRAMES; i++) {
+            assert_int_equal(f[i].id, 0x210u + i);
+            assert_int_equal(f[i].len, 8);
+            assert_true(e2e_ok(&f[i]));
+            assert_int_equal(sc_canproto_decode_assess_part(&f[i], &d), 0);
+            /* the DBC's scaling, applied by the table-driven decoder */
+            float phys[SC_CANPROTO_MAX_SIGS];
+            sc_msg m;
+            assert_int_equal(sc_canproto_decode_phys(&f[i], &m, phys, SC_CANPROTO_MAX_SIGS), 0);
+            assert_int_equal(m, (sc_msg)(SC_MSG_ASSESS_VESSELS + i));
+            if (i == 2u) {
+                assert_float_equal(phys[7], (float)a.call, 0.0f);       /* TraineeCall */
+                assert_float_equal(phys[8], (float)a.finding, 0.0f);    /* CaseFinding */
+                assert_float_equal(phys[9], (float)a.criteria_met, 0.0f);
+                assert_float_equal(phys[10], (float)a.score, 0.0f);
+                assert_float_equal(phys[11], (float)a.score_max, 0.0f);
+            } else {
+                const float *want = i == 0u ? a.min_ratio : a.force_at_min_n;
+                for (unsigned v = 0; v < SC_ASSESS_VESSELS; v++) {
+                    if (want[v] >= 0.0f) {
+                        const float step = i == 0u ? 0.001f : 0.01f;
+                        assert_float_equal(phys[2u + v], want[v], 0.5f * step + 1e-4f);
+                    } else {
+                        assert_float_equal(phys[2u + v], 65535.0f * (i == 0u ? 0.001f : 0.01f),
+                                           0.01f);
+                    }
+                }
+            }
+        }
+        for (unsigned v = 0; v < SC_ASSESS_VESSELS; v++) {
+            if (a.min_ratio[v] < 0.0f) {
+                assert_true(d.min_ratio[v] < 0.0f);
+            } else {
+                assert_float_equal(d.min_ratio[v], a.min_ratio[v], 0.0006f);
+            }
+            if (a.force_at_min_n[v] < 0.0f) {
+                assert_true(d.force_at_min_n[v] < 0.0f);
+            } else {
+                assert_float_equal(d.force_at_min_n[v], a.force_at_min_n[v], 0.006f);
+            }
+            assert_int_equal(d.coapted[v], a.coapted[v]);
+        }
+        if (a.peak_force_n < 0.0f) {
+            assert_true(d.peak_force_n < 0.0f);
+        } else {
+            assert_float_equal(d.peak_force_n, a.peak_force_n, 0.006f);
+        }
+        assert_int_equal(d.artery_over, a.artery_over);
+        assert_int_equal(d.call, a.call);
+        assert_int_equal(d.finding, a.finding);
+        assert_int_equal(d.criteria_met, a.criteria_met);
+        assert_int_equal(d.score, a.score);
+        assert_int_equal(d.score_max, a.score_max);
+    }
+    /* refused: a call or finding out of range, a non-finite value; another message */
+    sc_assess_msg bad = {.call = 3u};
+    sc_can_frame f[SC_ASSESS_FRAMES];
+    assert_int_equal(sc_canproto_encode_assess(&bad, tx, f), SC_ERR_CAN_SIGNAL);
+    bad = (sc_assess_msg){.peak_force_n = NAN};
+    assert_int_equal(sc_canproto_encode_assess(&bad, tx, f), SC_ERR_NOT_FINITE);
+    const sc_can_frame status = {.id = 0x200, .len = 8};
+    sc_assess_msg d;
+    assert_int_equal(sc_canproto_decode_assess_part(&status, &d), SC_ERR_CAN_ID);
+    /* a ratio above the field is sent as its maximum */
+    sc_assess_msg big = {.min_ratio = {100.0f, 0.5f, 0.5f}, .finding = 1u};
+    assert_int_equal(sc_canproto_encode_assess(&big, tx, f), 0);
+    assert_int_equal(sc_canproto_decode_assess_part(&f[0], &d), 0);
+    assert_float_equal(d.min_ratio[0], 65.534f, 0.001f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(assessment_command_round_trips_and_bad_pairs_are_refused),
+        cmocka_unit_test(assessment_frames_decode_as_the_dbc_says),
         cmocka_unit_test(pose_round_trip_within_half_a_step_classic_and_fd),
         cmocka_unit_test(every_raw_value_of_a_16_bit_signal_survives_phys_and_back),
         cmocka_unit_test(pose_values_outside_the_fields_are_refused),
