@@ -14,7 +14,7 @@ _Static_assert(SC_CMD_MSGS == (unsigned)SC_MSG_CMD_ASSESS + 1u, "commands first"
  * receivers of 64 B and their last payloads (180 B), 2 assembly slots of 56 B, the command
  * FIFO (48 B each), 5 pending commands (72 B each), the last accepted pairs and their times
  * (120 B), the SecOC receiver (256 B), counters (152 B). The sixth command (CmdAssessment)
- * adds a receiver, a payload, a pending command and a pair: 184 B. */
+ * adds a receiver, a payload, a pending command and a pair: 2,480 B in all. */
 _Static_assert(sizeof(sc_tracker) <= 2104u + 48u * SC_CAN_CMD_QUEUE_MAX, "tracker state grew");
 
 sc_tracker_def sc_tracker_default_def(void)

@@ -52,7 +52,8 @@ static void usage(void)
             "       (--iface IFNAME | --log FILE|- [--log-iface IFNAME] [--t0 SECONDS])\n"
             "faults: bad-crc counter-jump repeat silence implausible\n"
             "commands: case=N method=msds|fem reset=tissue|faults|all\n"
-            "          imaging=DEPTH_MM:GAIN_DB:DYN_RANGE_DB:TGC_DB_PER_CM:linear|curvilinear\n");
+            "          imaging=DEPTH_MM:GAIN_DB:DYN_RANGE_DB:TGC_DB_PER_CM:linear|curvilinear\n"
+            "          assess=reset call=normal|dvt (the compression exam's assessment)\n");
 }
 
 /* A whole, finite number (NaN and infinities compare false with every range below). */
@@ -151,6 +152,19 @@ static int parse_command(const char *arg, timed_cmd *out)
                          : strcmp(val, "all") == 0    ? SC_RESET_ALL
                                                       : 0u;
         if (c.reset_target == 0u) {
+            return -1;
+        }
+    } else if (strcmp(buf, "assess") == 0 && strcmp(val, "reset") == 0) {
+        c.kind = SC_CMD_ASSESS;
+        c.assess_action = SC_ASSESS_ACTION_RESET;
+    } else if (strcmp(buf, "call") == 0) {
+        c.kind = SC_CMD_ASSESS;
+        c.assess_action = SC_ASSESS_ACTION_CALL;
+        if (strcmp(val, "normal") == 0) {
+            c.assess_call = SC_ASSESS_CALL_NORMAL;
+        } else if (strcmp(val, "dvt") == 0) {
+            c.assess_call = SC_ASSESS_CALL_DVT;
+        } else {
             return -1;
         }
     } else if (strcmp(buf, "imaging") == 0) {
