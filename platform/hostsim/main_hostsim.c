@@ -6,6 +6,11 @@
  * a scripted probe over the simulated bus (or a candump -l log is replayed). Every received
  * CAN frame can be recorded as a candump -l log; replaying that log reproduces the session's
  * frames bit for bit. Output: scan-converted PNG frames, a per-frame CSV and a summary.
+ * A session bundle (--record-bundle FILE.scb, docs/session-bundle.md) holds the case's
+ * identity, the method and configuration, the received CAN log, the engine's events, every
+ * frame's image hash and the assessment's score in one checksummed file; --replay FILE.scb
+ * replays it with nothing else given, refuses it when its case is missing or different, and
+ * checks every image hash; --list-bundles DIR prints the bundles of a folder as JSON.
  * Virtual time makes the run deterministic; the host CPU time of each frame is measured
  * separately (wall clock around each frame) and reported.
  *
@@ -21,7 +26,10 @@
 #include <sys/stat.h>
 #include <time.h>
 
+#include "sc_bundle.h"
 #include "sc_candump.h"
+#include "sc_cmdsign.h"
+#include <dirent.h>
 #include "sc_engine.h"
 #include "sc_err.h"
 #include "sc_cpu.h"
@@ -60,6 +68,11 @@ typedef struct options {
     int point_set;
     float depth_mm;
     int quiet;
+    const char *bundle_path;  /* --record-bundle */
+    const char *list_dir;     /* --list-bundles */
+    uint8_t call;             /* --call: SC_ASSESS_CALL_*, NONE: no call */
+    double call_t_s;          /* its time; < 0: 0.5 s before the end */
+    int case_set, seconds_set, faults_set;
 } options;
 
 static void usage(FILE *f)
@@ -84,7 +97,13 @@ static void usage(FILE *f)
             "  --rx-cost-us US      virtual time each CAN frame the engine takes costs (default 0)\n"
             "  --seed N             fault injection seed (default 1)\n"
             "  --record FILE        write every frame the engine received as a candump -l log\n"
-            "  --replay FILE        replay a candump -l log instead of the emulator\n"
+            "  --record-bundle FILE write the session as a bundle (case, method, CAN log, events,\n"
+            "                       image hashes, score; docs/session-bundle.md), e.g. x.scb\n"
+            "  --replay FILE        replay a candump -l log instead of the emulator, or a bundle:\n"
+            "                       its case, method and length, every image hash checked\n"
+            "  --list-bundles DIR   print the bundles (*.scb) of DIR as JSON and exit\n"
+            "  --call normal|dvt[@T_S]  the trainee's call (CmdAssessment, signed with the bench\n"
+            "                       key) at T_S (default 0.5 s before the end)\n"
             "  --every N            write every N-th frame as PNG (default 6; 0: none)\n"
             "  --png-size WxH       PNG raster (default 480x640)\n"
             "  --frame-raw FILE     also write the deepest-compression frame as a raw frame file\n"
@@ -134,7 +153,7 @@ static int parse_args(int argc, char **argv, options *o)
     (void)sc_hs_fault_plan_parse("", &o->faults, NULL, 0);
     enum { O_CASE = 256, O_CASES_DIR, O_OUT, O_SCRIPT, O_CSV, O_SECONDS, O_METHOD, O_POINT,
            O_DEPTH, O_FD, O_FAULTS, O_SEED, O_RECORD, O_REPLAY, O_EVERY, O_PNG, O_RAW, O_QUIET,
-           O_HELP, O_VERSION, O_RX_COST };
+           O_HELP, O_VERSION, O_RX_COST, O_BUNDLE, O_LIST, O_CALL };
     static const struct option opts[] = {
         {"case", required_argument, 0, O_CASE},     {"cases-dir", required_argument, 0, O_CASES_DIR},
         {"out", required_argument, 0, O_OUT},       {"script", required_argument, 0, O_SCRIPT},
@@ -147,6 +166,9 @@ static int parse_args(int argc, char **argv, options *o)
         {"frame-raw", required_argument, 0, O_RAW}, {"quiet", no_argument, 0, O_QUIET},
         {"help", no_argument, 0, O_HELP},           {"version", no_argument, 0, O_VERSION},
         {"rx-cost-us", required_argument, 0, O_RX_COST},
+        {"record-bundle", required_argument, 0, O_BUNDLE},
+        {"list-bundles", required_argument, 0, O_LIST},
+        {"call", required_argument, 0, O_CALL},
         {0, 0, 0, 0}};
     int c;
     opterr = 0;
@@ -155,7 +177,7 @@ static int parse_args(int argc, char **argv, options *o)
         uint64_t u;
         double d;
         switch (c) {
-        case O_CASE: o->case_name = optarg; break;
+        case O_CASE: o->case_name = optarg; o->case_set = 1; break;
         case O_CASES_DIR: o->cases_dir = optarg; break;
         case O_OUT: o->out_dir = optarg; break;
         case O_SCRIPT: o->script = optarg; break;
@@ -165,6 +187,7 @@ static int parse_args(int argc, char **argv, options *o)
                 fprintf(stderr, "sc-hostsim: --seconds wants 0.01..3600, got '%s'\n", optarg);
                 return 2;
             }
+            o->seconds_set = 1;
             break;
         case O_METHOD:
             if (strcmp(optarg, "msds") == 0) {
@@ -198,6 +221,7 @@ static int parse_args(int argc, char **argv, options *o)
                 fprintf(stderr, "sc-hostsim: --faults '%s': %s\n", optarg, why);
                 return 2;
             }
+            o->faults_set = 1;
             break;
         }
         case O_RX_COST:
@@ -230,6 +254,34 @@ static int parse_args(int argc, char **argv, options *o)
             }
             break;
         case O_RAW: o->frame_raw_path = optarg; break;
+        case O_BUNDLE: o->bundle_path = optarg; break;
+        case O_LIST: o->list_dir = optarg; break;
+        case O_CALL: {
+            char buf[64];
+            if (strlen(optarg) >= sizeof buf) {
+                fprintf(stderr, "sc-hostsim: --call wants normal|dvt[@T_S], got '%s'\n", optarg);
+                return 2;
+            }
+            strcpy(buf, optarg);
+            char *at = strchr(buf, '@');
+            o->call_t_s = -1.0;
+            if (at) {
+                *at = '\0';
+                if (parse_double(at + 1, 0.0, 3600.0, &o->call_t_s)) {
+                    fprintf(stderr, "sc-hostsim: --call time wants 0..3600 s, got '%s'\n", at + 1);
+                    return 2;
+                }
+            }
+            if (strcmp(buf, "normal") == 0) {
+                o->call = SC_ASSESS_CALL_NORMAL;
+            } else if (strcmp(buf, "dvt") == 0) {
+                o->call = SC_ASSESS_CALL_DVT;
+            } else {
+                fprintf(stderr, "sc-hostsim: --call wants normal|dvt[@T_S], got '%s'\n", optarg);
+                return 2;
+            }
+            break;
+        }
         case O_QUIET: o->quiet = 1; break;
         case O_HELP: usage(stdout); return -1;
         case O_VERSION: printf("sc-hostsim %s\n", SC_HOSTSIM_VERSION); return -1;
@@ -243,9 +295,23 @@ static int parse_args(int argc, char **argv, options *o)
         fprintf(stderr, "sc-hostsim: unexpected argument '%s'\n", argv[optind]);
         return 2;
     }
-    if (o->replay_path && (o->csv_path || o->record_path)) {
-        fprintf(stderr, "sc-hostsim: --replay cannot be combined with --csv or --record\n");
+    if (o->replay_path && (o->csv_path || o->record_path || o->bundle_path || o->call)) {
+        fprintf(stderr, "sc-hostsim: --replay cannot be combined with --csv, --record, "
+                        "--record-bundle or --call\n");
         return 2;
+    }
+    if (o->bundle_path) {
+        /* a bundle holds what the engine received; a bus-off or a display link down acts
+         * outside the received frames and would not replay: refuse rather than record a
+         * session that cannot be reproduced */
+        for (uint32_t i = 0; i < o->faults.n; i++) {
+            if (o->faults.ep[i].kind == SC_HS_EP_BUS_OFF ||
+                o->faults.ep[i].kind == SC_HS_EP_LINK_DOWN) {
+                fprintf(stderr, "sc-hostsim: --record-bundle cannot record busoff or linkdown "
+                                "episodes (they act outside the received CAN frames)\n");
+                return 2;
+            }
+        }
     }
     return 0;
 }
@@ -256,6 +322,7 @@ typedef struct recorder {
     FILE *fp;
     uint64_t frames;
     uint64_t errors;
+    sc_bundle_writer *bundle; /* also into the bundle (NULL: no bundle) */
 } recorder;
 
 static void record_frame(void *user, const sc_can_frame *f)
@@ -263,6 +330,12 @@ static void record_frame(void *user, const sc_can_frame *f)
     recorder *r = user;
     sc_candump_rec rec = {.ts_us = f->ts_ns / 1000u, .frame = *f};
     strcpy(rec.iface, "hs0");
+    if (r->bundle != NULL) {
+        sc_bundle_add_can(r->bundle, &rec);
+    }
+    if (r->fp == NULL) {
+        return;
+    }
     char line[SC_CANDUMP_LINE_MAX + 2];
     int n = sc_candump_format(&rec, line, sizeof(line));
     if (n < 0 || fputs(line, r->fp) == EOF) {
@@ -270,6 +343,125 @@ static void record_frame(void *user, const sc_can_frame *f)
         return;
     }
     r->frames++;
+}
+
+/* ---- bundles ------------------------------------------------------------------------------ */
+
+#define BUNDLE_MAX_BYTES ((size_t)1 << 30)
+
+/* JSON string body: quotes, backslashes and control bytes escaped. */
+static void json_str(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; *s; s++) {
+        const unsigned char ch = (unsigned char)*s;
+        if (ch == '"' || ch == '\\') {
+            fprintf(f, "\\%c", ch);
+        } else if (ch < 0x20u || ch > 0x7Eu) {
+            fprintf(f, "\\u%04x", ch);
+        } else {
+            fputc(ch, f);
+        }
+    }
+    fputc('"', f);
+}
+
+static int name_cmp(const void *a, const void *b)
+{
+    return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+/* The replayed bundle's bytes, freed at exit (every return path of main). */
+static uint8_t *g_bundle_buf;
+static void free_bundle_buf(void)
+{
+    free(g_bundle_buf);
+    g_bundle_buf = NULL;
+}
+
+/* --list-bundles DIR: every *.scb as a JSON object, refused ones with their reason; sorted by
+ * file name. 0, or 1 when DIR cannot be read. */
+static int list_bundles(const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (d == NULL) {
+        fprintf(stderr, "sc-hostsim: cannot read %s: %s\n", dir, strerror(errno));
+        return 1;
+    }
+    static char *names[4096];
+    size_t n = 0;
+    const struct dirent *de;
+    while ((de = readdir(d)) != NULL && n < sizeof names / sizeof names[0]) {
+        const size_t l = strlen(de->d_name);
+        if (l > 4u && strcmp(de->d_name + l - 4u, ".scb") == 0) {
+            names[n] = strdup(de->d_name);
+            if (names[n] != NULL) {
+                n++;
+            }
+        }
+    }
+    closedir(d);
+    qsort(names, n, sizeof names[0], name_cmp);
+    uint32_t refused = 0;
+    printf("{\"dir\": ");
+    json_str(stdout, dir);
+    printf(", \"bundles\": [");
+    for (size_t i = 0; i < n; i++) {
+        char path[4096];
+        snprintf(path, sizeof path, "%s/%s", dir, names[i]);
+        printf("%s\n  {\"file\": ", i ? "," : "");
+        json_str(stdout, names[i]);
+        uint8_t *buf;
+        size_t len;
+        sc_bundle_info info;
+        sc_bundle_reject why = SC_BDL_OK;
+        uint64_t line = 0;
+        int rc = sc_bundle_read_file(path, BUNDLE_MAX_BYTES, &buf, &len);
+        if (rc == SC_OK) {
+            rc = sc_bundle_parse(buf, len, &info, &why, &line);
+            free(buf);
+        }
+        if (rc != SC_OK) {
+            refused++;
+            printf(", \"error\": ");
+            json_str(stdout, why != SC_BDL_OK ? sc_bundle_reject_name(why) : sc_err_str(rc));
+            printf(", \"line\": %" PRIu64 "}", line);
+        } else {
+            const sc_bundle_meta *m = &info.meta;
+            printf(", \"case\": ");
+            json_str(stdout, m->case_name);
+            printf(", \"case_id\": \"0x%08x\", \"method\": \"%s\", \"date\": ", m->case_id,
+                   m->method ? "fem" : "msds");
+            json_str(stdout, m->date);
+            printf(", \"source\": ");
+            json_str(stdout, m->source);
+            printf(", \"frames\": %" PRIu64 ", \"rate_hz\": %u, \"seconds\": %.3f, "
+                   "\"can_frames\": %" PRIu64 ", \"events\": %" PRIu64 ", \"score\": %u, "
+                   "\"score_max\": %u, \"criteria_met\": %u, \"call\": \"%s\", "
+                   "\"finding\": \"%s\"}",
+                   m->frames, m->rate_hz, (double)m->frames / (double)m->rate_hz, info.can_count,
+                   info.ev_count, m->score, m->score_max, m->criteria, sc_bundle_call_name(m->call),
+                   sc_bundle_call_name(m->finding));
+        }
+        free(names[i]);
+    }
+    printf("%s], \"count\": %zu, \"refused\": %u}\n", n ? "\n" : "", n, refused);
+    return 0;
+}
+
+/* The engine's log records since the last call, into the bundle (the hostsim log's ring keeps
+ * the last SC_HS_LOG_RING; more in one frame are counted as lost). */
+static void bundle_events(sc_bundle_writer *w, const sc_hs_log *log, uint64_t *seen,
+                          uint64_t frame, uint64_t *lost)
+{
+    if (log->total - *seen > SC_HS_LOG_RING) {
+        *lost += log->total - *seen - SC_HS_LOG_RING;
+        *seen = log->total - SC_HS_LOG_RING;
+    }
+    for (; *seen < log->total; (*seen)++) {
+        const sc_hs_log_record *r = &log->ring[*seen % SC_HS_LOG_RING];
+        sc_bundle_add_event(w, frame, r->event, r->err, r->a, r->b);
+    }
 }
 
 /* ---- output ------------------------------------------------------------------------------- */
@@ -391,6 +583,58 @@ int main(int argc, char **argv)
     if (rc) {
         return rc < 0 ? 0 : rc;
     }
+    if (o.list_dir) {
+        return list_bundles(o.list_dir);
+    }
+    /* a bundle to replay: it names the case, the method and the length */
+    static sc_bundle_info binfo;
+    uint8_t *bbuf = NULL;
+    atexit(free_bundle_buf);
+    size_t blen = 0;
+    int bundle_replay = 0;
+    char bundle_case[SC_BUNDLE_TEXT_MAX + 8];
+    if (o.replay_path) {
+        rc = sc_bundle_read_file(o.replay_path, BUNDLE_MAX_BYTES, &bbuf, &blen);
+        g_bundle_buf = bbuf;
+        if (rc != SC_OK) {
+            fprintf(stderr, "sc-hostsim: cannot read %s: %s\n", o.replay_path, sc_err_str(rc));
+            return 1;
+        }
+        bundle_replay = sc_bundle_is_bundle(bbuf, blen);
+        if (!bundle_replay) {
+            free(bbuf);
+            bbuf = NULL;
+            g_bundle_buf = NULL;
+        } else {
+            sc_bundle_reject why;
+            uint64_t line;
+            if (sc_bundle_parse(bbuf, blen, &binfo, &why, &line) != SC_OK) {
+                fprintf(stderr, "sc-hostsim: %s: bundle refused: %s (line %" PRIu64 ")\n",
+                        o.replay_path, sc_bundle_reject_name(why), line);
+                return 1;
+            }
+            const sc_bundle_meta *m = &binfo.meta;
+            char want[1100];
+            snprintf(want, sizeof want, "%s%s", o.case_name,
+                     strstr(o.case_name, ".scase") ? "" : ".scase");
+            if (o.case_set && strcmp(want, m->case_name) != 0) {
+                fprintf(stderr, "sc-hostsim: %s was recorded on case '%s'; --case '%s' is "
+                                "another case: refused\n", o.replay_path, m->case_name,
+                        o.case_name);
+                return 1;
+            }
+            if ((o.method >= 0 && o.method != (int)m->method) || o.seconds_set || o.faults_set ||
+                o.point_set) {
+                fprintf(stderr, "sc-hostsim: a bundle sets the method, the length and the "
+                                "probe; --method, --seconds, --faults and --point do not apply\n");
+                return 2;
+            }
+            snprintf(bundle_case, sizeof bundle_case, "%s", m->case_name);
+            o.case_name = bundle_case;
+            o.method = (int)m->method;
+            o.rx_cost_ns = (uint64_t)m->rx_cost_us * 1000u;
+        }
+    }
     if (mkdir_p(o.out_dir) != 0) {
         fprintf(stderr, "sc-hostsim: cannot create %s: %s\n", o.out_dir, strerror(errno));
         return 1;
@@ -433,7 +677,18 @@ int main(int argc, char **argv)
     } else {
         snprintf(case_name, sizeof(case_name), "%s.scase", o.case_name);
     }
+    if (bundle_replay && binfo.meta.rate_hz != def.sched.rate_hz) {
+        fprintf(stderr, "sc-hostsim: %s was recorded at %u Hz, this engine runs at %u Hz: "
+                        "refused\n", o.replay_path, binfo.meta.rate_hz, def.sched.rate_hz);
+        return 1;
+    }
     rc = sc_engine_load_case(&rig.engine, case_name);
+    if (rc != SC_OK && bundle_replay) {
+        fprintf(stderr, "sc-hostsim: %s: the bundle's case '%s' %s in %s (%s): refused\n",
+                o.replay_path, case_name, rc == SC_ERR_NOT_FOUND ? "is not" : "cannot be loaded",
+                o.cases_dir, sc_err_str(rc));
+        return 1;
+    }
     if (rc != SC_OK) {
         fprintf(stderr, "sc-hostsim: case '%s' refused: %s (%s)%s\n", case_name,
                 sc_err_name(rc), sc_err_str(rc),
@@ -442,6 +697,12 @@ int main(int argc, char **argv)
         return 1;
     }
     const sc_case *cs = sc_engine_get_case(&rig.engine);
+    if (bundle_replay && cs->case_id != binfo.meta.case_id) {
+        fprintf(stderr, "sc-hostsim: %s: case '%s' in %s is not the bundle's: its content id is "
+                        "0x%08x, the bundle's 0x%08x: refused\n",
+                o.replay_path, case_name, o.cases_dir, cs->case_id, binfo.meta.case_id);
+        return 1;
+    }
 
     /* probe: emulator script or replay */
     FILE *replay = NULL;
@@ -449,7 +710,10 @@ int main(int argc, char **argv)
     sc_candump_rec pending;
     int have_pending = 0;
     recorder rec = {0};
-    if (o.replay_path) {
+    size_t bpos = binfo.can_off;
+    if (bundle_replay) {
+        /* the bundle's CAN records, fed below */
+    } else if (o.replay_path) {
         replay = sc_fopen_regular(o.replay_path);
         if (!replay) {
             fprintf(stderr, "sc-hostsim: cannot open %s: %s\n", o.replay_path, strerror(errno));
@@ -514,6 +778,26 @@ int main(int argc, char **argv)
             rig.tap.user = &rec;
         }
     }
+    static sc_bundle_writer bw;
+    if (o.bundle_path) {
+        if (sc_bundle_writer_open(&bw) != SC_OK) {
+            fprintf(stderr, "sc-hostsim: no temporary file for the bundle\n");
+            return 1;
+        }
+        rec.bundle = &bw;
+        rig.tap.fn = record_frame;
+        rig.tap.user = &rec;
+    }
+    static sc_cmdsign signer;
+    int call_pending = 0;
+    if (o.call) {
+        if (sc_cmdsign_init(&signer, sc_secoc_bench_key, 0u, 1000u, 0) != SC_OK) {
+            return 1;
+        }
+        call_pending = 1;
+    }
+    uint64_t log_seen = rig.log.total, events_lost = 0, hash_mismatches = 0;
+    uint32_t first_mismatch = 0;
 
     char path[4096];
     snprintf(path, sizeof(path), "%s/frames.csv", o.out_dir);
@@ -545,12 +829,40 @@ int main(int argc, char **argv)
         fprintf(stderr, "sc-hostsim: no bus node left for the flood\n");
         return 1;
     }
-    const uint32_t frames = (uint32_t)ceil(o.seconds * 1e9 / (double)period);
+    const uint32_t frames = bundle_replay ? (uint32_t)binfo.meta.frames
+                                          : (uint32_t)ceil(o.seconds * 1e9 / (double)period);
+    if (bundle_replay) {
+        o.seconds = (double)frames * (double)period * 1e-9;
+    }
+    const uint64_t call_ns =
+        o.call_t_s >= 0.0 ? (uint64_t)llround(o.call_t_s * 1e9)
+                          : (uint64_t)llround(fmax(0.0, o.seconds - 0.5) * 1e9);
     for (uint32_t i = 0; i < frames; i++) {
         /* release time of the frame about to run */
         const uint64_t release = sc_engine_next_release_ns(&rig.engine);
         sc_hs_fault_run_before(&faults, release);
-        if (replay) {
+        if (bundle_replay) {
+            const char *line;
+            size_t len;
+            for (;;) {
+                if (!have_pending) {
+                    size_t p2 = bpos;
+                    sc_candump_reject why;
+                    if (!sc_bundle_next_line(bbuf, binfo.can_off + binfo.can_len, &p2, &line,
+                                             &len) ||
+                        sc_candump_parse_line(line, len, &pending, &why) != SC_OK) {
+                        break;
+                    }
+                    bpos = p2;
+                    have_pending = 1;
+                }
+                if (pending.ts_us * 1000u > release) {
+                    break;
+                }
+                (void)sc_hs_can_inject(&rig.bus, rig.engine_node, &pending.frame);
+                have_pending = 0;
+            }
+        } else if (replay) {
             for (;;) {
                 if (!have_pending) {
                     int r = sc_candump_reader_next(&reader, &pending);
@@ -568,6 +880,20 @@ int main(int argc, char **argv)
         } else {
             /* every sample due before this frame, from the tracker node */
             (void)sc_emu_feed(&emu, release - t0, send_peer, &rig.peer);
+            if (call_pending && release - t0 >= call_ns) {
+                /* the trainee's call: a freshness sync, then CmdAssessment, each signed */
+                const sc_cmd c = {.kind = SC_CMD_ASSESS, .assess_action = SC_ASSESS_ACTION_CALL,
+                                  .assess_call = o.call};
+                sc_can_frame cf[4];
+                rc = sc_cmdsign_sync(&signer, &cf[0]);
+                if (rc == SC_OK) {
+                    rc = sc_cmdsign_command(&signer, &c, &cf[2]);
+                }
+                for (int k = 0; k < 4 && rc == SC_OK; k++) {
+                    (void)send_peer(&rig.peer, &cf[k]);
+                }
+                call_pending = 0;
+            }
         }
         const double w0 = mono_s();
         sc_engine_step(&rig.engine, NULL);
@@ -579,6 +905,26 @@ int main(int argc, char **argv)
         const uint64_t h = rig.display.hash_count
                                ? rig.display.hashes[rig.display.hash_count - 1u]
                                : 0u;
+        if (o.bundle_path) {
+            bundle_events(&bw, &rig.log, &log_seen, i, &events_lost);
+            sc_bundle_add_hash(&bw, i, h);
+        }
+        if (bundle_replay) {
+            const char *line;
+            size_t len;
+            size_t hp = binfo.hash_off;
+            static size_t hash_pos;
+            if (i == 0u) {
+                hash_pos = hp;
+            }
+            if (sc_bundle_next_line(bbuf, binfo.hash_off + binfo.hash_len, &hash_pos, &line,
+                                    &len) &&
+                sc_bundle_hash_of_line(line, len) != h) {
+                if (hash_mismatches++ == 0u) {
+                    first_mismatch = i;
+                }
+            }
+        }
         fprintf(csv, "%u,%.4f,%u,%u,%.4f,%.4f,%s,0x%04x,%016" PRIx64 "\n", i,
                 (double)(rig.clock.now_ns - t0) * 1e-9, st.probe_tracked, st.probe_contact,
                 (double)st.vein_area_ratio, (double)st.artery_area_ratio,
@@ -624,6 +970,49 @@ int main(int argc, char **argv)
     fclose(csv);
     if (rec.fp) {
         fclose(rec.fp);
+    }
+    const sc_assess_report *ar = sc_engine_assessment(&rig.engine);
+    int bundle_rc = SC_OK;
+    if (o.bundle_path) {
+        sc_bundle_meta m;
+        memset(&m, 0, sizeof m);
+        const char *base = strrchr(case_name, '/') ? strrchr(case_name, '/') + 1 : case_name;
+        if (strlen(base) >= sizeof m.case_name) {
+            base = ""; /* refused by the writer below: a bundle names its case in 127 bytes */
+        }
+        memcpy(m.case_name, base, strlen(base) + 1u);
+        m.case_id = cs->case_id;
+        m.method = (uint8_t)(sc_engine_get_tissue(&rig.engine) != NULL &&
+                             rig.engine.def.tissue.method == SC_TISSUE_FEM);
+        m.rate_hz = def.sched.rate_hz;
+        m.frames = frames;
+        m.rx_cost_us = (uint32_t)(o.rx_cost_ns / 1000u);
+        const char *src = o.csv_path ? o.csv_path : o.script;
+        snprintf(m.source, sizeof m.source, "%s%s", o.csv_path ? "csv:" : "script:", src);
+        for (char *q = m.source; *q; q++) {
+            *q = (*q == ' ' || (unsigned char)*q < 0x20u || (unsigned char)*q > 0x7Eu) ? '_' : *q;
+        }
+        const time_t now = time(NULL);
+        struct tm tmv;
+        if (gmtime_r(&now, &tmv) == NULL ||
+            strftime(m.date, sizeof m.date, "%Y-%m-%dT%H:%M:%SZ", &tmv) == 0u) {
+            snprintf(m.date, sizeof m.date, "unknown");
+        }
+        m.score = ar->score;
+        m.score_max = ar->score_max;
+        m.criteria = ar->criteria_met;
+        m.call = ar->call;
+        m.finding = ar->finding;
+        for (int v = 0; v < 3; v++) {
+            m.min_ratio[v] = ar->vessel[v].min_ratio;
+        }
+        m.peak_force_n = ar->peak_force_n;
+        bundle_rc = sc_bundle_writer_finish(&bw, &m, o.bundle_path);
+        sc_bundle_writer_close(&bw);
+        if (bundle_rc != SC_OK) {
+            fprintf(stderr, "sc-hostsim: cannot write the bundle %s: %s\n", o.bundle_path,
+                    sc_err_str(bundle_rc));
+        }
     }
     if (replay) {
         fclose(replay);
@@ -743,11 +1132,32 @@ int main(int argc, char **argv)
         if (rec.fp) {
             fprintf(f, "recorded        %" PRIu64 " frames to %s\n", rec.frames, o.record_path);
         }
+        fprintf(f, "assessment      score %u/%u (criteria 0x%02x), call %s, finding %s, vein "
+                   "min %.3f%s, peak force %.2f N\n",
+                ar->score, ar->score_max, ar->criteria_met, sc_bundle_call_name(ar->call),
+                sc_bundle_call_name(ar->finding), (double)ar->vessel[SC_ASSESS_VEIN].min_ratio,
+                ar->vessel[SC_ASSESS_VEIN].coapted ? " (coapted)" : "",
+                (double)ar->peak_force_n);
+        if (o.bundle_path && bundle_rc == SC_OK) {
+            fprintf(f, "bundle          %s: %u frames, %" PRIu64 " CAN records, %" PRIu64
+                       " events (%" PRIu64 " lost)\n",
+                    o.bundle_path, frames, bw.n_can, bw.n_ev, events_lost);
+        }
+        if (bundle_replay) {
+            fprintf(f, "bundle replay   %u frames: %s", frames,
+                    hash_mismatches ? "IMAGE HASHES DIFFER" : "every image hash identical");
+            if (hash_mismatches) {
+                fprintf(f, " (%" PRIu64 " frames, the first at frame %u)", hash_mismatches,
+                        first_mismatch);
+            }
+            fprintf(f, "; recorded score %u/%u, replayed %u/%u\n", binfo.meta.score,
+                    binfo.meta.score_max, ar->score, ar->score_max);
+        }
     }
     if (sf) {
         fclose(sf);
     }
     sc_scanconv_free(&conv);
     free(raster);
-    return (png_errors || rec.errors) ? 1 : 0;
+    return (png_errors || rec.errors || bundle_rc != SC_OK || hash_mismatches) ? 1 : 0;
 }
