@@ -26,7 +26,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         SC_FUZZ_CHECK(!o.point_set || (isfinite(o.point_mm[0]) && isfinite(o.point_mm[1]) &&
                                        isfinite(o.point_mm[2])));
         SC_FUZZ_CHECK(o.case_name && o.cases_dir && o.out_dir && o.script);
-        SC_FUZZ_CHECK(!(o.replay_path && (o.csv_path || o.record_path)));
+        SC_FUZZ_CHECK(!(o.replay_path && (o.csv_path || o.record_path || o.bundle_path ||
+                                          o.call)));
+        SC_FUZZ_CHECK(o.call <= SC_ASSESS_CALL_DVT);
+        SC_FUZZ_CHECK(!o.call || o.call_t_s < 0.0 || o.call_t_s <= 3600.0);
     }
     sc_fuzz_argv_free(&av);
     return 0;
