@@ -902,9 +902,13 @@ int main(int argc, char **argv)
 
         sc_engine_status st;
         sc_engine_get_status(&rig.engine, &st);
-        const uint64_t h = rig.display.hash_count
-                               ? rig.display.hashes[rig.display.hash_count - 1u]
-                               : 0u;
+        /* the hash of the last complete frame, computed here: the recorder's history of
+         * hashes ends after SC_HS_DISPLAY_HISTORY frames, a session may run longer */
+        const uint64_t h =
+            rig.display.frames_complete
+                ? sc_hs_hash64(rig.display.last, (uint64_t)rig.display.last_info.lines *
+                                                     rig.display.last_info.samples, 0)
+                : 0u;
         if (o.bundle_path) {
             bundle_events(&bw, &rig.log, &log_seen, i, &events_lost);
             sc_bundle_add_hash(&bw, i, h);
