@@ -29,8 +29,11 @@
  *   imaging  sc_tissue_out -> sc_image_out (scan lines to the display, the compression
  *            measure). O(lines x samples) plus the tets each line crosses (sc_bscan.h); every
  *            line leaves through the display HAL as soon as it is computed, the frame's
- *            compression measure closes the display frame (hal/sc_hal_display.h).
- *   status   sc_image_out -> CAN status frames every status_period_ms (3 frames). O(1).
+ *            compression measure closes the display frame (hal/sc_hal_display.h). Then the
+ *            exam's assessment takes the frame (sc_assess.h: O(1), and the probe's force,
+ *            O(contacts), sc_tissue_probe_force_n).
+ *   status   sc_image_out -> CAN status frames every status_period_ms: the four status
+ *            frames and the three assessment frames (0x210..0x212). O(1).
  *   control  between this frame and the next, in the frame's slack: the queued commands
  *            (O(SC_CAN_CMD_QUEUE_MAX)), then at most one slice of a pending case switch:
  *              open      the storage mapping, the file's framing (O(sections));
