@@ -276,7 +276,7 @@ sc_engine_def sc_engine_default_def(void);
  * SC_FAULT_NO_CASE) until a switch completes. O(1) plus the subsystems' inits (no tissue
  * build). Never allocates. Errors: SC_ERR_INVALID_ARG (NULL, a mandatory HAL op missing, case
  * catalogue too long or with a NULL or too long name), SC_ERR_RANGE (rate, periods, slice
- * budget), errors of sc_tracker_def_validate and sc_bscan_init. */
+ * budget), errors of sc_tracker_def_validate, sc_bscan_init and sc_assess_def_validate. */
 int sc_engine_init(sc_engine *e, const sc_engine_def *def, const sc_hal *hal);
 
 /* Switch to case `name` now, outside the frame loop (start-up): every slice of the control
