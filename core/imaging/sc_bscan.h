@@ -24,9 +24,19 @@
  *   through a boundary triangle (found among the boundary triangles cut by the image plane) and
  *   walks from tet to face neighbour, the exit parameter of each tet coming from its
  *   barycentric coordinates along the ray; inside a tet the rest position is affine in the
- *   sample index. A line the walker cannot trust (an inverted or flat tet on its way, a folded
- *   boundary, a start inside the mesh) is redone by the region path, which is point location
- *   and needs no orientation.
+ *   sample index. Where the deformed mesh folds (a tet on the way is inverted or flat, as
+ *   under a firm press where a vein's walls meet, or the line starts inside the mesh), the
+ *   walker locates the next sample among the tets cut by the plane (the region path's bins)
+ *   and walks on from the tet found; samples covered by inverted tets only take the deepest
+ *   of those. A line the walker still cannot trust (a walk over SC_BSCAN_MAX_WALK_STEPS, a
+ *   degenerate exit) is redone by the region path.
+ *
+ * Folds: a point of a folded mesh lies in more than one tet (the fold's layers). All three
+ * mappers prefer a positively oriented tet (tissue that is there) to an inverted one (a
+ * layer turned inside out); among several the oracle takes the one that holds the point
+ * deepest (largest smallest barycentric coordinate), the walker stays on the layer it walks,
+ * the region path takes the first it finds: inside a fold they may differ, elsewhere they agree
+ * up to ties on faces.
  *
  * The compression measure comes from the same pass: for each label, the image area whose rest
  * position has that label now, against the area with that label in the rigid (undeformed) slice
@@ -100,8 +110,10 @@ typedef struct sc_bscan_status {
     /* cumulative counters of degraded work (each stays exact or falls back, see .c) */
     uint32_t walk_aborts;      /* a line exceeded SC_BSCAN_MAX_WALK_STEPS */
     uint32_t event_overflows;  /* a line crossed the boundary > SC_BSCAN_MAX_LINE_EVENTS */
-    uint32_t line_fallbacks;   /* lines the walker handed to the region path (inverted or
-                                  flat tets, folded boundary, line start inside the mesh) */
+    uint32_t line_fallbacks;   /* lines the walker handed to the region path (a walk over its
+                                  step limit, a degenerate exit) */
+    uint32_t walk_relocations; /* folds the walker crossed by locating (inverted or flat tets,
+                                  a line start inside the mesh) */
     uint32_t region_overflows; /* region path over its limits (walker result kept) */
     uint32_t display_errors;   /* display calls that returned an error */
 } sc_bscan_status;
@@ -127,6 +139,8 @@ typedef struct sc_bscan_ptet {
     float lam[4][3];  /* lambda_i = lam[i][0] + lam[i][1] x + lam[i][2] z */
     float rest[3][3]; /* rest coordinate d = rest[d][0] + rest[d][1] x + rest[d][2] z */
     float xmin, xmax, zmin, zmax;
+    uint32_t tet;   /* mesh tet */
+    int32_t orient; /* 1 positively oriented, -1 inverted (a fold of the deformed mesh) */
 } sc_bscan_ptet;
 
 /* Samples [k0, k1) of a line inside the mesh; rest position in voxel units is a + k b. */

@@ -524,6 +524,10 @@ int sc_phantom_generate(const sc_phantom_def *pd, sc_phantom *out)
     d->volume.origin_mm[2] = PH_Z0;
     d->volume.voxels = vox;
     d->volume.labels = labels;
+    /* usable imaging depth: the data's depth below the skin (z = 0) less 6 mm (a press of the
+     * host simulator's scripts, 8 mm, then still ends 2 mm inside), whole mm; the engine's
+     * default imaging depth on this case never exceeds it */
+    d->usable_depth_mm = floorf(PH_Z0 + (float)(dim[2] - 1u) * sp - 6.0f);
     static const sc_case_material mats[] = {
 #define PH_MAT_(label, e, nu, rho) {(e), (nu), (rho)},
         SC_MATERIAL_LIST(PH_MAT_)
