@@ -45,6 +45,7 @@ sc_bscan_def sc_bscan_default_def(void)
     }
     d.dynamic_range_db = 60.0f;
     d.volume_range_db = 60.0f;
+    d.focus_mm = 20.0f; /* a 7.5 MHz linear probe's usual transmit focus */
     d.rest_margin_mm = 60.0f; /* the range's top: deeper than any mesh box the limits allow
                                  a press into (the appliance's 64x32x32 boxes are 30-45 mm) */
     d.acoustics = 0u;
@@ -60,7 +61,7 @@ static int db_ok(float v, float lo, float hi)
 static int check_def(const sc_bscan_def *d)
 {
     if (!isfinite(d->gain_db) || !isfinite(d->dynamic_range_db) || !isfinite(d->volume_range_db) ||
-        !isfinite(d->rest_margin_mm)) {
+        !isfinite(d->rest_margin_mm) || !isfinite(d->focus_mm)) {
         return SC_ERR_NOT_FINITE;
     }
     for (uint32_t i = 0; i < SC_BSCAN_TGC_BANDS; i++) {
@@ -74,7 +75,8 @@ static int check_def(const sc_bscan_def *d)
     if (d->mapper >= (uint32_t)SC_BSCAN_MAP_COUNT || d->regions_n < 1u ||
         d->regions_n > SC_BSCAN_MAX_REGIONS || !db_ok(d->gain_db, -60.0f, 60.0f) ||
         !db_ok(d->dynamic_range_db, 10.0f, 120.0f) || !db_ok(d->volume_range_db, 10.0f, 120.0f) ||
-        !db_ok(d->rest_margin_mm, 0.0f, 60.0f) || d->acoustics > 1u) {
+        !db_ok(d->rest_margin_mm, 0.0f, 60.0f) || d->acoustics > 1u || !(d->focus_mm > 0.0f) ||
+        d->focus_mm > 300.0f) {
         return SC_ERR_RANGE;
     }
     return SC_OK;
@@ -1436,7 +1438,7 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
     st->plane_tets = 0u;
     st->walk_steps = 0u;
 
-    const sc_display_frame_info info = {
+    sc_display_frame_info info = {
         .frame_no = frame_no,
         .lines = (uint16_t)lines,
         .samples = (uint16_t)n,
@@ -1446,7 +1448,14 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
         .width_mm = sd->kind == SC_SCAN_GEOM_LINEAR ? sd->width_mm : sd->sector_deg,
         /* the sinks draw the fan from the probe face's arc, radius_mm in front of the apex */
         .radius_mm = sd->kind == SC_SCAN_GEOM_LINEAR ? 0.0f : sd->radius_mm,
+        .gain_db = b->def.gain_db,
+        .dynamic_range_db = b->def.dynamic_range_db,
+        .focus_mm = b->def.focus_mm,
+        .frequency_mhz = b->def.acoustic.frequency_mhz,
     };
+    for (uint32_t i = 0; i < SC_BSCAN_TGC_BANDS; i++) {
+        info.tgc_db[i] = b->def.tgc_db[i];
+    }
     int rc = sc_display_frame_begin(display, &info);
     if (rc != SC_OK) {
         st->display_errors++;

@@ -66,6 +66,8 @@
 #include "sc_scan_geom.h"
 #include "sc_volume.h"
 
+_Static_assert(SC_BSCAN_TGC_BANDS == SC_DISPLAY_TGC_BANDS, "the frame record carries every band");
+
 enum {
     SC_BSCAN_MAP_WALK = 0,
     SC_BSCAN_MAP_REGIONS = 1,
@@ -86,6 +88,8 @@ typedef struct sc_bscan_def {
     float tgc_db[SC_BSCAN_TGC_BANDS]; /* per depth band, shallow first, [-60, 60] */
     float dynamic_range_db;           /* displayed range, [10, 120] */
     float volume_range_db;            /* range the volume's 0..255 stands for, [10, 120] */
+    float focus_mm;            /* transmit focus below the probe face, (0, 300]: the display's
+                                  focus marker (and the beam's narrowest point) */
     float rest_margin_mm;      /* the compression measure's rest reference extends this far above
                                   the probe face (tissue pushed into view), [0, 60] */
     uint32_t acoustics;        /* 1: beam-dependent acoustics along each line (sc_acoustics.h);

@@ -38,6 +38,7 @@
 #include "sc_dlink.h"
 #include "sc_err.h"
 #include "sc_png_write.h"
+#include "sc_scan_overlay.h"
 #include "sc_scanconv.h"
 #include "vw_gif.h"
 #include "vw_overlay.h"
@@ -285,6 +286,10 @@ static void render_frame(vw_render *r, const sc_dlink_done *d, double fps, uint6
         d->frame.frame_no, d->frame.line_count, d->frame.samples,  d->frame.geometry_id,
         d->frame.flags,    d->begin.depth_mm,   d->begin.width_mm, d->begin.radius_mm};
     sc_scanconv_render(&r->conv, &info, d->image, SC_MAX_SCAN_SAMPLES, r->grey);
+    /* the scanner's display items below the viewer's own band (sc_scan_overlay.h: depth
+     * scale, orientation, probe type; what the link does not carry is left out) */
+    const int band_px = (r->w >= 400u ? 2 : 1) * 9 * 2 + 4;
+    sc_overlay_draw_below(r->grey, r->w, r->h, &info, band_px);
     const size_t n = (size_t)r->w * r->h;
     for (size_t i = 0; i < n; i++) {
         r->index[i] = vw_grey_index(r->grey[i]);
