@@ -282,9 +282,23 @@ static void render_free(vw_render *r)
 
 static void render_frame(vw_render *r, const sc_dlink_done *d, double fps, uint64_t lost_total)
 {
-    const sc_display_frame_info info = {
-        d->frame.frame_no, d->frame.line_count, d->frame.samples,  d->frame.geometry_id,
-        d->frame.flags,    d->begin.depth_mm,   d->begin.width_mm, d->begin.radius_mm};
+    sc_display_frame_info info = {.frame_no = d->frame.frame_no,
+                                  .lines = d->frame.line_count,
+                                  .samples = d->frame.samples,
+                                  .geometry_id = d->frame.geometry_id,
+                                  .flags = d->frame.flags,
+                                  .depth_mm = d->begin.depth_mm,
+                                  .width_mm = d->begin.width_mm,
+                                  .radius_mm = d->begin.radius_mm};
+    if (d->params_known) { /* FRAME_PARAMS: the readout and the focus marker */
+        info.gain_db = d->params.gain_db;
+        info.dynamic_range_db = d->params.dynamic_range_db;
+        info.focus_mm = d->params.focus_mm;
+        info.frequency_mhz = d->params.frequency_mhz;
+        for (uint32_t i = 0; i < SC_DLINK_PARAMS_TGC && i < SC_DISPLAY_TGC_BANDS; i++) {
+            info.tgc_db[i] = d->params.tgc_db[i];
+        }
+    }
     sc_scanconv_render(&r->conv, &info, d->image, SC_MAX_SCAN_SAMPLES, r->grey);
     /* the scanner's display items below the viewer's own band (sc_scan_overlay.h: depth
      * scale, orientation, probe type; what the link does not carry is left out) */
