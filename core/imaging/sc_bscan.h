@@ -224,8 +224,8 @@ sc_bscan_def sc_bscan_default_def(void);
 /* Validate def and set up the geometry and display tables; forgets any attached mesh.
  * O(lines + samples). Never allocates.
  * Errors: SC_ERR_INVALID_ARG (NULL), SC_ERR_IMG_GEOMETRY (scan geometry), SC_ERR_RANGE
- * (mapper, regions_n, gain/TGC/range, acoustics flag or table out of range), SC_ERR_NOT_FINITE. On
- * error b is not usable (call again with a valid def). */
+ * (mapper, regions_n, gain/TGC/range, focus, acoustics flag or table out of range),
+ * SC_ERR_NOT_FINITE. On error b is not usable (call again with a valid def). */
 int sc_bscan_init(sc_bscan *b, const sc_bscan_def *def);
 
 /* Change runtime settings (geometry, depth, mapper, gain, TGC, range, R) between frames,
