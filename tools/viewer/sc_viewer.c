@@ -354,6 +354,7 @@ typedef struct vw_freeze {
     double cal[2][2];
 } vw_freeze;
 
+#ifdef SC_VIEWER_SDL
 /* A frozen cine frame with the calipers and their distance in mm. */
 static void render_frozen(vw_render *r, vw_freeze *fz)
 {
@@ -389,6 +390,7 @@ static void render_frozen(vw_render *r, vw_freeze *fz)
         memcpy(r->rgb + 3u * i, r->palette + 3u * r->index[i], 3u);
     }
 }
+#endif
 
 /* ---- main ------------------------------------------------------------------------------- */
 
