@@ -446,6 +446,19 @@ static uint8_t case_finding(const sc_mesh *m)
     return SC_ASSESS_CALL_NORMAL;
 }
 
+/* The imaging depth a case starts with, as a scanner's preset: the configured default depth
+ * (the running one if the probe kind was changed by a command), never deeper than the case's
+ * usable depth where it states one (issue 15: no black "no data" below the case). */
+static float case_imaging_depth_mm(const sc_engine *e, const sc_case *c, const sc_scan_def *scan)
+{
+    float depth =
+        scan->kind == e->def.bscan.scan.kind ? e->def.bscan.scan.depth_mm : scan->depth_mm;
+    if (c->usable_depth_mm > 0.0f && depth > c->usable_depth_mm) {
+        depth = c->usable_depth_mm;
+    }
+    return depth;
+}
+
 /* Between two frames: the new case becomes the running one. */
 static int swap_case(sc_engine *e, uint32_t slot)
 {
@@ -454,6 +467,7 @@ static int swap_case(sc_engine *e, uint32_t slot)
     bd.scan.image_to_probe = e->sw.c.image_to_probe;
     /* the case says whether its volume holds the acoustics or the engine adds them */
     bd.acoustics = (e->sw.c.imaging_flags & SC_CASE_IMAGING_ENGINE_ACOUSTICS) != 0u ? 1u : 0u;
+    bd.scan.depth_mm = case_imaging_depth_mm(e, &e->sw.c, &bd.scan);
     /* a method command during the build applies to the new tissue too */
     int rc = sc_tissue_set_method(&e->tissue[slot], e->def.tissue.method);
     if (rc == SC_OK) {

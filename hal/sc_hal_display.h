@@ -25,6 +25,9 @@
 
 #include "sc_err.h"
 
+/* TGC bands a frame's record carries (the B-scan's SC_BSCAN_TGC_BANDS). */
+#define SC_DISPLAY_TGC_BANDS 8u
+
 typedef struct sc_display_frame_info {
     uint32_t frame_no;    /* engine frame counter */
     uint16_t lines;       /* scan lines in this frame */
@@ -35,6 +38,14 @@ typedef struct sc_display_frame_info {
     float width_mm;       /* linear: aperture width; curvilinear: sector angle in degrees */
     float radius_mm;      /* curvilinear: probe face radius (apex radius_mm behind the face,
                            * samples from radius_mm to radius_mm + depth_mm); linear: 0 */
+    /* what a scanner's display shows beside the image (overlay: depth scale from depth_mm,
+     * focus marker, gain / range / TGC readout, probe type from geometry_id and frequency);
+     * 0 where the sender has none (a sink then leaves that item out) */
+    float gain_db;
+    float dynamic_range_db;
+    float focus_mm; /* transmit focus below the probe face */
+    float frequency_mhz;
+    float tgc_db[SC_DISPLAY_TGC_BANDS]; /* per depth band, shallow first */
 } sc_display_frame_info;
 
 enum {

@@ -9,6 +9,9 @@ foreach(_t test_sc_udp_display test_sc_png_write test_sc_png_sink test_sc_log_li
 endforeach()
 
 # The viewer's GIF writer is tested against an independent decoder.
+if(TARGET test_sc_viewer_cine)
+  target_link_libraries(test_sc_viewer_cine PRIVATE sc_viewer_parts)
+endif()
 if(TARGET test_sc_viewer_gif)
   target_link_libraries(test_sc_viewer_gif PRIVATE sc_viewer_parts)
 endif()

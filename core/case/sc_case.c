@@ -269,6 +269,7 @@ int sc_case_write(const sc_case_def *def, uint8_t *buf, size_t cap, size_t *out_
                 wr_f32(p + 40 + 4 * i, def->orientation[i]);
             }
             wr_u32(p + 76, def->imaging_flags);
+            wr_f32(p + 12, def->usable_depth_mm);
             break;
         case 2:
             memcpy(p, def->volume.voxels, n);
@@ -499,10 +500,16 @@ static int parse_case(const section_ref sec[SC_CASE_SECTION_COUNT], uint32_t cas
     if (sec[1].size != SC_CASE_GRID_SIZE) {
         return SC_ERR_CASE_SIZE;
     }
-    if (rd_u32(g + 12) != 0u || (rd_u32(g + 76) & ~SC_CASE_IMAGING_KNOWN) != 0u) {
+    if ((rd_u32(g + 76) & ~SC_CASE_IMAGING_KNOWN) != 0u) {
         return SC_ERR_CASE_RESERVED;
     }
     c.imaging_flags = rd_u32(g + 76);
+    c.usable_depth_mm = rd_f32(g + 12); /* formerly reserved zero: 0 = not stated */
+    if (!isfinite(c.usable_depth_mm) || c.usable_depth_mm < 0.0f ||
+        (c.usable_depth_mm > 0.0f && !(c.usable_depth_mm >= SC_CASE_MIN_DEPTH_MM &&
+                                       c.usable_depth_mm <= SC_CASE_MAX_DEPTH_MM))) {
+        return SC_ERR_CASE_DEPTH;
+    }
     for (int a = 0; a < 3; a++) {
         c.volume.dim[a] = rd_u32(g + 4 * a);
         c.volume.spacing_mm[a] = rd_f32(g + 16 + 4 * a);

@@ -75,7 +75,7 @@
 
 /* Payload sizes of the fixed-size sections. */
 #define SC_CASE_INFO_SIZE      (SC_CASE_NAME_LEN + SC_CASE_DESCRIPTION_LEN) /* 1024 */
-#define SC_CASE_GRID_SIZE      80u /* u32 dim[3], u32 0, f32 spacing[3], origin[3], orient[9], u32 0 */
+#define SC_CASE_GRID_SIZE      80u /* dim[3], usable depth, spacing[3], origin[3], orient[9], flags */
 #define SC_CASE_MESH_SIZE      40u /* f32 origin[3], size[3], u32 nx, ny, nz, u32 0 */
 #define SC_CASE_XFRM_SIZE      96u /* image->probe, tracker->patient: 12 f32 each (r[9], t[3]) */
 #define SC_CASE_MATL_HEAD_SIZE 8u  /* u32 count, u32 0; then count 16-byte records */
@@ -94,6 +94,13 @@ _Static_assert(SC_CASE_INFO_SIZE == 1024u, "INFO payload size");
                                                (real-patient volumes) */
 #define SC_CASE_IMAGING_KNOWN            SC_CASE_IMAGING_ENGINE_ACOUSTICS
 
+/* GRID usable imaging depth (f32 at GRID offset 12, formerly reserved zero, so older files read
+ * as "not stated"): how deep below the skin the image stays on the case's data, mm; 0: not
+ * stated, else within [SC_CASE_MIN_DEPTH_MM, SC_CASE_MAX_DEPTH_MM] (SC_ERR_CASE_DEPTH). The
+ * engine's imaging depth after a case swap never exceeds it. */
+#define SC_CASE_MIN_DEPTH_MM 5.0f
+#define SC_CASE_MAX_DEPTH_MM 500.0f
+
 /* One material record per label value (index = label, config/sc_labels.h). */
 typedef struct sc_case_material {
     float e_pa;          /* Young's modulus, Pa; finite, > 0 */
@@ -108,6 +115,7 @@ typedef struct sc_case {
     sc_volume volume;        /* voxels and labels point into the bytes; labels never NULL */
     float orientation[9];    /* grid axes in the mannequin frame, row-major, as stored */
     uint32_t imaging_flags;  /* SC_CASE_IMAGING_* */
+    float usable_depth_mm;   /* 0: not stated (see SC_CASE_MIN_DEPTH_MM) */
     uint32_t material_count; /* 1..SC_MAX_LABELS; every label value is < material_count */
     sc_case_material materials[SC_MAX_LABELS];
     sc_mesh_def mesh;            /* mesh box (volume frame, mm) and node counts */
@@ -127,6 +135,7 @@ typedef struct sc_case_def {
     sc_volume volume;
     float orientation[9];
     uint32_t imaging_flags; /* SC_CASE_IMAGING_* */
+    float usable_depth_mm;  /* 0: not stated */
     uint32_t material_count;
     sc_case_material materials[SC_MAX_LABELS];
     sc_mesh_def mesh;

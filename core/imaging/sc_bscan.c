@@ -45,6 +45,7 @@ sc_bscan_def sc_bscan_default_def(void)
     }
     d.dynamic_range_db = 60.0f;
     d.volume_range_db = 60.0f;
+    d.focus_mm = 20.0f; /* a 7.5 MHz linear probe's usual transmit focus */
     d.rest_margin_mm = 60.0f; /* the range's top: deeper than any mesh box the limits allow
                                  a press into (the appliance's 64x32x32 boxes are 30-45 mm) */
     d.acoustics = 0u;
@@ -60,7 +61,7 @@ static int db_ok(float v, float lo, float hi)
 static int check_def(const sc_bscan_def *d)
 {
     if (!isfinite(d->gain_db) || !isfinite(d->dynamic_range_db) || !isfinite(d->volume_range_db) ||
-        !isfinite(d->rest_margin_mm)) {
+        !isfinite(d->rest_margin_mm) || !isfinite(d->focus_mm)) {
         return SC_ERR_NOT_FINITE;
     }
     for (uint32_t i = 0; i < SC_BSCAN_TGC_BANDS; i++) {
@@ -74,7 +75,8 @@ static int check_def(const sc_bscan_def *d)
     if (d->mapper >= (uint32_t)SC_BSCAN_MAP_COUNT || d->regions_n < 1u ||
         d->regions_n > SC_BSCAN_MAX_REGIONS || !db_ok(d->gain_db, -60.0f, 60.0f) ||
         !db_ok(d->dynamic_range_db, 10.0f, 120.0f) || !db_ok(d->volume_range_db, 10.0f, 120.0f) ||
-        !db_ok(d->rest_margin_mm, 0.0f, 60.0f) || d->acoustics > 1u) {
+        !db_ok(d->rest_margin_mm, 0.0f, 60.0f) || d->acoustics > 1u || !(d->focus_mm > 0.0f) ||
+        d->focus_mm > 300.0f) {
         return SC_ERR_RANGE;
     }
     return SC_OK;
@@ -188,6 +190,7 @@ typedef struct frame_ctx {
     uint32_t n;        /* samples per line */
     uint32_t margin_n; /* samples of the rest reference above the face */
     /* current line, image frame */
+    uint32_t line;
     float ox, oz, dx, dz;
     /* current line, voxel-index units: rigid position of sample k is f0 + k * fd */
     float f0[3], fd[3];
@@ -453,6 +456,51 @@ static const sc_bscan_tcache *tet_cached(sc_bscan *b, const sc_mesh *m, uint32_t
     return tc;
 }
 
+static int build_regions(sc_bscan *b, const sc_mesh *m);
+static void map_line_regions(sc_bscan *b, uint32_t l, const frame_ctx *c);
+static int32_t locate_deepest(const sc_bscan *b, uint32_t r, float x, float z);
+static void fill_run(sc_bscan *b, const frame_ctx *c, uint32_t ta, uint32_t a, uint32_t z);
+static uint32_t region_of_line(uint32_t l, uint32_t lines, uint32_t regions);
+
+/* Where the walk cannot go on through face neighbours (a fold: an inverted or flat tet next),
+ * the samples from ks on are located among the tets cut by the plane: a sample inside a
+ * positively oriented tet ends the search (*t_out, *s_out: the walk goes on from there); one
+ * covered by inverted tets only takes the deepest of them; one in no tet has left the mesh.
+ * Returns 1 with the tet to walk on from, 0 when the line left the mesh or ended (*s_out: where),
+ * -1 when the region bins are over their limits (the caller falls back). fill_first: the first
+ * sample is filled from the tet found whatever its orientation (a walk that relocated at this
+ * sample and could not move on: no loop). O(samples located x tets of the line's region). */
+static int relocate(sc_bscan *b, const sc_mesh *m, const frame_ctx *c, uint32_t ks, uint32_t *k,
+                    int fill_first, uint32_t *t_out, float *s_out)
+{
+    if (b->regions_state == 0u) {
+        b->regions_state = build_regions(b, m) ? 1u : 2u;
+    }
+    if (b->regions_state != 1u) {
+        return -1;
+    }
+    const uint32_t r = region_of_line(c->line, b->def.scan.lines_n, b->def.regions_n);
+    for (uint32_t kk = ks < *k ? *k : ks; kk < c->n; kk++) {
+        const int32_t pi =
+            locate_deepest(b, r, c->ox + (float)kk * c->dx, c->oz + (float)kk * c->dz);
+        if (pi < 0) {
+            *s_out = (float)kk;
+            return 0;
+        }
+        const sc_bscan_ptet *p = &b->ptets[pi];
+        if (p->orient > 0 && !fill_first) {
+            *t_out = p->tet;
+            *s_out = (float)kk;
+            return 1;
+        }
+        fill_run(b, c, (uint32_t)pi, kk, kk);
+        *k = kk + 1u;
+        fill_first = 0;
+    }
+    *s_out = (float)c->n;
+    return 0;
+}
+
 /* Walk the current line from tet t, entered through local face f_in (4: none) at line
  * parameter s_in, writing the rest positions of the samples from *k on. Returns the parameter
  * where the walk left the mesh (or >= n when it reached the end of the line). */
@@ -460,6 +508,7 @@ static float walk(sc_bscan *b, const sc_mesh *m, const frame_ctx *c, uint32_t t,
                   float s_in, uint32_t *k, uint32_t *steps, int *trouble)
 {
     const uint32_t n = c->n;
+    uint32_t reloc_k = UINT32_MAX; /* the sample of the last relocation */
     for (;;) {
         if (*steps >= SC_BSCAN_MAX_WALK_STEPS) {
             b->status.walk_aborts++;
@@ -469,8 +518,24 @@ static float walk(sc_bscan *b, const sc_mesh *m, const frame_ctx *c, uint32_t t,
         (*steps)++;
         const sc_bscan_tcache *tc = tet_cached(b, m, t);
         if (!tc->ok) {
-            *trouble = 1; /* flat or inverted tet: the walk cannot be trusted */
-            return (float)n;
+            /* flat or inverted: a fold; locate the samples from here on and walk on */
+            uint32_t tn = 0;
+            float sn = 0.0f;
+            const uint32_t ks = first_k(s_in, n);
+            const int rr = relocate(b, m, c, ks, k, ks == reloc_k && *k <= ks, &tn, &sn);
+            if (rr < 0) {
+                *trouble = 1;
+                return (float)n;
+            }
+            if (rr == 0) {
+                return sn;
+            }
+            b->status.walk_relocations++;
+            reloc_k = (uint32_t)sn;
+            t = tn;
+            f_in = 4u;
+            s_in = sn;
+            continue;
         }
         float a[4], be[4];
         for (uint32_t i = 0; i < 4u; i++) {
@@ -529,9 +594,6 @@ static float walk(sc_bscan *b, const sc_mesh *m, const frame_ctx *c, uint32_t t,
     }
 }
 
-static int build_regions(sc_bscan *b, const sc_mesh *m);
-static void map_line_regions(sc_bscan *b, uint32_t l, const frame_ctx *c);
-
 static void map_line_walk(sc_bscan *b, const sc_mesh *m, uint32_t l, uint32_t *active_n,
                           const frame_ctx *c)
 {
@@ -540,9 +602,23 @@ static void map_line_walk(sc_bscan *b, const sc_mesh *m, uint32_t l, uint32_t *a
     int trouble = 0;
     if (ne > 0u && !b->events[0].entry) {
         /* the line starts inside the mesh (behind the face) or the boundary is folded:
-         * harmless if that is behind the first pixel, else the walker has no entry */
-        trouble = b->events[0].s > 0.0f;
+         * harmless if that is behind the first pixel, else the walk starts by locating */
         ei = 1u;
+        if (b->events[0].s > 0.0f) {
+            uint32_t t0 = 0;
+            float s0 = 0.0f;
+            const int rr = relocate(b, m, c, 0u, &k, 0, &t0, &s0);
+            float sx = s0;
+            if (rr < 0) {
+                trouble = 1;
+            } else if (rr > 0) {
+                b->status.walk_relocations++;
+                sx = walk(b, m, c, t0, 4u, s0, &k, &steps, &trouble);
+            }
+            while (ei < ne && b->events[ei].s < sx - 1e-3f) {
+                ei++;
+            }
+        }
     }
     while (!trouble && ei < ne && k < c->n) {
         const sc_bscan_event *e = &b->events[ei++];
@@ -600,7 +676,8 @@ static int build_regions(sc_bscan *b, const sc_mesh *m)
             continue;
         }
         float al[4], g[4][3];
-        if (!tet_affine(b, tv, al, g)) {
+        const int orient = tet_affine(b, tv, al, g);
+        if (orient == 0) {
             continue;
         }
         float xmin = b->qx[tv[0]], xmax = xmin, zmin = b->qz[tv[0]], zmax = zmin;
@@ -633,6 +710,8 @@ static int build_regions(sc_bscan *b, const sc_mesh *m)
                 p->rest[2][j] += p->lam[i][j] * m->rest_z[tv[i]];
             }
         }
+        p->tet = t;
+        p->orient = orient;
         p->xmin = xmin;
         p->xmax = xmax;
         p->zmin = zmin;
@@ -685,12 +764,15 @@ static int build_regions(sc_bscan *b, const sc_mesh *m)
     return 1;
 }
 
+/* The first tet of region r holding (x, z), a positively oriented one before an inverted one
+ * (a fold's turned layer counts only where nothing else covers the point). */
 static int32_t locate_region(const sc_bscan *b, uint32_t r, float x, float z)
 {
     const float *bx = b->region_box[r];
     if (x < bx[0] || x > bx[1] || z < bx[2] || z > bx[3]) {
         return -1;
     }
+    int32_t inverted = -1;
     for (uint32_t i = b->region_start[r]; i < b->region_start[r + 1u]; i++) {
         const uint32_t pi = b->region_refs[i];
         const sc_bscan_ptet *p = &b->ptets[pi];
@@ -702,10 +784,50 @@ static int32_t locate_region(const sc_bscan *b, uint32_t r, float x, float z)
             in = p->lam[v][0] + p->lam[v][1] * x + p->lam[v][2] * z >= -SC_BSCAN_LAMBDA_EPS;
         }
         if (in) {
-            return (int32_t)pi;
+            if (p->orient > 0) {
+                return (int32_t)pi;
+            }
+            if (inverted < 0) {
+                inverted = (int32_t)pi;
+            }
         }
     }
-    return -1;
+    return inverted;
+}
+
+/* The tet of region r that holds (x, z) deepest (largest smallest barycentric coordinate), a
+ * positively oriented one before an inverted one: the oracle's rule, for the walker's
+ * relocation inside folds. */
+static int32_t locate_deepest(const sc_bscan *b, uint32_t r, float x, float z)
+{
+    const float *bx = b->region_box[r];
+    if (x < bx[0] || x > bx[1] || z < bx[2] || z > bx[3]) {
+        return -1;
+    }
+    int32_t best = -1;
+    int32_t best_orient = -2;
+    float best_min = -SC_BSCAN_LAMBDA_EPS;
+    for (uint32_t i = b->region_start[r]; i < b->region_start[r + 1u]; i++) {
+        const uint32_t pi = b->region_refs[i];
+        const sc_bscan_ptet *p = &b->ptets[pi];
+        if (x < p->xmin || x > p->xmax || z < p->zmin || z > p->zmax) {
+            continue;
+        }
+        float lmin = p->lam[0][0] + p->lam[0][1] * x + p->lam[0][2] * z;
+        for (uint32_t v = 1; v < 4u; v++) {
+            const float l = p->lam[v][0] + p->lam[v][1] * x + p->lam[v][2] * z;
+            lmin = l < lmin ? l : lmin;
+        }
+        if (!(lmin >= -SC_BSCAN_LAMBDA_EPS)) {
+            continue;
+        }
+        if (p->orient > best_orient || (p->orient == best_orient && lmin > best_min)) {
+            best = (int32_t)pi;
+            best_orient = p->orient;
+            best_min = lmin;
+        }
+    }
+    return best;
 }
 
 /* Rest positions of samples a..z (all in ptet ta), interpolated linearly between the ends. */
@@ -805,6 +927,7 @@ static void map_line_oracle(sc_bscan *b, const sc_mesh *m, const sc_nodes *nd, u
         sc_scan_geom_pixel(&b->geom, l, k, img);
         sc_xform_apply(&c->img2vol, img, w);
         int32_t best = -1;
+        int best_pos = 0; /* a positively oriented tet before an inverted one (sc_bscan.h) */
         float best_min = -SC_BSCAN_LAMBDA_EPS, best_l[4] = {0.0f, 0.0f, 0.0f, 0.0f};
         for (uint32_t t = 0; t < m->tet_count; t++) {
             const uint32_t *tv = m->tet[t];
@@ -846,7 +969,12 @@ static void map_line_oracle(sc_bscan *b, const sc_mesh *m, const sc_nodes *nd, u
 #undef SC_DET3_
             lam[0] = 1.0f - lam[1] - lam[2] - lam[3];
             const float lmin = fminf(fminf(lam[0], lam[1]), fminf(lam[2], lam[3]));
-            if (lmin > best_min) {
+            const int pos = det > 0.0f;
+            if (!(lmin >= -SC_BSCAN_LAMBDA_EPS)) {
+                continue;
+            }
+            if ((pos && !best_pos) || (pos == best_pos && (best < 0 || lmin > best_min))) {
+                best_pos = pos;
                 best_min = lmin;
                 best = (int32_t)t;
                 for (uint32_t v = 0; v < 4u; v++) {
@@ -1027,7 +1155,11 @@ static float fold_axis(float p, float dim, float slab, int mirror, float *out)
     float outside = 0.0f;
     if (p < lo || p >= hi) {
         outside = p < lo ? lo - p : p - hi;
-        float m = fmodf(outside, 2.0f * slab);
+        /* outside mod 2 slab (outside >= 0), without the libm call */
+        const float period = 2.0f * slab;
+        float q_n = outside / period;
+        q_n = q_n < 1e7f ? q_n : 1e7f; /* far outside: any fold is as good */
+        float m = outside - period * (float)(int32_t)q_n;
         m = m < slab ? m : 2.0f * slab - m;
         q = p < lo ? (mirror ? lo + m : 0.0f) : hi - m;
     }
@@ -1069,39 +1201,26 @@ static void beyond_sample(const vol_ctx *vc, const vol_regs vr, const int64_t *r
     lab[k] = (uint8_t)SC_LABEL_OUTSIDE;
 }
 
-/* Samples [k0, k1) at voxel positions a + k b. */
-static void sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1, const float a[3],
-                        const float bb[3])
+/* Samples [k0, k1) at voxel positions a + k b, all inside the volume box (the ends are, and the
+ * box is convex). */
+static void sample_span_inside(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1,
+                               const float a[3], const float bb[3])
 {
-    float p0[3], p1[3];
-    for (uint32_t d = 0; d < 3u; d++) {
-        p0[d] = a[d] + (float)k0 * bb[d];
-        p1[d] = a[d] + (float)(k1 - 1u) * bb[d];
-    }
     const vol_regs vr = {vc->vox, vc->lab, vc->stride[1], vc->stride[2], vc->la};
     const int64_t *restrict lut = b->lut_b_fx;
     const int64_t xm0 = vc->xmax[0], xm1 = vc->xmax[1], xm2 = vc->xmax[2];
     uint8_t *restrict out = b->line_out;
     uint8_t *restrict lab = b->line_label;
-    if (in_volume(vc, p0) && in_volume(vc, p1)) {
-        /* the volume box is convex: every sample between is inside */
-        int64_t X = to_fx32(p0[0]), Y = to_fx32(p0[1]), Z = to_fx32(p0[2]);
-        const int64_t DX = to_fx32(bb[0]), DY = to_fx32(bb[1]), DZ = to_fx32(bb[2]);
-        const int64_t j1 = (int64_t)(k1 - 1u - k0);
-        const int64_t xe = X + j1 * DX, ye = Y + j1 * DY, ze = Z + j1 * DZ;
-        if (X >= 0 && xe >= 0 && Y >= 0 && ye >= 0 && Z >= 0 && ze >= 0 && X <= xm0 && xe <= xm0 &&
-            Y <= xm1 && ye <= xm1 && Z <= xm2 && ze <= xm2) {
-            /* clear of the half-voxel border at both ends, so everywhere: no clamping */
-            for (uint32_t k = k0; k < k1; k++) {
-                sample_fx(vr, lut, k, X, Y, Z, out, lab);
-                X += DX;
-                Y += DY;
-                Z += DZ;
-            }
-            return;
-        }
+    int64_t X = to_fx32(a[0] + (float)k0 * bb[0]), Y = to_fx32(a[1] + (float)k0 * bb[1]),
+            Z = to_fx32(a[2] + (float)k0 * bb[2]);
+    const int64_t DX = to_fx32(bb[0]), DY = to_fx32(bb[1]), DZ = to_fx32(bb[2]);
+    const int64_t j1 = (int64_t)(k1 - 1u - k0);
+    const int64_t xe = X + j1 * DX, ye = Y + j1 * DY, ze = Z + j1 * DZ;
+    if (X >= 0 && xe >= 0 && Y >= 0 && ye >= 0 && Z >= 0 && ze >= 0 && X <= xm0 && xe <= xm0 &&
+        Y <= xm1 && ye <= xm1 && Z <= xm2 && ze <= xm2) {
+        /* clear of the half-voxel border at both ends, so everywhere: no clamping */
         for (uint32_t k = k0; k < k1; k++) {
-            sample_fx(vr, lut, k, clamp_fx(X, xm0), clamp_fx(Y, xm1), clamp_fx(Z, xm2), out, lab);
+            sample_fx(vr, lut, k, X, Y, Z, out, lab);
             X += DX;
             Y += DY;
             Z += DZ;
@@ -1109,14 +1228,70 @@ static void sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1
         return;
     }
     for (uint32_t k = k0; k < k1; k++) {
-        const float p[3] = {a[0] + (float)k * bb[0], a[1] + (float)k * bb[1],
-                            a[2] + (float)k * bb[2]};
-        if (!in_volume(vc, p)) {
-            beyond_sample(vc, vr, lut, k, p, out, lab);
+        sample_fx(vr, lut, k, clamp_fx(X, xm0), clamp_fx(Y, xm1), clamp_fx(Z, xm2), out, lab);
+        X += DX;
+        Y += DY;
+        Z += DZ;
+    }
+}
+
+static int in_volume_k(const vol_ctx *vc, const float a[3], const float bb[3], uint32_t k)
+{
+    const float p[3] = {a[0] + (float)k * bb[0], a[1] + (float)k * bb[1], a[2] + (float)k * bb[2]};
+    return in_volume(vc, p);
+}
+
+/* Samples [k0, k1) at voxel positions a + k b: the part inside the volume box (an interval: the
+ * line is straight, the box convex; its ends found from the slab intersection and confirmed by
+ * the per-sample test) in fixed point, the parts beyond it continued (beyond_sample). */
+static void sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1, const float a[3],
+                        const float bb[3])
+{
+    /* the line parameter range inside the box, per axis: -1/2 <= a + k b < hi */
+    float lo = (float)k0, hi = (float)k1;
+    for (uint32_t d = 0; d < 3u && lo < hi; d++) {
+        if (bb[d] > 0.0f || bb[d] < 0.0f) {
+            const float t0 = (-0.5f - a[d]) / bb[d], t1 = (vc->hi[d] - a[d]) / bb[d];
+            const float tl = t0 < t1 ? t0 : t1, th = t0 < t1 ? t1 : t0; /* no libm calls */
+            lo = tl > lo ? tl : lo;
+            hi = th < hi ? th : hi;
+        } else if (!(a[d] >= -0.5f && a[d] < vc->hi[d])) {
+            hi = lo; /* parallel to the faces of this axis and outside them */
+        }
+    }
+    uint32_t ka = k1, kb = k1;
+    if (lo < hi) {
+        ka = first_k(lo, k1);
+        ka = ka < k0 ? k0 : ka;
+        kb = first_k(hi, k1);
+        kb = kb < ka ? ka : kb;
+        /* the ends as the per-sample test sees them (a rounding either way) */
+        while (ka > k0 && in_volume_k(vc, a, bb, ka - 1u)) {
+            ka--;
+        }
+        while (ka < kb && !in_volume_k(vc, a, bb, ka)) {
+            ka++;
+        }
+        while (kb < k1 && kb > ka && in_volume_k(vc, a, bb, kb)) {
+            kb++;
+        }
+        while (kb > ka && !in_volume_k(vc, a, bb, kb - 1u)) {
+            kb--;
+        }
+        if (ka == kb) {
+            ka = kb = k1;
+        }
+    }
+    const vol_regs vr = {vc->vox, vc->lab, vc->stride[1], vc->stride[2], vc->la};
+    for (uint32_t k = k0; k < k1; k++) {
+        if (k == ka) {
+            sample_span_inside(b, vc, ka, kb, a, bb);
+            k = kb - 1u;
             continue;
         }
-        sample_fx(vr, lut, k, clamp_fx(to_fx32(p[0]), xm0), clamp_fx(to_fx32(p[1]), xm1),
-                  clamp_fx(to_fx32(p[2]), xm2), out, lab);
+        const float p[3] = {a[0] + (float)k * bb[0], a[1] + (float)k * bb[1],
+                            a[2] + (float)k * bb[2]};
+        beyond_sample(vc, vr, b->lut_b_fx, k, p, b->line_out, b->line_label);
     }
 }
 
@@ -1263,7 +1438,7 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
     st->plane_tets = 0u;
     st->walk_steps = 0u;
 
-    const sc_display_frame_info info = {
+    sc_display_frame_info info = {
         .frame_no = frame_no,
         .lines = (uint16_t)lines,
         .samples = (uint16_t)n,
@@ -1273,7 +1448,14 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
         .width_mm = sd->kind == SC_SCAN_GEOM_LINEAR ? sd->width_mm : sd->sector_deg,
         /* the sinks draw the fan from the probe face's arc, radius_mm in front of the apex */
         .radius_mm = sd->kind == SC_SCAN_GEOM_LINEAR ? 0.0f : sd->radius_mm,
+        .gain_db = b->def.gain_db,
+        .dynamic_range_db = b->def.dynamic_range_db,
+        .focus_mm = b->def.focus_mm,
+        .frequency_mhz = b->def.acoustic.frequency_mhz,
     };
+    for (uint32_t i = 0; i < SC_BSCAN_TGC_BANDS; i++) {
+        info.tgc_db[i] = b->def.tgc_db[i];
+    }
     int rc = sc_display_frame_begin(display, &info);
     if (rc != SC_OK) {
         st->display_errors++;
@@ -1366,6 +1548,7 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
     memset(&acc, 0, sizeof acc);
     uint32_t active_n = 0;
     for (uint32_t l = 0; l < lines; l++) {
+        c.line = l;
         c.ox = b->geom.start_x_mm[l];
         c.oz = b->geom.start_z_mm[l];
         c.dx = b->geom.step_x_mm[l];

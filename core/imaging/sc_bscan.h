@@ -24,9 +24,19 @@
  *   through a boundary triangle (found among the boundary triangles cut by the image plane) and
  *   walks from tet to face neighbour, the exit parameter of each tet coming from its
  *   barycentric coordinates along the ray; inside a tet the rest position is affine in the
- *   sample index. A line the walker cannot trust (an inverted or flat tet on its way, a folded
- *   boundary, a start inside the mesh) is redone by the region path, which is point location
- *   and needs no orientation.
+ *   sample index. Where the deformed mesh folds (a tet on the way is inverted or flat, as
+ *   under a firm press where a vein's walls meet, or the line starts inside the mesh), the
+ *   walker locates the next sample among the tets cut by the plane (the region path's bins)
+ *   and walks on from the tet found; samples covered by inverted tets only take the deepest
+ *   of those. A line the walker still cannot trust (a walk over SC_BSCAN_MAX_WALK_STEPS, a
+ *   degenerate exit) is redone by the region path.
+ *
+ * Folds: a point of a folded mesh lies in more than one tet (the fold's layers). All three
+ * mappers prefer a positively oriented tet (tissue that is there) to an inverted one (a
+ * layer turned inside out); among several the oracle takes the one that holds the point
+ * deepest (largest smallest barycentric coordinate), the walker stays on the layer it walks,
+ * the region path takes the first it finds: inside a fold they may differ, elsewhere they agree
+ * up to ties on faces.
  *
  * The compression measure comes from the same pass: for each label, the image area whose rest
  * position has that label now, against the area with that label in the rigid (undeformed) slice
@@ -56,6 +66,8 @@
 #include "sc_scan_geom.h"
 #include "sc_volume.h"
 
+_Static_assert(SC_BSCAN_TGC_BANDS == SC_DISPLAY_TGC_BANDS, "the frame record carries every band");
+
 enum {
     SC_BSCAN_MAP_WALK = 0,
     SC_BSCAN_MAP_REGIONS = 1,
@@ -76,6 +88,8 @@ typedef struct sc_bscan_def {
     float tgc_db[SC_BSCAN_TGC_BANDS]; /* per depth band, shallow first, [-60, 60] */
     float dynamic_range_db;           /* displayed range, [10, 120] */
     float volume_range_db;            /* range the volume's 0..255 stands for, [10, 120] */
+    float focus_mm;            /* transmit focus below the probe face, (0, 300]: the display's
+                                  focus marker (and the beam's narrowest point) */
     float rest_margin_mm;      /* the compression measure's rest reference extends this far above
                                   the probe face (tissue pushed into view), [0, 60] */
     uint32_t acoustics;        /* 1: beam-dependent acoustics along each line (sc_acoustics.h);
@@ -100,8 +114,10 @@ typedef struct sc_bscan_status {
     /* cumulative counters of degraded work (each stays exact or falls back, see .c) */
     uint32_t walk_aborts;      /* a line exceeded SC_BSCAN_MAX_WALK_STEPS */
     uint32_t event_overflows;  /* a line crossed the boundary > SC_BSCAN_MAX_LINE_EVENTS */
-    uint32_t line_fallbacks;   /* lines the walker handed to the region path (inverted or
-                                  flat tets, folded boundary, line start inside the mesh) */
+    uint32_t line_fallbacks;   /* lines the walker handed to the region path (a walk over its
+                                  step limit, a degenerate exit) */
+    uint32_t walk_relocations; /* folds the walker crossed by locating (inverted or flat tets,
+                                  a line start inside the mesh) */
     uint32_t region_overflows; /* region path over its limits (walker result kept) */
     uint32_t display_errors;   /* display calls that returned an error */
 } sc_bscan_status;
@@ -127,6 +143,8 @@ typedef struct sc_bscan_ptet {
     float lam[4][3];  /* lambda_i = lam[i][0] + lam[i][1] x + lam[i][2] z */
     float rest[3][3]; /* rest coordinate d = rest[d][0] + rest[d][1] x + rest[d][2] z */
     float xmin, xmax, zmin, zmax;
+    uint32_t tet;   /* mesh tet */
+    int32_t orient; /* 1 positively oriented, -1 inverted (a fold of the deformed mesh) */
 } sc_bscan_ptet;
 
 /* Samples [k0, k1) of a line inside the mesh; rest position in voxel units is a + k b. */
@@ -206,8 +224,8 @@ sc_bscan_def sc_bscan_default_def(void);
 /* Validate def and set up the geometry and display tables; forgets any attached mesh.
  * O(lines + samples). Never allocates.
  * Errors: SC_ERR_INVALID_ARG (NULL), SC_ERR_IMG_GEOMETRY (scan geometry), SC_ERR_RANGE
- * (mapper, regions_n, gain/TGC/range, acoustics flag or table out of range), SC_ERR_NOT_FINITE. On
- * error b is not usable (call again with a valid def). */
+ * (mapper, regions_n, gain/TGC/range, focus, acoustics flag or table out of range),
+ * SC_ERR_NOT_FINITE. On error b is not usable (call again with a valid def). */
 int sc_bscan_init(sc_bscan *b, const sc_bscan_def *def);
 
 /* Change runtime settings (geometry, depth, mapper, gain, TGC, range, R) between frames,

@@ -173,6 +173,67 @@ int sc_dlink_encode_end(uint8_t *buf, size_t cap, const sc_dlink_frame *f, const
     return finish(buf, (uint16_t)SC_DLINK_END_PAYLOAD);
 }
 
+static int params_ok(const float v[4 + SC_DLINK_PARAMS_TGC])
+{
+    static const float lo[4] = {-60.0f, 0.0f, 0.0f, 0.0f}, hi[4] = {60.0f, 120.0f, 300.0f, 30.0f};
+    for (uint32_t i = 0; i < 4u + SC_DLINK_PARAMS_TGC; i++) {
+        const float l = i < 4u ? lo[i] : -60.0f, h = i < 4u ? hi[i] : 60.0f;
+        if (!(v[i] >= l && v[i] <= h)) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+static void params_to_array(const sc_dlink_params *p, float v[4 + SC_DLINK_PARAMS_TGC])
+{
+    v[0] = p->gain_db;
+    v[1] = p->dynamic_range_db;
+    v[2] = p->focus_mm;
+    v[3] = p->frequency_mhz;
+    for (uint32_t i = 0; i < SC_DLINK_PARAMS_TGC; i++) {
+        v[4 + i] = p->tgc_db[i];
+    }
+}
+
+int sc_dlink_encode_params(uint8_t *buf, size_t cap, const sc_dlink_frame *f,
+                           const sc_dlink_params *p)
+{
+    if (!buf || !f || !p) {
+        return SC_ERR_INVALID_ARG;
+    }
+    if (cap < SC_DLINK_HEADER_SIZE + SC_DLINK_PARAMS_PAYLOAD) {
+        return SC_ERR_NO_SPACE;
+    }
+    float v[4 + SC_DLINK_PARAMS_TGC];
+    params_to_array(p, v);
+    for (uint32_t i = 0; i < 4u + SC_DLINK_PARAMS_TGC; i++) {
+        if (!isfinite(v[i])) {
+            return SC_ERR_NOT_FINITE;
+        }
+    }
+    if (!frame_fields_ok(f) || !params_ok(v)) {
+        return SC_ERR_DLINK_FIELD;
+    }
+    write_header(buf, f, SC_DLINK_FRAME_PARAMS, 0u, (uint16_t)SC_DLINK_PARAMS_PAYLOAD);
+    uint8_t *q = buf + SC_DLINK_HEADER_SIZE;
+    for (uint32_t i = 0; i < 4u + SC_DLINK_PARAMS_TGC; i++) {
+        put32(q + 4u * i, f32_bits(v[i]));
+    }
+    return finish(buf, (uint16_t)SC_DLINK_PARAMS_PAYLOAD);
+}
+
+void sc_dlink_parse_params(const uint8_t *payload, sc_dlink_params *p)
+{
+    p->gain_db = f32_from_bits(get32(payload + 0));
+    p->dynamic_range_db = f32_from_bits(get32(payload + 4));
+    p->focus_mm = f32_from_bits(get32(payload + 8));
+    p->frequency_mhz = f32_from_bits(get32(payload + 12));
+    for (uint32_t i = 0; i < SC_DLINK_PARAMS_TGC; i++) {
+        p->tgc_db[i] = f32_from_bits(get32(payload + 16u + 4u * i));
+    }
+}
+
 int sc_dlink_decode(const uint8_t *pkt, size_t len, sc_dlink_header *h, const uint8_t **payload)
 {
     if (!pkt || !h || !payload) {
@@ -216,6 +277,9 @@ int sc_dlink_decode(const uint8_t *pkt, size_t len, sc_dlink_header *h, const ui
     case SC_DLINK_FRAME_END:
         expect_len = (uint16_t)SC_DLINK_END_PAYLOAD;
         break;
+    case SC_DLINK_FRAME_PARAMS:
+        expect_len = (uint16_t)SC_DLINK_PARAMS_PAYLOAD;
+        break;
     default:
         return SC_ERR_DLINK_TYPE;
     }
@@ -244,6 +308,14 @@ int sc_dlink_decode(const uint8_t *pkt, size_t len, sc_dlink_header *h, const ui
     } else if (d.type == SC_DLINK_FRAME_END) {
         if ((uint32_t)get16(pl + 0) + get16(pl + 2) > d.line_count ||
             !compression_ok(get16(pl + 4)) || !compression_ok(get16(pl + 6))) {
+            return SC_ERR_DLINK_FIELD;
+        }
+    } else if (d.type == SC_DLINK_FRAME_PARAMS) {
+        sc_dlink_params p;
+        float v[4 + SC_DLINK_PARAMS_TGC];
+        sc_dlink_parse_params(pl, &p);
+        params_to_array(&p, v);
+        if (!params_ok(v)) { /* NaN fails the range too */
             return SC_ERR_DLINK_FIELD;
         }
     }
@@ -352,6 +424,8 @@ static void close_frame(sc_dlink_asm *a, uint8_t end_seen)
     a->done.begin_seen = a->begin_seen;
     a->done.end_seen = end_seen;
     a->done.image = img;
+    a->done.params = a->params;
+    a->done.params_known = a->params_known;
     a->have_done = 1u;
     a->last_closed_no = a->frame.frame_no;
     a->cur ^= 1u;
@@ -436,6 +510,10 @@ int sc_dlink_asm_push(sc_dlink_asm *a, const uint8_t *pkt, size_t len)
         a->stats.lines_received++;
         break;
     }
+    case SC_DLINK_FRAME_PARAMS:
+        sc_dlink_parse_params(pl, &a->params);
+        a->params_known = 1u;
+        break;
     case SC_DLINK_FRAME_END: {
         sc_dlink_end e;
         sc_dlink_parse_end(pl, &e);

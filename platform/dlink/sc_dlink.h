@@ -33,6 +33,8 @@
 #define SC_DLINK_HEADER_SIZE   28u
 #define SC_DLINK_BEGIN_PAYLOAD 16u /* depth, width, radius f32; reserved u32 */
 #define SC_DLINK_END_PAYLOAD   8u  /* lines_sent, lines_dropped, vein and artery compression u16 */
+#define SC_DLINK_PARAMS_PAYLOAD 48u /* gain, range, focus, frequency, tgc[8]: f32 */
+#define SC_DLINK_PARAMS_TGC     8u
 /* Largest packet: a line of SC_MAX_SCAN_SAMPLES samples (540 bytes with the default limits,
  * below the 1472-byte UDP payload of a 1500-byte Ethernet MTU, so no IP fragmentation). */
 #define SC_DLINK_MAX_PACKET (SC_DLINK_HEADER_SIZE + SC_MAX_SCAN_SAMPLES)
@@ -47,6 +49,10 @@ typedef enum sc_dlink_type {
     SC_DLINK_FRAME_BEGIN = 1,
     SC_DLINK_LINE = 2,
     SC_DLINK_FRAME_END = 3,
+    /* additive extension (same version): the imaging parameters a scanner's display shows,
+     * optional, once between FRAME_BEGIN and FRAME_END. A receiver that predates it rejects
+     * it by type (counted) and still shows the frame; 4..7 left to other extensions. */
+    SC_DLINK_FRAME_PARAMS = 8,
 } sc_dlink_type;
 
 /* Decoded header. For FRAME_BEGIN and FRAME_END line_index is 0. */
@@ -80,6 +86,16 @@ typedef struct sc_dlink_end {
     uint16_t artery_compression_pm; /* the same for the artery */
 } sc_dlink_end;
 
+/* FRAME_PARAMS payload (little-endian f32 each). Ranges checked by the codec: gain and TGC
+ * [-60, 60] dB, range [0, 120] dB, focus [0, 300] mm, frequency [0, 30] MHz (0: not known). */
+typedef struct sc_dlink_params {
+    float gain_db;
+    float dynamic_range_db;
+    float focus_mm;
+    float frequency_mhz;
+    float tgc_db[SC_DLINK_PARAMS_TGC];
+} sc_dlink_params;
+
 /* The compression measure in permille of an area ratio (now / at rest; < 0 or not finite:
  * unknown): 1000 (1 - ratio), clamped to 0..1000. O(1). */
 uint16_t sc_dlink_compression_pm(float area_ratio);
@@ -106,6 +122,10 @@ int sc_dlink_encode_begin(uint8_t *buf, size_t cap, const sc_dlink_frame *f,
 int sc_dlink_encode_line(uint8_t *buf, size_t cap, const sc_dlink_frame *f, uint16_t line_index,
                          const uint8_t *samples, uint16_t count);
 int sc_dlink_encode_end(uint8_t *buf, size_t cap, const sc_dlink_frame *f, const sc_dlink_end *e);
+/* FRAME_PARAMS: as the others; SC_ERR_NOT_FINITE for a non-finite value, SC_ERR_DLINK_FIELD for
+ * one outside the ranges of sc_dlink_params. */
+int sc_dlink_encode_params(uint8_t *buf, size_t cap, const sc_dlink_frame *f,
+                           const sc_dlink_params *p);
 
 /* Decode and check one received packet of len bytes. On success fills *h, points *payload at
  * the payload inside pkt and returns 0. Checks, in this order: length at least a header
@@ -122,6 +142,7 @@ int sc_dlink_decode(const uint8_t *pkt, size_t len, sc_dlink_header *h, const ui
  * lines_sent + lines_dropped <= line_count, reserved bytes zero). O(1), cannot fail. */
 void sc_dlink_parse_begin(const uint8_t *payload, sc_dlink_begin *b);
 void sc_dlink_parse_end(const uint8_t *payload, sc_dlink_end *e);
+void sc_dlink_parse_params(const uint8_t *payload, sc_dlink_params *p);
 
 /* ---- receiver-side frame assembler ----------------------------------------------------- */
 
@@ -152,6 +173,8 @@ typedef struct sc_dlink_done {
     uint8_t begin_seen;
     uint8_t end_seen;
     const uint8_t *image; /* valid until the next frame closes */
+    sc_dlink_params params; /* FRAME_PARAMS, or the last frame's that had one */
+    uint8_t params_known;   /* a FRAME_PARAMS has arrived (this frame or before) */
 } sc_dlink_done;
 
 typedef struct sc_dlink_asm {
@@ -164,6 +187,8 @@ typedef struct sc_dlink_asm {
     sc_dlink_frame frame;    /* open frame */
     sc_dlink_begin begin;    /* open frame's (or last known) begin payload */
     sc_dlink_end end;        /* the FRAME_END payload that closes the open frame */
+    sc_dlink_params params;  /* last FRAME_PARAMS received */
+    uint8_t params_known;
     uint16_t received;       /* lines of the open frame */
     uint32_t last_closed_no; /* frame number of the last closed frame */
     sc_dlink_done done;      /* last closed frame */

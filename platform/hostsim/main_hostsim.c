@@ -37,6 +37,7 @@
 #include "sc_hs_rig.h"
 #include "sc_labels.h"
 #include "sc_png_write.h"
+#include "sc_scan_overlay.h"
 #include "sc_scanconv.h"
 #include "sc_stats.h"
 #include "sc_storage_linux.h"
@@ -472,6 +473,7 @@ static int write_frame_png(const options *o, sc_scanconv *conv, uint8_t *raster,
     char path[4096];
     snprintf(path, sizeof(path), "%s/frame_%05u.png", o->out_dir, frame_no);
     sc_scanconv_render(conv, &d->last_info, d->last, d->last_info.samples, raster);
+    sc_overlay_draw(raster, conv->width, conv->height, &d->last_info);
     return sc_png_write(path, conv->width, conv->height, 1, raster, conv->width);
 }
 
@@ -1023,6 +1025,7 @@ int main(int argc, char **argv)
     }
     if (deepest_info.lines) {
         sc_scanconv_render(&conv, &deepest_info, deepest, deepest_info.samples, raster);
+        sc_overlay_draw(raster, conv.width, conv.height, &deepest_info);
         snprintf(path, sizeof(path), "%s/deepest_compression.png", o.out_dir);
         if (sc_png_write(path, conv.width, conv.height, 1, raster, conv.width) == 0) {
             pngs++;

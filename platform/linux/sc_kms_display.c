@@ -16,6 +16,7 @@
 
 #include "sc_config.h"
 #include "sc_err.h"
+#include "sc_scan_overlay.h"
 #include "sc_scanconv.h"
 
 enum { KIND_DRM = 0, KIND_FBDEV = 1 };
@@ -404,6 +405,7 @@ static int kms_end(void *ctx, const sc_display_end_info *end)
         }
     }
     sc_scanconv_render(&d->conv, &d->info, d->image, SC_MAX_SCAN_SAMPLES, d->grey);
+    sc_overlay_draw(d->grey, d->conv.width, d->conv.height, &d->info); /* a scanner's display */
     if (d->kind == KIND_FBDEV) {
         blit(d, d->fb_map, d->pitch, d->bpp);
         d->stats.frames_shown++;

@@ -11,6 +11,7 @@
 #include "sc_config.h"
 #include "sc_err.h"
 #include "sc_png_write.h"
+#include "sc_scan_overlay.h"
 #include "sc_scanconv.h"
 
 #define STRIDE      SC_MAX_SCAN_SAMPLES
@@ -55,6 +56,7 @@ static void *writer_main(void *arg)
         const sc_display_frame_info info = s->handoff_info;
         pthread_mutex_unlock(&s->lock);
         sc_scanconv_render(&s->conv, &info, s->handoff, STRIDE, s->raster);
+        sc_overlay_draw(s->raster, s->conv.width, s->conv.height, &info); /* a scanner's display */
         char path[4200];
         snprintf(path, sizeof path, "%s/frame_%06u.png", s->dir, (unsigned)info.frame_no);
         int rc = sc_png_write(path, s->conv.width, s->conv.height, 1u, s->raster, s->conv.width);

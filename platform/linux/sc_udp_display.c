@@ -187,7 +187,24 @@ static int udp_frame_begin(void *ctx, const sc_display_frame_info *info)
     }
     u->in_frame = 1;
     u->frames++;
-    const int rq = queue(u, SC_DLINK_FRAME_BEGIN, len);
+    int rq = queue(u, SC_DLINK_FRAME_BEGIN, len);
+    if (info->dynamic_range_db > 0.0f) {
+        /* the display's imaging parameters (FRAME_PARAMS, an additive extension) */
+        sc_dlink_params p = {.gain_db = info->gain_db,
+                             .dynamic_range_db = info->dynamic_range_db,
+                             .focus_mm = info->focus_mm,
+                             .frequency_mhz = info->frequency_mhz};
+        for (uint32_t i = 0; i < SC_DLINK_PARAMS_TGC; i++) {
+            p.tgc_db[i] = info->tgc_db[i];
+        }
+        len = sc_dlink_encode_params(u->q_pkt[u->queued], SC_DLINK_MAX_PACKET, &u->frame, &p);
+        if (len > 0) {
+            const int rp = queue(u, SC_DLINK_FRAME_PARAMS, len);
+            rq = rq != 0 ? rq : rp;
+        } else {
+            u->protocol_errors++;
+        }
+    }
     return rq != 0 ? rq : rc;
 }
 

@@ -559,6 +559,26 @@ static void imaging_flags_round_trip_and_unknown_bits_are_refused(void **state)
     assert_int_equal(sc_case_load(g_buf, n, &c), SC_ERR_CASE_RESERVED);
 }
 
+static void usable_depth_round_trips_zero_means_not_stated_and_bad_values_are_refused(void **state)
+{
+    (void)state;
+    sc_case_def d = make_def();
+    sc_case c;
+    size_t n = write_def(&d, g_buf);
+    assert_int_equal(sc_case_load(g_buf, n, &c), SC_OK);
+    assert_true(fabsf(c.usable_depth_mm) < 1e-6f); /* a file of before the field: not stated */
+    d.usable_depth_mm = 39.0f;
+    n = write_def(&d, g_buf);
+    assert_int_equal(sc_case_load(g_buf, n, &c), SC_OK);
+    assert_true(fabsf(c.usable_depth_mm - 39.0f) < 1e-6f);
+    static const float bad[] = {-1.0f, 4.9f, 500.5f, INFINITY, NAN};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        d.usable_depth_mm = bad[i];
+        n = write_def(&d, g_buf);
+        assert_int_equal(sc_case_load(g_buf, n, &c), SC_ERR_CASE_DEPTH);
+    }
+}
+
 static void header_magic_version_and_section_table_errors_are_named(void **state)
 {
     (void)state;
@@ -732,6 +752,7 @@ int main(void)
         cmocka_unit_test(mesh_node_counts_outside_limits_are_refused),
         cmocka_unit_test(non_finite_or_non_rigid_transforms_are_refused),
         cmocka_unit_test(imaging_flags_round_trip_and_unknown_bits_are_refused),
+        cmocka_unit_test(usable_depth_round_trips_zero_means_not_stated_and_bad_values_are_refused),
         cmocka_unit_test(header_magic_version_and_section_table_errors_are_named),
         cmocka_unit_test(unterminated_or_control_character_text_is_refused),
         cmocka_unit_test(writer_refuses_small_buffers_and_null_volumes),

@@ -369,6 +369,57 @@ static void complete_frames_assemble_without_loss(void **state)
     assert_int_equal(g_asm.stats.lines_lost + g_asm.stats.lines_late + g_asm.stats.rejected, 0u);
 }
 
+/* FRAME_PARAMS (the display's imaging parameters, an additive extension): round trip, the
+ * assembler keeps them for the frame and the frames after, values out of range refused. */
+static void frame_params_round_trip_reach_the_closed_frame_and_are_range_checked(void **state)
+{
+    (void)state;
+    sc_dlink_asm_init(&g_asm);
+    sender s = {.f = {.frame_no = 1u, .flags = 1u, .line_count = 4u, .samples = 16u}};
+    sc_dlink_params p = {.gain_db = 6.0f, .dynamic_range_db = 60.0f, .focus_mm = 20.0f,
+                         .frequency_mhz = 7.5f};
+    for (uint32_t i = 0; i < SC_DLINK_PARAMS_TGC; i++) {
+        p.tgc_db[i] = 1.5f * (float)i;
+    }
+    assert_int_equal(push_begin(&s), 0);
+    int n = sc_dlink_encode_params(s.buf, sizeof s.buf, &s.f, &p);
+    assert_int_equal(n, (int)(SC_DLINK_HEADER_SIZE + SC_DLINK_PARAMS_PAYLOAD));
+    sc_dlink_header h;
+    const uint8_t *pl = NULL;
+    assert_int_equal(sc_dlink_decode(s.buf, (size_t)n, &h, &pl), 0);
+    assert_int_equal(h.type, SC_DLINK_FRAME_PARAMS);
+    sc_dlink_params q;
+    sc_dlink_parse_params(pl, &q);
+    assert_memory_equal(&p, &q, sizeof p);
+    assert_int_equal(sc_dlink_asm_push(&g_asm, s.buf, (size_t)n), 0);
+    for (uint16_t i = 0; i < 4u; i++) {
+        assert_int_equal(push_line(&s, i), 0);
+    }
+    assert_int_equal(push_end(&s, 4u), 1);
+    const sc_dlink_done *d = sc_dlink_asm_done(&g_asm);
+    assert_true(d->params_known);
+    assert_memory_equal(&d->params, &p, sizeof p);
+    /* the next frame without FRAME_PARAMS keeps the last ones */
+    s.f.frame_no = 2u;
+    assert_int_equal(push_begin(&s), 0);
+    assert_int_equal(push_end(&s, 0u), 1);
+    assert_true(sc_dlink_asm_done(&g_asm)->params_known);
+    assert_true(fabsf(sc_dlink_asm_done(&g_asm)->params.focus_mm - 20.0f) < 1e-6f);
+    /* ranges */
+    sc_dlink_params bad = p;
+    bad.dynamic_range_db = 130.0f;
+    assert_int_equal(sc_dlink_encode_params(s.buf, sizeof s.buf, &s.f, &bad), SC_ERR_DLINK_FIELD);
+    bad = p;
+    bad.tgc_db[7] = NAN;
+    assert_int_equal(sc_dlink_encode_params(s.buf, sizeof s.buf, &s.f, &bad), SC_ERR_NOT_FINITE);
+    /* a NaN written on the wire with a valid CRC: refused by the decoder */
+    n = sc_dlink_encode_params(s.buf, sizeof s.buf, &s.f, &p);
+    const float nan_v = NAN;
+    memcpy(s.buf + SC_DLINK_HEADER_SIZE + 8u, &nan_v, sizeof nan_v);
+    refresh_crc(s.buf, (size_t)n);
+    assert_int_equal(sc_dlink_decode(s.buf, (size_t)n, &h, &pl), SC_ERR_DLINK_FIELD);
+}
+
 static void dropped_lines_are_counted_exactly_and_show_the_previous_row(void **state)
 {
     (void)state;
@@ -514,6 +565,7 @@ int main(void)
         cmocka_unit_test(begin_and_end_payload_fields_are_range_checked),
         cmocka_unit_test(encoders_refuse_out_of_range_fields_and_small_buffers),
         cmocka_unit_test(complete_frames_assemble_without_loss),
+        cmocka_unit_test(frame_params_round_trip_reach_the_closed_frame_and_are_range_checked),
         cmocka_unit_test(dropped_lines_are_counted_exactly_and_show_the_previous_row),
         cmocka_unit_test(late_duplicate_and_missing_markers_are_counted),
         cmocka_unit_test(frame_numbers_wrap_and_a_restarted_sender_resynchronises),

@@ -15,7 +15,14 @@
 
 static void send_frame(sc_display_dev *d, uint32_t no, uint16_t lines, int skip_line)
 {
-    const sc_display_frame_info info = {no, lines, 64u, 0u, 0u, 40.0f, 38.0f, 0.0f};
+    const sc_display_frame_info info = {.frame_no = no,
+                                        .lines = lines,
+                                        .samples = 64u,
+                                        .geometry_id = 0u,
+                                        .flags = 0u,
+                                        .depth_mm = 40.0f,
+                                        .width_mm = 38.0f,
+                                        .radius_mm = 0.0f};
     uint8_t s[64];
     assert_int_equal(sc_display_frame_begin(d, &info), 0);
     for (uint16_t l = 0; l < lines; l++) {
@@ -122,9 +129,23 @@ static void protocol_violations_are_refused(void **state)
     sc_display_dev d = sc_png_sink_dev(s);
     uint8_t smp[8] = {0};
     assert_int_equal(sc_display_line(&d, 1u, 0u, smp, 8u), SC_ERR_STATE);
-    const sc_display_frame_info bad = {1u, 0u, 8u, 0u, 0u, 40.0f, 38.0f, 0.0f};
+    const sc_display_frame_info bad = {.frame_no = 1u,
+                                       .lines = 0u,
+                                       .samples = 8u,
+                                       .geometry_id = 0u,
+                                       .flags = 0u,
+                                       .depth_mm = 40.0f,
+                                       .width_mm = 38.0f,
+                                       .radius_mm = 0.0f};
     assert_int_equal(sc_display_frame_begin(&d, &bad), SC_ERR_RANGE);
-    const sc_display_frame_info ok = {1u, 4u, 8u, 0u, 0u, 40.0f, 38.0f, 0.0f};
+    const sc_display_frame_info ok = {.frame_no = 1u,
+                                      .lines = 4u,
+                                      .samples = 8u,
+                                      .geometry_id = 0u,
+                                      .flags = 0u,
+                                      .depth_mm = 40.0f,
+                                      .width_mm = 38.0f,
+                                      .radius_mm = 0.0f};
     assert_int_equal(sc_display_frame_begin(&d, &ok), 0);
     assert_int_equal(sc_display_line(&d, 1u, 4u, smp, 8u), SC_ERR_STATE);
     assert_int_equal(sc_display_line(&d, 1u, 0u, smp, 7u), SC_ERR_STATE);

@@ -60,7 +60,14 @@ static uint32_t drain(int fd)
 
 static void send_frame(sc_display_dev *dev, uint32_t frame_no, uint16_t lines, uint16_t samples)
 {
-    const sc_display_frame_info info = {frame_no, lines, samples, 0u, 1u, 40.0f, 38.0f, 0.0f};
+    const sc_display_frame_info info = {.frame_no = frame_no,
+                                        .lines = lines,
+                                        .samples = samples,
+                                        .geometry_id = 0u,
+                                        .flags = 1u,
+                                        .depth_mm = 40.0f,
+                                        .width_mm = 38.0f,
+                                        .radius_mm = 0.0f};
     uint8_t s[SC_MAX_SCAN_SAMPLES];
     (void)sc_display_frame_begin(dev, &info);
     for (uint16_t l = 0; l < lines; l++) {
@@ -168,7 +175,14 @@ static void calls_out_of_order_are_refused_and_counted(void **state)
     uint8_t s[16] = {0};
     assert_int_equal(sc_display_line(&dev, 1u, 0u, s, 16u), SC_ERR_STATE);
     assert_int_equal(sc_display_frame_end(&dev, SC_DISPLAY_END_PLAIN(1u)), SC_ERR_STATE);
-    const sc_display_frame_info info = {1u, 4u, 16u, 0u, 0u, 40.0f, 38.0f, 0.0f};
+    const sc_display_frame_info info = {.frame_no = 1u,
+                                        .lines = 4u,
+                                        .samples = 16u,
+                                        .geometry_id = 0u,
+                                        .flags = 0u,
+                                        .depth_mm = 40.0f,
+                                        .width_mm = 38.0f,
+                                        .radius_mm = 0.0f};
     assert_int_equal(sc_display_frame_begin(&dev, &info), 0);
     assert_int_equal(sc_display_line(&dev, 1u, 4u, s, 16u), SC_ERR_DLINK_FIELD);
     assert_int_equal(sc_display_line(&dev, 1u, 0u, s, 15u), SC_ERR_DLINK_FIELD);
@@ -272,7 +286,14 @@ static void lines_wait_in_the_batch_until_it_is_full_or_the_frame_ends(void **st
     def.batch_packets = 8u;
     assert_int_equal(sc_udp_display_open(&u, &def), 0);
     sc_display_dev dev = sc_udp_display_dev(&u);
-    const sc_display_frame_info info = {3u, 20u, 16u, 0u, 0u, 40.0f, 38.0f, 0.0f};
+    const sc_display_frame_info info = {.frame_no = 3u,
+                                        .lines = 20u,
+                                        .samples = 16u,
+                                        .geometry_id = 0u,
+                                        .flags = 0u,
+                                        .depth_mm = 40.0f,
+                                        .width_mm = 38.0f,
+                                        .radius_mm = 0.0f};
     uint8_t s[16] = {0};
     assert_int_equal(sc_display_frame_begin(&dev, &info), 0);
     for (uint16_t l = 0; l < 6u; l++) {
@@ -390,7 +411,14 @@ static void frame_end_is_tried_once_more_alone_when_its_batch_did_not_all_go(voi
     assert_true(dup2(sv[0], u.fd) == u.fd);
     close(sv[0]);
     sc_display_dev dev = sc_udp_display_dev(&u);
-    const sc_display_frame_info info = {9u, 40u, 64u, 0u, 0u, 40.0f, 38.0f, 0.0f};
+    const sc_display_frame_info info = {.frame_no = 9u,
+                                        .lines = 40u,
+                                        .samples = 64u,
+                                        .geometry_id = 0u,
+                                        .flags = 0u,
+                                        .depth_mm = 40.0f,
+                                        .width_mm = 38.0f,
+                                        .radius_mm = 0.0f};
     uint8_t s[64] = {0};
     assert_int_equal(sc_display_frame_begin(&dev, &info), 0);
     for (uint16_t l = 0; l < 40u; l++) {
@@ -432,7 +460,14 @@ static void refused_destination_takes_the_link_down_until_a_receiver_appears(voi
     sc_display_dev dev = sc_udp_display_dev(&u);
     /* one batch: BEGIN goes, its ICMP error refuses the next packet and sendmmsg stops there;
      * the error is consumed, so FRAME_END sent again alone goes (to nobody) */
-    const sc_display_frame_info info = {0u, 40u, 64u, 0u, 0u, 40.0f, 38.0f, 0.0f};
+    const sc_display_frame_info info = {.frame_no = 0u,
+                                        .lines = 40u,
+                                        .samples = 64u,
+                                        .geometry_id = 0u,
+                                        .flags = 0u,
+                                        .depth_mm = 40.0f,
+                                        .width_mm = 38.0f,
+                                        .radius_mm = 0.0f};
     uint8_t s[64] = {0};
     assert_int_equal(sc_display_frame_begin(&dev, &info), 0);
     for (uint16_t l = 0; l < 40u; l++) {

@@ -3,7 +3,11 @@
  * compression (a 10 mm dent of the generated scene); and PNGs of compression sweeps.
  *
  * Usage: bench_bscan [png_dir] [frames]     (defaults: bscan_png, 40)
- * Prints a table; run it from a Release build (build/bscan-rel).
+ *        bench_bscan contact [cases_dir] [case] [frames] [msds|fem]
+ *                    the engine's contact case (bench_contact.c): a host-simulated engine
+ *                    presses a built case (default neck-ijv from the build's cases folder) and
+ *                    the deformed mesh at the deepest point of the press script is imaged
+ * Prints a table; run it from a Release build (build/release).
  */
 #define _POSIX_C_SOURCE 200809L
 #include <png.h>
@@ -13,6 +17,7 @@
 #include <sys/stat.h>
 #include <time.h>
 
+#include "bench_contact.h"
 #include "bscan_scene.h"
 #include "sc_bscan.h"
 #include "sc_err.h"
@@ -207,6 +212,15 @@ static void print_acoustics_row(const sc_xform *probe, int frames)
 
 int main(int argc, char **argv)
 {
+    if (argc > 1 && strcmp(argv[1], "contact") == 0) {
+        const char *cases = argc > 2 ? argv[2] : SC_DEFAULT_CASES_DIR;
+        const char *name = argc > 3 ? argv[3] : "neck-ijv";
+        const int n = argc > 4 ? atoi(argv[4]) : 40;
+        const int method =
+            argc > 5 ? (strcmp(argv[5], "fem") == 0 ? (int)SC_TISSUE_FEM : (int)SC_TISSUE_MSDS)
+                     : -1;
+        return bench_contact_run(cases, name, method, n > 0 ? n : 40);
+    }
     const char *dir = argc > 1 ? argv[1] : "bscan_png";
     const int frames = argc > 2 ? atoi(argv[2]) : 40;
     scn_make_volume(&g_vol);

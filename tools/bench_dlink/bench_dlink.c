@@ -278,8 +278,14 @@ int main(int argc, char **argv)
                 while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) == EINTR) {
                 }
             }
-            const sc_display_frame_info info = {
-                f, (uint16_t)lines, (uint16_t)samples, 0u, 1u, 40.0f, 38.0f, 0.0f};
+            const sc_display_frame_info info = {.frame_no = f,
+                                                .lines = (uint16_t)lines,
+                                                .samples = (uint16_t)samples,
+                                                .geometry_id = 0u,
+                                                .flags = 1u,
+                                                .depth_mm = 40.0f,
+                                                .width_mm = 38.0f,
+                                                .radius_mm = 0.0f};
             const uint64_t c0 = now_ns(CLOCK_THREAD_CPUTIME_ID), w0 = now_ns(CLOCK_MONOTONIC);
             (void)sc_display_frame_begin(&dev, &info);
             for (unsigned l = 0; l < lines; l++) {

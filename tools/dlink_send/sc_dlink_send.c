@@ -157,14 +157,14 @@ int main(int argc, char **argv)
         /* compression: 0 .. 1 .. 0 over 2 s */
         const double t = (double)f / rate;
         const float comp = (float)(0.5 - 0.5 * cos(t * M_PI));
-        const sc_display_frame_info info = {(uint32_t)f,
-                                            (uint16_t)lines,
-                                            (uint16_t)samples,
-                                            (uint16_t)curvilinear,
-                                            (uint16_t)(comp > 0.05f ? 1u : 0u),
-                                            curvilinear ? 80.0f : 40.0f,
-                                            curvilinear ? 60.0f : 38.0f,
-                                            curvilinear ? 40.0f : 0.0f};
+        const sc_display_frame_info info = {.frame_no = (uint32_t)f,
+                                            .lines = (uint16_t)lines,
+                                            .samples = (uint16_t)samples,
+                                            .geometry_id = (uint16_t)curvilinear,
+                                            .flags = (uint16_t)(comp > 0.05f ? 1u : 0u),
+                                            .depth_mm = curvilinear ? 80.0f : 40.0f,
+                                            .width_mm = curvilinear ? 60.0f : 38.0f,
+                                            .radius_mm = curvilinear ? 40.0f : 0.0f};
         sc_display_frame_begin(&dev, &info);
         for (unsigned l = 0; l < lines; l++) {
             make_line(buf, (uint32_t)f, l, lines, samples, comp);

@@ -25,6 +25,7 @@
 #include "sc_config.h"
 #include "sc_err.h"
 #include "sc_kms_display.h"
+#include "sc_scan_overlay.h"
 #include "sc_scanconv.h"
 
 typedef struct frame {
@@ -195,6 +196,7 @@ static int compare(const char *frame_path, const char *ppm_path)
         return 2;
     }
     sc_scanconv_render(&c, &f.info, f.data, f.info.samples, want);
+    sc_overlay_draw(want, w, h, &f.info); /* the sink draws the scanner's display items too */
     uint64_t off = 0, nonzero = 0;
     int maxd = 0;
     for (size_t i = 0; i < (size_t)w * h; i++) {

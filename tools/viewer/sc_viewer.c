@@ -38,6 +38,8 @@
 #include "sc_dlink.h"
 #include "sc_err.h"
 #include "sc_png_write.h"
+#include "sc_scan_overlay.h"
+#include "vw_cine.h"
 #include "sc_scanconv.h"
 #include "vw_gif.h"
 #include "vw_overlay.h"
@@ -281,10 +283,28 @@ static void render_free(vw_render *r)
 
 static void render_frame(vw_render *r, const sc_dlink_done *d, double fps, uint64_t lost_total)
 {
-    const sc_display_frame_info info = {
-        d->frame.frame_no, d->frame.line_count, d->frame.samples,  d->frame.geometry_id,
-        d->frame.flags,    d->begin.depth_mm,   d->begin.width_mm, d->begin.radius_mm};
+    sc_display_frame_info info = {.frame_no = d->frame.frame_no,
+                                  .lines = d->frame.line_count,
+                                  .samples = d->frame.samples,
+                                  .geometry_id = d->frame.geometry_id,
+                                  .flags = d->frame.flags,
+                                  .depth_mm = d->begin.depth_mm,
+                                  .width_mm = d->begin.width_mm,
+                                  .radius_mm = d->begin.radius_mm};
+    if (d->params_known) { /* FRAME_PARAMS: the readout and the focus marker */
+        info.gain_db = d->params.gain_db;
+        info.dynamic_range_db = d->params.dynamic_range_db;
+        info.focus_mm = d->params.focus_mm;
+        info.frequency_mhz = d->params.frequency_mhz;
+        for (uint32_t i = 0; i < SC_DLINK_PARAMS_TGC && i < SC_DISPLAY_TGC_BANDS; i++) {
+            info.tgc_db[i] = d->params.tgc_db[i];
+        }
+    }
     sc_scanconv_render(&r->conv, &info, d->image, SC_MAX_SCAN_SAMPLES, r->grey);
+    /* the scanner's display items below the viewer's own band (sc_scan_overlay.h: depth
+     * scale, orientation, probe type; what the link does not carry is left out) */
+    const int band_px = (r->w >= 400u ? 2 : 1) * 9 * 2 + 4;
+    sc_overlay_draw_below(r->grey, r->w, r->h, &info, band_px);
     const size_t n = (size_t)r->w * r->h;
     for (size_t i = 0; i < n; i++) {
         r->index[i] = vw_grey_index(r->grey[i]);
@@ -321,6 +341,57 @@ static void render_frame(vw_render *r, const sc_dlink_done *d, double fps, uint6
     }
 }
 
+/* ---- freeze, cine loop, calipers (window only) ------------------------------------------- */
+
+/* The viewer's cine loop: the last VW_CINE_FRAMES frames (2 s at 60 Hz). */
+#define VW_CINE_FRAMES 120u
+
+typedef struct vw_freeze {
+    vw_cine cine;
+    int frozen;
+    uint32_t back; /* cine position: frames before the newest */
+    int cal_n;     /* caliper points set (0..2) */
+    double cal[2][2];
+} vw_freeze;
+
+#ifdef SC_VIEWER_SDL
+/* A frozen cine frame with the calipers and their distance in mm. */
+static void render_frozen(vw_render *r, vw_freeze *fz)
+{
+    const sc_dlink_done *d = vw_cine_get(&fz->cine, fz->back);
+    if (d == NULL) {
+        return;
+    }
+    render_frame(r, d, 0.0, 0u);
+    const int sc = r->w >= 400u ? 2 : 1;
+    char t[96];
+    snprintf(t, sizeof t, "FROZEN  CINE -%u/%u", (unsigned)fz->back, (unsigned)fz->cine.count);
+    vw_text(r->index, r->w, r->h, 4, (int)r->h - 10 * sc, sc, VW_COL_WARN, t);
+    for (int i = 0; i < fz->cal_n; i++) {
+        vw_fill_rect(r->index, r->w, r->h, (int)fz->cal[i][0] - 3, (int)fz->cal[i][1], 7, 1,
+                     VW_COL_VESSEL);
+        vw_fill_rect(r->index, r->w, r->h, (int)fz->cal[i][0], (int)fz->cal[i][1] - 3, 1, 7,
+                     VW_COL_VESSEL);
+    }
+    if (fz->cal_n == 2) {
+        const sc_display_frame_info info = {.lines = d->frame.line_count,
+                                            .samples = d->frame.samples,
+                                            .geometry_id = d->frame.geometry_id,
+                                            .depth_mm = d->begin.depth_mm,
+                                            .width_mm = d->begin.width_mm,
+                                            .radius_mm = d->begin.radius_mm};
+        const double mm = vw_caliper_mm(&info, r->w, r->h, fz->cal[0][0], fz->cal[0][1],
+                                        fz->cal[1][0], fz->cal[1][1]);
+        snprintf(t, sizeof t, "DIST %.1f MM", mm);
+        vw_text(r->index, r->w, r->h, 4, (int)r->h - 20 * sc, sc, VW_COL_VESSEL, t);
+    }
+    const size_t n = (size_t)r->w * r->h;
+    for (size_t i = 0; i < n; i++) {
+        memcpy(r->rgb + 3u * i, r->palette + 3u * r->index[i], 3u);
+    }
+}
+#endif
+
 /* ---- main ------------------------------------------------------------------------------- */
 
 static void usage(FILE *f)
@@ -346,6 +417,9 @@ static void usage(FILE *f)
                "  -q, --quiet           no per-second status on stderr\n"
                "  -h, --help            this help\n"
                "  -V, --version         version\n\n"
+               "Window keys: space freezes (and unfreezes) the image; while frozen, left /\n"
+               "right step back / forward through the cine loop of the last 120 frames and\n"
+               "two mouse clicks set calipers (distance in mm); Esc or q quits.\n"
                "At exit prints one line of key=value statistics on stdout.\n"
                "Exit status: 0 ok, 1 runtime error, 2 usage error.\n");
 }
@@ -558,6 +632,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "sc-viewer: out of memory\n");
         return 1;
     }
+    static vw_freeze fz; /* window: space freezes, left/right step the cine, clicks: calipers */
+    const int cine_ok = o.headless ? 0 : vw_cine_init(&fz.cine, VW_CINE_FRAMES) == 0;
     vw_gif gif;
     int gif_open = 0;
     if (o.gif_path) {
@@ -658,6 +734,9 @@ int main(int argc, char **argv)
                 fps_n = 0;
                 fps_t = t;
             }
+            if (cine_ok && !fz.frozen) {
+                vw_cine_push(&fz.cine, &local.done);
+            }
             if (need_render) {
                 render_frame(&r, &local.done, fps, lost_total);
                 have_frame = 1;
@@ -683,7 +762,7 @@ int main(int argc, char **argv)
                 }
             }
 #ifdef SC_VIEWER_SDL
-            if (tex) {
+            if (tex && !fz.frozen) {
                 SDL_UpdateTexture(tex, NULL, r.rgb, (int)(r.w * 3u));
                 SDL_RenderClear(ren);
                 SDL_RenderCopy(ren, tex, NULL, NULL);
@@ -694,12 +773,38 @@ int main(int argc, char **argv)
 #ifdef SC_VIEWER_SDL
         if (win) {
             SDL_Event ev;
+            int redraw = 0;
             while (SDL_PollEvent(&ev)) {
                 if (ev.type == SDL_QUIT ||
                     (ev.type == SDL_KEYDOWN &&
                      (ev.key.keysym.sym == SDLK_ESCAPE || ev.key.keysym.sym == SDLK_q))) {
                     g_signal = SIGINT;
+                } else if (cine_ok && ev.type == SDL_KEYDOWN && ev.key.keysym.sym == SDLK_SPACE) {
+                    fz.frozen = !fz.frozen && fz.cine.count > 0u;
+                    fz.back = 0u;
+                    fz.cal_n = 0;
+                    redraw = fz.frozen;
+                } else if (fz.frozen && ev.type == SDL_KEYDOWN &&
+                           (ev.key.keysym.sym == SDLK_LEFT || ev.key.keysym.sym == SDLK_RIGHT)) {
+                    fz.back =
+                        vw_cine_step(&fz.cine, fz.back, ev.key.keysym.sym == SDLK_LEFT ? 1 : -1);
+                    redraw = 1;
+                } else if (fz.frozen && ev.type == SDL_MOUSEBUTTONDOWN) {
+                    if (fz.cal_n == 2) {
+                        fz.cal_n = 0;
+                    }
+                    fz.cal[fz.cal_n][0] = ev.button.x;
+                    fz.cal[fz.cal_n][1] = ev.button.y;
+                    fz.cal_n++;
+                    redraw = 1;
                 }
+            }
+            if (redraw && tex) {
+                render_frozen(&r, &fz);
+                SDL_UpdateTexture(tex, NULL, r.rgb, (int)(r.w * 3u));
+                SDL_RenderClear(ren);
+                SDL_RenderCopy(ren, tex, NULL, NULL);
+                SDL_RenderPresent(ren);
             }
         }
 #endif
@@ -798,6 +903,9 @@ int main(int argc, char **argv)
     SDL_Quit();
 #endif
     render_free(&r);
+    if (cine_ok) {
+        vw_cine_free(&fz.cine);
+    }
     close(sh->fd);
     if (png_errors) {
         rc = 1;
