@@ -74,6 +74,7 @@
 #include "sc_hal.h"
 #include "sc_health.h"
 #include "sc_sched.h"
+#include "sc_state.h"
 #include "sc_status_tx.h"
 #include "sc_tissue.h"
 #include "sc_tracker.h"
@@ -136,6 +137,10 @@ typedef struct sc_engine_def {
     /* Case catalogue: catalogue index i (CmdSelectCase) names case_names[i] in storage. */
     const char *case_names[SC_ENGINE_MAX_CASES];
     uint32_t case_count;
+    /* Console state stream (sc_state.h, through hal->state when present): records at most
+     * every state_period_ms (0: off), state_vert_records surface-vertex records per period. */
+    uint32_t state_period_ms;
+    uint32_t state_vert_records;
 } sc_engine_def;
 
 typedef struct sc_engine_counters {
@@ -258,6 +263,9 @@ typedef struct sc_engine {
     uint32_t misses_unlogged; /* misses since then that got no line of their own */
     sc_engine_hook_fn hook;
     void *hook_user;
+#if SC_STATE_STREAM
+    sc_state_tx state_tx; /* console state stream (sc_state.h) */
+#endif
     sc_bscan bscan;
     sc_tissue tissue[SC_ENGINE_TISSUE_SLOTS]; /* the large ones last */
 } sc_engine;
@@ -313,5 +321,9 @@ const sc_bscan_status *sc_engine_get_bscan_status(const sc_engine *e);
 uint64_t sc_engine_next_release_ns(const sc_engine *e);
 /* This frame's probe as the rx stage produced it. */
 const sc_probe_in *sc_engine_get_probe(const sc_engine *e);
+#if SC_STATE_STREAM
+/* The state stream's counters (records sent, dropped). O(1). */
+const sc_state_tx *sc_engine_get_state_tx(const sc_engine *e);
+#endif
 
 #endif /* SC_ENGINE_H */
