@@ -26,6 +26,7 @@
 #include "sc_err.h"
 #include "sc_cpu.h"
 #include "sc_hs_faults.h"
+#include "sc_hs_live.h"
 #include "sc_hs_rig.h"
 #include "sc_labels.h"
 #include "sc_png_write.h"
@@ -60,6 +61,7 @@ typedef struct options {
     int point_set;
     float depth_mm;
     int quiet;
+    sc_hs_live_def live; /* --live, --can-udp, --state-udp, --dlink-udp, --state-out */
 } options;
 
 static void usage(FILE *f)
@@ -89,6 +91,14 @@ static void usage(FILE *f)
             "  --png-size WxH       PNG raster (default 480x640)\n"
             "  --frame-raw FILE     also write the deepest-compression frame as a raw frame file\n"
             "  --quiet              no per-second progress\n"
+            "  --live               release frames at wall-clock time (the engine keeps the\n"
+            "                       virtual clock) for the console gateway (tools/gateway)\n"
+            "  --can-udp PORT       CAN frames in over UDP on 127.0.0.1:PORT (sc_udpcan.h:\n"
+            "                       sc-tracker-emu --udp, the gateway's commands) instead of\n"
+            "                       the built-in emulator script\n"
+            "  --state-udp H:P      the console state stream to UDP H:P (docs/state-stream.md)\n"
+            "  --state-out FILE     the state stream's records into FILE (u16 length + record)\n"
+            "  --dlink-udp H:P      scan lines over the UDP display link to H:P as well\n"
             "  --help, --version\n");
 }
 
@@ -134,7 +144,8 @@ static int parse_args(int argc, char **argv, options *o)
     (void)sc_hs_fault_plan_parse("", &o->faults, NULL, 0);
     enum { O_CASE = 256, O_CASES_DIR, O_OUT, O_SCRIPT, O_CSV, O_SECONDS, O_METHOD, O_POINT,
            O_DEPTH, O_FD, O_FAULTS, O_SEED, O_RECORD, O_REPLAY, O_EVERY, O_PNG, O_RAW, O_QUIET,
-           O_HELP, O_VERSION, O_RX_COST };
+           O_HELP, O_VERSION, O_RX_COST, O_LIVE, O_CAN_UDP, O_STATE_UDP, O_STATE_OUT,
+           O_DLINK_UDP };
     static const struct option opts[] = {
         {"case", required_argument, 0, O_CASE},     {"cases-dir", required_argument, 0, O_CASES_DIR},
         {"out", required_argument, 0, O_OUT},       {"script", required_argument, 0, O_SCRIPT},
@@ -147,6 +158,10 @@ static int parse_args(int argc, char **argv, options *o)
         {"frame-raw", required_argument, 0, O_RAW}, {"quiet", no_argument, 0, O_QUIET},
         {"help", no_argument, 0, O_HELP},           {"version", no_argument, 0, O_VERSION},
         {"rx-cost-us", required_argument, 0, O_RX_COST},
+        {"live", no_argument, 0, O_LIVE},           {"can-udp", required_argument, 0, O_CAN_UDP},
+        {"state-udp", required_argument, 0, O_STATE_UDP},
+        {"state-out", required_argument, 0, O_STATE_OUT},
+        {"dlink-udp", required_argument, 0, O_DLINK_UDP},
         {0, 0, 0, 0}};
     int c;
     opterr = 0;
@@ -231,6 +246,31 @@ static int parse_args(int argc, char **argv, options *o)
             break;
         case O_RAW: o->frame_raw_path = optarg; break;
         case O_QUIET: o->quiet = 1; break;
+        case O_LIVE: o->live.pace = 1; break;
+        case O_CAN_UDP:
+            if (parse_u64(optarg, 65535u, &u) || u == 0u) {
+                fprintf(stderr, "sc-hostsim: --can-udp wants a port 1..65535, got '%s'\n", optarg);
+                return 2;
+            }
+            o->live.can_port = (uint16_t)u;
+            break;
+        case O_STATE_UDP:
+        case O_DLINK_UDP: {
+            char host[256];
+            uint16_t port;
+            if (sc_udp_parse_target(optarg, host, sizeof host, &port) != 0) {
+                fprintf(stderr, "sc-hostsim: --%s wants HOST:PORT or PORT, got '%s'\n",
+                        c == O_STATE_UDP ? "state-udp" : "dlink-udp", optarg);
+                return 2;
+            }
+            if (c == O_STATE_UDP) {
+                o->live.state_target = optarg;
+            } else {
+                o->live.dlink_target = optarg;
+            }
+            break;
+        }
+        case O_STATE_OUT: o->live.state_file = optarg; break;
         case O_HELP: usage(stdout); return -1;
         case O_VERSION: printf("sc-hostsim %s\n", SC_HOSTSIM_VERSION); return -1;
         default:
@@ -241,6 +281,10 @@ static int parse_args(int argc, char **argv, options *o)
     }
     if (optind != argc) {
         fprintf(stderr, "sc-hostsim: unexpected argument '%s'\n", argv[optind]);
+        return 2;
+    }
+    if (o->live.can_port && (o->replay_path || o->csv_path)) {
+        fprintf(stderr, "sc-hostsim: --can-udp cannot be combined with --replay or --csv\n");
         return 2;
     }
     if (o->replay_path && (o->csv_path || o->record_path)) {
@@ -374,6 +418,7 @@ static sc_emu emu;
 static sc_emu_row csv_rows[100000];
 
 static sc_hs_fault_run faults;
+static sc_hs_live live;
 
 /* sc_emu_send_fn over a CAN device (the simulated tracker node); a silence episode discards */
 static int send_peer(void *ctx, const sc_can_frame *f)
@@ -545,12 +590,35 @@ int main(int argc, char **argv)
         fprintf(stderr, "sc-hostsim: no bus node left for the flood\n");
         return 1;
     }
-    const uint32_t frames = (uint32_t)ceil(o.seconds * 1e9 / (double)period);
+    const int live_on = o.live.pace || o.live.can_port || o.live.state_target ||
+                        o.live.dlink_target || o.live.state_file;
+    if (live_on) {
+        char why[256];
+        if (sc_hs_live_open(&live, &o.live, &rig, why, sizeof why) != SC_OK) {
+            fprintf(stderr, "sc-hostsim: %s\n", why);
+            return 1;
+        }
+        if (o.live.pace) {
+            printf("sc-hostsim: live, case %s, %.0f s at most (SIGINT/SIGTERM stop)\n", case_name,
+                   o.seconds);
+            fflush(stdout);
+        }
+    }
+    uint32_t frames = (uint32_t)ceil(o.seconds * 1e9 / (double)period);
     for (uint32_t i = 0; i < frames; i++) {
         /* release time of the frame about to run */
         const uint64_t release = sc_engine_next_release_ns(&rig.engine);
         sc_hs_fault_run_before(&faults, release);
-        if (replay) {
+        if (live_on) {
+            sc_hs_live_before_frame(&live, &rig, release);
+            if (sc_hs_live_stop()) {
+                frames = i;
+                break;
+            }
+        }
+        if (o.live.can_port) {
+            /* the probe and the commands come in over UDP */
+        } else if (replay) {
             for (;;) {
                 if (!have_pending) {
                     int r = sc_candump_reader_next(&reader, &pending);
@@ -743,9 +811,15 @@ int main(int argc, char **argv)
         if (rec.fp) {
             fprintf(f, "recorded        %" PRIu64 " frames to %s\n", rec.frames, o.record_path);
         }
+        if (live_on) {
+            sc_hs_live_summary(&live, &rig, f);
+        }
     }
     if (sf) {
         fclose(sf);
+    }
+    if (live_on) {
+        sc_hs_live_close(&live);
     }
     sc_scanconv_free(&conv);
     free(raster);
