@@ -165,6 +165,13 @@ static uint32_t emit_surf_info(sc_state_tx *t, const sc_state_dev *dev, const sc
         put_u32(&w, 0u);
     }
     put_text(&w, in->c->name, 64u);
+    /* the probe calibration (image -> probe), so a view can place the image plane */
+    for (int i = 0; i < 9; i++) {
+        put_f32(&w, in->c->image_to_probe.r[i]);
+    }
+    for (int i = 0; i < 3; i++) {
+        put_f32(&w, in->c->image_to_probe.t_mm[i]);
+    }
     return finish(t, dev, &w, in->frame_no);
 }
 
