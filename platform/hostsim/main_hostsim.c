@@ -729,8 +729,8 @@ int main(int argc, char **argv)
                 cs->mesh.nx, cs->mesh.ny, cs->mesh.nz, tis ? tis->mesh.node_count : 0u,
                 tis ? tis->mesh.tet_count : 0u);
         fprintf(f, "probe           %s%s, %.2f s simulated, %u frames at %u Hz\n",
-                replay ? "replay of " : (o.csv_path ? "csv " : "script "),
-                replay ? o.replay_path : (o.csv_path ? o.csv_path : o.script), o.seconds,
+                o.live.can_port ? "CAN over UDP, " : (replay ? "replay of " : (o.csv_path ? "csv " : "script ")),
+                o.live.can_port ? "live" : (replay ? o.replay_path : (o.csv_path ? o.csv_path : o.script)), o.seconds,
                 frames, def.sched.rate_hz);
         fprintf(f, "method          %s\n", st.method == SC_TISSUE_FEM ? "fem" : "msds");
         fprintf(f, "display         %" PRIu64 " complete frames, %" PRIu64

@@ -458,7 +458,15 @@ static int on_writeable(struct lws *wsi, client *cl)
     }
     pthread_mutex_lock(&g.lock);
     int rc = 0, more = 0;
-    if (cl->cat_gen != g.cat_gen) {
+    const double t = now_s();
+    const int bscan_due = cl->bscan_gen != g.bscan_gen && g.bscan_len > 0u;
+    if (bscan_due && t - cl->bscan_t >= 1.0 / opt.bscan_hz) {
+        /* the newest frame goes first when due: records never starve the image */
+        cl->bscan_gen = g.bscan_gen;
+        cl->bscan_t = t;
+        rc = write_msg(wsi, cl, g.bscan, g.bscan_len, LWS_WRITE_BINARY);
+        more = cl->next_rec < g.ring_head || cl->cat_gen != g.cat_gen;
+    } else if (cl->cat_gen != g.cat_gen) {
         cl->cat_gen = g.cat_gen;
         rc = write_msg(wsi, cl, g.cat_json, strlen(g.cat_json), LWS_WRITE_TEXT);
         more = 1;
@@ -472,15 +480,9 @@ static int on_writeable(struct lws *wsi, client *cl)
         cl->next_rec++;
         more = cl->next_rec < g.ring_head;
     }
-    const double t = now_s();
-    if (rc == 0 && !more && cl->bscan_gen != g.bscan_gen && g.bscan_len > 0u) {
-        if (t - cl->bscan_t >= 1.0 / opt.bscan_hz) {
-            cl->bscan_gen = g.bscan_gen;
-            cl->bscan_t = t;
-            rc = write_msg(wsi, cl, g.bscan, g.bscan_len, LWS_WRITE_BINARY);
-        } else {
-            lws_set_timer_usecs(wsi, (lws_usec_t)((1.0 / opt.bscan_hz - (t - cl->bscan_t)) * 1e6) + 1000);
-        }
+    if (rc == 0 && !more && bscan_due && cl->bscan_gen != g.bscan_gen) {
+        /* a newer frame waits for its turn: wake up then */
+        lws_set_timer_usecs(wsi, (lws_usec_t)((1.0 / opt.bscan_hz - (t - cl->bscan_t)) * 1e6) + 1000);
     }
     pthread_mutex_unlock(&g.lock);
     if (rc == 0 && more) {
@@ -794,7 +796,7 @@ int main(int argc, char **argv)
     info.port = opt.port;
     info.mounts = &m;
     info.protocols = protocols;
-    info.options = LWS_SERVER_OPTION_HTTP_HEADERS_SECURITY_BEST_PRACTICES_ENFORCE;
+    info.options = 0; /* lws's "best practices" CSP would refuse the page's inline import map */
     lws_set_log_level(LLL_ERR, NULL);
     ctx = lws_create_context(&info);
     if (ctx == NULL) {

@@ -58,6 +58,7 @@ let trisSeen = null;  // Uint8Array(nt)
 let caseCrc = -1;
 let geomDirty = false;
 let fitted = false;
+let measuring = null; // the surface of the measurement view, when on
 
 function resetSurfaces(info) {
   for (const s of surfaces) { root.remove(s.mesh); s.mesh.geometry.dispose(); }
@@ -87,7 +88,7 @@ function rebuildIndex(s) {
   const idx = new Uint32Array(s.triCount * 3);
   for (let t = 0; t < s.triCount * 3; t++) idx[t] = triangles[s.firstTri * 3 + t] - s.first;
   s.mesh.geometry.setIndex(new THREE.BufferAttribute(idx, 1));
-  s.mesh.visible = s.kind !== 0 || $('show-skin').checked;
+  s.mesh.visible = measuring ? s === measuring : (s.kind !== 0 || $('show-skin').checked);
   s.indexDone = true;
 }
 
@@ -133,10 +134,12 @@ $('show-skin').onchange = () => { for (const s of surfaces) if (s.kind === 0) s.
 $('freeze').onchange = () => { sc.frozen = $('freeze').checked; };
 
 // A fixed view for measurements (tests, docs): orthographic, looking along the vessel's long
-// axis at rest, skin and probe hidden, only the vessel labelled `label` shown.
-window.scMeasureView = (label = 4) => {
+// axis at rest through a thin slab at its middle, skin and probe hidden, only the vessel
+// labelled `label` shown.
+window.scMeasureView = (label = 4, slabMm = 8) => {
   const s = surfaces.find((x) => x.kind === 1 && x.label === label);
   if (!s) return false;
+  measuring = s;
   for (const x of surfaces) x.mesh.visible = x === s;
   probe.visible = false;
   s.mesh.geometry.computeBoundingBox();
@@ -151,11 +154,15 @@ window.scMeasureView = (label = 4) => {
   const half = Math.max(size.z, along === 'x' ? size.y : size.x) * 0.8;
   const a = canvas.clientWidth / canvas.clientHeight;
   ortho.top = half; ortho.bottom = -half; ortho.left = -half * a; ortho.right = half * a;
+  // a slab 8 mm thick across the vessel where the probe presses (the middle of the case's
+  // mesh top, where the phantoms put their vessels): the section the probe flattens
+  ortho.near = 500 - slabMm / 2; ortho.far = 500 + slabMm / 2;
   ortho.updateProjectionMatrix();
   active = ortho;
   return true;
 };
 window.scNormalView = () => {
+  measuring = null;
   for (const s of surfaces) s.mesh.visible = s.indexDone && (s.kind !== 0 || $('show-skin').checked);
   probe.visible = true; active = camera;
 };
