@@ -36,8 +36,7 @@ size_t sc_fuzz_seed(uint32_t i, uint8_t *buf, size_t cap)
     static const char *const seeds[] = {
         "{\"op\":\"case\",\"id\":1}",
         "{\"op\":\"method\",\"value\":\"fem\"}",
-        "{\"op\":\"imaging\",\"depth_mm\":40,\"gain_db\":12.5,\"dyn_range_db\":60,"
-        "\"tgc_db_per_cm\":1,\"geometry\":\"linear\"}",
+        "{\"op\":\"imaging\",\"depth_mm\":40,\"gain_db\":12.5,\"dyn_range_db\":60,\"tgc_db_per_cm\":1,\"geometry\":\"linear\"}",
         "{\"op\":\"reset\",\"target\":\"tissue\"}",
         "{\"op\":\"auth\",\"pass\":\"in\\\"struct\\\\or\"}",
         " { \"op\" : \"ping\" } ",

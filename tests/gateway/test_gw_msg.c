@@ -51,8 +51,8 @@ static void bad_messages_are_refused_with_a_reason(void **state)
         "{\"op\":\"case\",\"id\":1,\"id\":2}",             /* duplicate key */
         "{\"op\":\"case\",\"id\":1,\"extra\":0}",          /* unknown key */
         "{\"op\":\"method\",\"value\":\"magic\"}",
-        "{\"op\":\"imaging\",\"depth_mm\":5000,\"gain_db\":0,\"dyn_range_db\":60,"
-        "\"tgc_db_per_cm\":0,\"geometry\":\"linear\"}",   /* depth outside the DBC range */
+        /* depth outside the DBC range */
+        "{\"op\":\"imaging\",\"depth_mm\":5000,\"gain_db\":0,\"dyn_range_db\":60,\"tgc_db_per_cm\":0,\"geometry\":\"linear\"}",
         "{\"op\":\"imaging\",\"depth_mm\":40}",             /* fields missing */
         "{\"op\":\"reset\",\"target\":\"engine\"}",
         "{\"op\":\"shutdown\"}",                           /* not a protocol command */
