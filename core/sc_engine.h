@@ -31,6 +31,9 @@
  *            line leaves through the display HAL as soon as it is computed, the frame's
  *            compression measure closes the display frame (hal/sc_hal_display.h).
  *   status   sc_image_out -> CAN status frames every status_period_ms (3 frames). O(1).
+ *            Then, when hal->state is present, the console state stream (sc_state.h): at most
+ *            every state_period_ms a few fixed records handed to the state device, never
+ *            waiting (O(state_vert_records x 112) vertex interpolations).
  *   control  between this frame and the next, in the frame's slack: the queued commands
  *            (O(SC_CAN_CMD_QUEUE_MAX)), then at most one slice of a pending case switch:
  *              open      the storage mapping, the file's framing (O(sections));
