@@ -22,10 +22,12 @@ const consoleDir = process.env.SC_CONSOLE_SRC; // tools/console (node_modules)
 mkdirSync(outDir, { recursive: true });
 
 function skip(why) { console.log(`SKIPPED: ${why}`); process.exit(77); }
-function fail(why) {
+async function fail(why) {
   console.log(`FAIL: ${why}`);
-  for (const p of procs) console.log(`--- ${p.name}:\n${p.out.slice(-1500)}`);
   cleanup();
+  // the programs' own reports (the engine's summary comes at its exit)
+  await Promise.race([Promise.all(procs.map((p) => stopped(p))), sleep(4000)]);
+  for (const p of procs) console.log(`--- ${p.name}:\n${p.out.slice(-2500)}`);
   process.exit(1);
 }
 function ok(what) { console.log(`ok: ${what}`); }
@@ -36,15 +38,15 @@ let playwright;
 try {
   playwright = createRequire(path.join(consoleDir, 'package.json'))('playwright-core');
 } catch (e) {
-  fail(`playwright-core not installed in ${consoleDir} (npm ci there; tools/install-deps.sh does it): ${e.message}`);
+  await fail(`playwright-core not installed in ${consoleDir} (npm ci there; tools/install-deps.sh does it): ${e.message}`);
 }
 for (const f of ['platform/hostsim/sc-hostsim', 'tools/gateway/sc-gateway', 'tools/tracker_emu/sc-tracker-emu', 'console/index.html', 'cases/neck-ijv.scase']) {
-  if (!existsSync(path.join(build, f))) fail(`${f} not built in ${build}`);
+  if (!existsSync(path.join(build, f))) await fail(`${f} not built in ${build}`);
 }
 
 const freeTcp = () => new Promise((res) => { const s = createServer(); s.listen(0, '127.0.0.1', () => { const p = s.address().port; s.close(() => res(p)); }); });
 const freeUdp = () => new Promise((res) => { const s = createSocket('udp4'); s.bind(0, '127.0.0.1', () => { const p = s.address().port; s.close(() => res(p)); }); });
-const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+function sleep(ms) { return new Promise((r) => setTimeout(r, ms)); }
 
 const procs = [];
 function start(name, args) {
@@ -57,14 +59,14 @@ function start(name, args) {
   return p;
 }
 function cleanup() { for (const p of procs) if (p.exitCode === null) p.kill('SIGTERM'); }
-const stopped = (p) => new Promise((res) => { if (p.exitCode !== null) res(); else p.on('exit', () => res()); });
+function stopped(p) { return new Promise((res) => { if (p.exitCode !== null) res(); else p.on('exit', () => res()); }); }
 
 async function waitFor(page, fn, arg, what, ms = 20000) {
   try {
     await page.waitForFunction(fn, arg, { timeout: ms, polling: 100 });
   } catch (e) {
     const st = await page.evaluate(() => JSON.stringify({ frame: window.sc?.frame, errors: window.sc?.errors })).catch(() => '?');
-    fail(`${what}: not within ${ms} ms (page state ${st})`);
+    await fail(`${what}: not within ${ms} ms (page state ${st})`);
   }
 }
 
@@ -88,7 +90,7 @@ try {
 const page = await browser.newPage({ viewport: { width: 1100, height: 700 } });
 page.on('pageerror', (e) => console.log(`page error: ${e.message}`));
 for (let i = 0; i < 50; i++) {
-  try { await page.goto(url); break; } catch (e) { await sleep(200); if (i === 49) fail(`gateway at ${url} not answering: ${gateway.out}`); }
+  try { await page.goto(url); break; } catch (e) { await sleep(200); if (i === 49) await fail(`gateway at ${url} not answering: ${gateway.out}`); }
 }
 await waitFor(page, () => window.sc?.frame?.caseLoaded === 1 && window.sc.catalogue.length === 3 && window.sc.bscanFrames > 0,
   null, 'the page shows the running engine (state stream, catalogue, B-scan)');
@@ -125,16 +127,24 @@ if (scenario === 'press') {
   await sleep(2500); // every triangle and vertex round has arrived
   const rest = await veinHeight('rest');
   ok(`vein at rest: ${rest.height} px high, ${rest.pixels} px`);
-  if (rest.height < 20) fail(`the vein is not visible at rest (${rest.height} px)`);
-  const emu = start('sc-tracker-emu', [path.join(build, 'tools/tracker_emu/sc-tracker-emu'), '--script', 'press',
-    '--udp', `127.0.0.1:${canPort}`, '--duration-s', '8', '--depth-mm', '10']);
+  if (rest.height < 20) await fail(`the vein is not visible at rest (${rest.height} px)`);
+  // the probe over the default point (tracker frame, beam down; the skin at z = 0): from 30 mm
+  // above to 2 mm above in 1 s, then slowly (2 mm/s) to 10 mm below the skin, held 6 s, lifted.
+  // Slowly, because the sanitizer build on a loaded host (chromium's software GL beside it) may
+  // run the engine at a fraction of real time: a fast press would reach it as a jump of the
+  // probe into the tissue in one frame instead of a press
+  const csv = path.join(outDir, 'press.csv');
+  const rows = [[0, 30], [0.5, 30], [1.5, 2], [7.5, -10], [13.5, -10], [14.5, 30]];
+  writeFileSync(csv, rows.map(([t, z]) => `${t},0,0,${z},0,1,0,0,${(Math.max(0, -z) * 0.5).toFixed(2)}`).join('\n') + '\n');
+  const emu = start('sc-tracker-emu', [path.join(build, 'tools/tracker_emu/sc-tracker-emu'), '--csv', csv,
+    '--udp', `127.0.0.1:${canPort}`]);
   await waitFor(page, () => window.sc.frame.contact === 1 && window.sc.frame.vein >= 0 && window.sc.frame.vein < 0.3, null,
-    'the engine reports the vein compressed (area ratio < 0.3)', 15000);
-  await sleep(200); // a round of the surfaces' vertices after the press (about 130 ms)
+    'the engine reports the vein compressed (area ratio < 0.3)', 30000);
+  await sleep(1000); // the press held: the surfaces' vertex rounds (about 130 ms each) catch up
   const pressed = await veinHeight('pressed');
   const ratio = await page.evaluate(() => window.sc.frame.vein);
   ok(`vein pressed: ${pressed.height} px high, ${pressed.pixels} px (engine's vein area ratio ${ratio.toFixed(3)})`);
-  if (!(pressed.height < 0.7 * rest.height)) fail(`the vein is not visibly narrower: ${pressed.height} px vs ${rest.height} px at rest`);
+  if (!(pressed.height < 0.7 * rest.height)) await fail(`the vein is not visibly narrower: ${pressed.height} px vs ${rest.height} px at rest`);
   ok(`the vein in the 3D view is ${(100 * (1 - pressed.height / rest.height)).toFixed(0)} % narrower (screenshots in ${outDir})`);
   await stopped(emu);
   await page.evaluate(() => window.scNormalView());
@@ -154,7 +164,7 @@ if (scenario === 'press') {
   await waitFor(page, () => Math.abs(window.sc.frame.gainDb - 12) < 0.01, null, 'gain 12 dB');
   ok('gain set to 12 dB');
   const applied1 = await page.evaluate(() => window.sc.frame.commandsApplied);
-  if (applied1 - applied0 < 3) fail(`the engine counted ${applied1 - applied0} applied commands, want >= 3`);
+  if (applied1 - applied0 < 3) await fail(`the engine counted ${applied1 - applied0} applied commands, want >= 3`);
   ok(`engine applied ${applied1 - applied0} commands`);
   // a refused command: answered and counted, the engine untouched
   await page.evaluate(() => window.scSend('{"op":"method","value":"magic"}'));
@@ -163,7 +173,7 @@ if (scenario === 'press') {
   const errs = await page.evaluate(() => window.sc.errors.map((e) => `${e.reason} (refused ${e.refused})`));
   ok(`refused: ${errs.join('; ')}`);
   await sleep(300);
-  if (await page.evaluate(() => window.sc.frame.method) !== 'fem') fail('a refused command changed the method');
+  if (await page.evaluate(() => window.sc.frame.method) !== 'fem') await fail('a refused command changed the method');
   // a second client: views at once, cannot control without the pass phrase
   const page2 = await browser.newPage({ viewport: { width: 900, height: 600 } });
   await page2.goto(url);
@@ -171,11 +181,11 @@ if (scenario === 'press') {
   await page2.click('[data-testid=case-0]');
   await waitFor(page2, () => window.sc.errors.some((e) => /locked/.test(e.reason)), null, 'second client refused without the pass phrase');
   await sleep(500);
-  if (await page.evaluate(() => window.sc.frame.caseId) !== 1) fail('the locked client switched the case');
+  if (await page.evaluate(() => window.sc.frame.caseId) !== 1) await fail('the locked client switched the case');
   const f1 = await page.evaluate(() => window.sc.frame.frames);
   await sleep(1000);
   const [f2, b2] = await page2.evaluate(() => [window.sc.frame.frames, window.sc.bscanFrames]);
-  if (!(f2 > f1)) fail('the first client stopped updating while the second was connected');
+  if (!(f2 > f1)) await fail('the first client stopped updating while the second was connected');
   ok(`second client: viewing (${b2} B-scan frames), its command refused (controls locked); both clients updated`);
   await page2.close();
 }
@@ -186,8 +196,8 @@ await Promise.all([stopped(gateway), stopped(engine)]);
 writeFileSync(path.join(outDir, 'engine.txt'), engine.out);
 writeFileSync(path.join(outDir, 'gateway.txt'), gateway.out);
 const m = /deadline\s+(\d+) misses on the virtual clock/.exec(engine.out);
-if (!m) fail(`no engine summary: ${engine.out.slice(-500)}`);
-if (+m[1] !== 0 || misses !== 0) fail(`deadline misses with clients connected: ${m[1]} (engine summary), ${misses} (state stream)`);
+if (!m) await fail(`no engine summary: ${engine.out.slice(-500)}`);
+if (+m[1] !== 0 || misses !== 0) await fail(`deadline misses with clients connected: ${m[1]} (engine summary), ${misses} (state stream)`);
 ok(`zero deadline misses on the virtual clock with clients connected (${/frames at/.test(engine.out) ? engine.out.match(/probe .*frames at \d+ Hz/)[0] : ''})`);
 const gw = gateway.out.trim().split('\n').pop();
 ok(gw);

@@ -109,10 +109,18 @@ function resize() {
     renderer.setSize(w, h, false);
     camera.aspect = w / h; camera.updateProjectionMatrix();
     const a = w / h; ortho.left = -30 * a; ortho.right = 30 * a; ortho.updateProjectionMatrix();
+    needsRender = true;
   }
 }
 
-function animate() {
+// render on demand, at most 30 times a second: a tablet's battery and a loaded kiosk's CPU
+let needsRender = true, lastRender = 0;
+const redraw = () => { needsRender = true; };
+controls.addEventListener('change', redraw);
+
+function animate(t) {
+  requestAnimationFrame(animate);
+  if (t - lastRender < 33) return;
   resize();
   if (geomDirty && !sc.frozen) {
     for (const s of surfaces) {
@@ -121,15 +129,18 @@ function animate() {
       s.mesh.geometry.computeBoundingSphere();
     }
     geomDirty = false;
+    needsRender = true;
     if (!fitted && surfaces.every((s) => s.indexDone)) fitView();
   }
   if (active === camera) controls.update();
+  if (!needsRender) return;
+  needsRender = false;
+  lastRender = t;
   renderer.render(scene, active);
-  requestAnimationFrame(animate);
 }
 requestAnimationFrame(animate);
 
-$('view-reset').onclick = () => { active = camera; fitView(); };
+$('view-reset').onclick = () => { active = camera; fitView(); redraw(); };
 $('show-skin').onchange = () => { for (const s of surfaces) if (s.kind === 0) s.mesh.visible = $('show-skin').checked && s.indexDone; };
 $('freeze').onchange = () => { sc.frozen = $('freeze').checked; };
 
@@ -159,12 +170,13 @@ window.scMeasureView = (label = 4, slabMm = 8) => {
   ortho.near = 500 - slabMm / 2; ortho.far = 500 + slabMm / 2;
   ortho.updateProjectionMatrix();
   active = ortho;
+  needsRender = true;
   return true;
 };
 window.scNormalView = () => {
   measuring = null;
   for (const s of surfaces) s.mesh.visible = s.indexDone && (s.kind !== 0 || $('show-skin').checked);
-  probe.visible = true; active = camera;
+  probe.visible = true; active = camera; needsRender = true;
 };
 
 // ---- B-scan -----------------------------------------------------------------------------------
@@ -189,6 +201,7 @@ function onBscan(dv, u8) {
   }
   bctx.putImageData(bimg, 0, 0);
   bscanTex.needsUpdate = true;
+  needsRender = true;
   plane.scale.set(width > 0 && dv.getUint16(12, true) === 0 ? width : 40, depth, 1);
   plane.position.set(0, 0, depth / 2);
 }
@@ -219,9 +232,9 @@ function onFrame(dv, p) {
   };
   sc.frame = f;
   if (sc.frozen) return;
-  probe.visible = probe.visible && true;
   probe.position.set(f.pos[0], f.pos[1], f.pos[2]);
   probe.quaternion.set(f.q[1], f.q[2], f.q[3], f.q[0]);
+  needsRender = true;
   renderStatus(f);
 }
 
