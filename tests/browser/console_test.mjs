@@ -79,6 +79,9 @@ const gateway = start('sc-gateway', [path.join(build, 'tools/gateway/sc-gateway'
   '--www', path.join(build, 'console'), '--state-port', String(statePort), '--dlink-port', String(dlinkPort),
   '--can-udp', `127.0.0.1:${canPort}`, '--cases-dir', path.join(build, 'cases'), '--pass', pass]);
 process.on('exit', cleanup);
+// a playwright error (a timeout, a lost page) fails the test with the programs' reports
+process.on('uncaughtException', (e) => { fail(`unexpected error: ${e.message.split('\n')[0]}`); });
+process.on('unhandledRejection', (e) => { fail(`unexpected error: ${String(e?.message ?? e).split('\n')[0]}`); });
 const url = `http://127.0.0.1:${httpPort}/`;
 
 let browser;
@@ -156,7 +159,7 @@ if (scenario === 'press') {
   await waitFor(page, () => window.sc.surf && window.sc.surf.name === window.sc.catalogue[1].name, null, 'the view shows case 1');
   ok(`case switched to #1 (${await page.evaluate(() => window.sc.surf.name)})`);
   // method
-  await page.check('[data-testid=method-fem]');
+  await page.click('[data-testid=method-fem]');
   await waitFor(page, () => window.sc.frame.method === 'fem', null, 'method FEM');
   ok('method switched to FEM');
   // gain

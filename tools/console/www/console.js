@@ -257,7 +257,10 @@ function renderStatus(f) {
     dt.textContent = k; dd.textContent = String(v); dd.dataset.testid = 'st-' + k.replace(/ /g, '-');
     return [dt, dd];
   }));
-  for (const r of document.querySelectorAll('input[name=method]')) r.checked = r.value === f.method;
+  // the switch shows the engine's method, except just after the user changed it (until applied)
+  if (performance.now() > methodPendingUntil || f.method === pendingMethod) {
+    for (const r of document.querySelectorAll('input[name=method]')) r.checked = r.value === f.method;
+  }
   for (const li of $('catalogue').children) li.classList.toggle('running', f.caseLoaded && +li.dataset.index === f.caseId);
 }
 
@@ -380,7 +383,14 @@ function imagingChanged() {
   }), 150);
 }
 for (const id of ['gain', 'tgc', 'depth', 'dr', 'geometry']) $(id).addEventListener('input', imagingChanged);
-for (const r of document.querySelectorAll('input[name=method]')) r.onchange = () => send({ op: 'method', value: r.value });
+let methodPendingUntil = 0, pendingMethod = null;
+for (const r of document.querySelectorAll('input[name=method]')) {
+  r.onchange = () => {
+    pendingMethod = r.value;
+    methodPendingUntil = performance.now() + 2000;
+    send({ op: 'method', value: r.value });
+  };
+}
 for (const b of document.querySelectorAll('[data-reset]')) b.onclick = () => send({ op: 'reset', target: b.dataset.reset });
 $('unlock').onclick = () => send({ op: 'auth', pass: $('pass').value });
 
