@@ -238,4 +238,10 @@ _Static_assert(SC_BSCAN_MAX_LINE_EVENTS >= 2u, "a scan line needs an entry and a
 _Static_assert(SC_RTCFG_PATH_MAX >= 16u && SC_RTCFG_PATH_MAX < SC_RTCFG_LINE_MAX,
                "a configuration path must fit a configuration line");
 
+/* The console state stream (core/sc_state.h): 1 on, 0 leaves it out of the engine (it costs
+ * one record buffer, SC_STATE_RECORD_MAX bytes, plus a few counters). */
+#ifndef SC_STATE_STREAM
+#define SC_STATE_STREAM 1
+#endif
+
 #endif /* SC_CONFIG_H */

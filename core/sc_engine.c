@@ -35,6 +35,8 @@ sc_engine_def sc_engine_default_def(void)
     d.bscan = sc_bscan_default_def();
     d.assess = sc_assess_default_def();
     d.case_count = 0u;
+    d.state_period_ms = 33u;
+    d.state_vert_records = 16u;
     return d;
 }
 
@@ -659,6 +661,10 @@ static int def_valid(const sc_engine_def *def)
         def->control_wait_frames == 0u) {
         return SC_ERR_RANGE;
     }
+    if ((def->state_period_ms != 0u && def->state_period_ms < 10u) ||
+        def->state_period_ms > 10000u || def->state_vert_records > 64u) {
+        return SC_ERR_RANGE;
+    }
     return SC_OK;
 }
 
@@ -685,6 +691,9 @@ int sc_engine_init(sc_engine *e, const sc_engine_def *def, const sc_hal *hal)
         rc = sc_tracker_init(&e->tracker, &def->tracker);
     }
     sc_status_tx_init(&e->status_tx);
+#if SC_STATE_STREAM
+    sc_state_tx_init(&e->state_tx, def->state_period_ms, def->state_vert_records);
+#endif
     if (rc == SC_OK) {
         rc = sc_bscan_init(&e->bscan, &def->bscan);
     }
@@ -775,6 +784,67 @@ static void log_misses(sc_engine *e, const sc_frame_result *r)
     }
 }
 
+#if SC_STATE_STREAM
+/* The console state stream, off the deadline's critical work: a few bounded records at most
+ * every state_period_ms, handed to the optional state device (sc_state.h). */
+static void state_stream(sc_engine *e, uint64_t now)
+{
+    if (e->hal->state.ops == NULL) {
+        return;
+    }
+    sc_engine_status st;
+    sc_engine_get_status(e, &st);
+    const sc_bscan_def *b = &e->bscan.def;
+    sc_state_in in = {
+        .now_ns = now,
+        .frame_no = e->frame_no,
+        .health_state = (uint8_t)st.state,
+        .case_loaded = st.case_loaded,
+        .case_id = st.case_id,
+        .method = (uint8_t)st.method,
+        .tracked = st.probe_tracked,
+        .contact = st.probe_contact,
+        .switching = st.switching,
+        .faults = st.faults,
+        .frames = st.frames,
+        .misses = st.misses,
+        .worst_frame_ns = st.worst_frame_ns,
+        .p99_frame_ns = st.p99_frame_ns,
+        .vein_area_ratio = st.vein_area_ratio,
+        .artery_area_ratio = st.artery_area_ratio,
+        .probe_volume = e->probe.pose_volume,
+        .gain_db = b->gain_db,
+        .dynamic_range_db = b->dynamic_range_db,
+        .depth_mm = b->scan.depth_mm,
+        .geometry_id = b->scan.kind,
+        .commands_applied = e->counters.commands_applied,
+        .commands_refused = e->counters.commands_refused,
+        .commands_auth_refused = e->counters.commands_auth_refused,
+        .case_loads = e->counters.case_loads,
+        .case_load_failures = e->counters.case_load_failures,
+        .last_case_error = e->counters.last_case_error,
+        .catalogue = e->def.case_names,
+        .catalogue_count = e->def.case_count,
+    };
+    for (uint32_t i = 0; i < 8u && i < SC_BSCAN_TGC_BANDS; i++) {
+        in.tgc_db[i] = b->tgc_db[i];
+    }
+    if (e->case_loaded && e->tissue_out.mesh != NULL && e->tissue_out.nodes != NULL) {
+        in.c = &e->slot.c;
+        in.mesh = e->tissue_out.mesh;
+        in.x = e->tissue_out.nodes->x;
+        in.y = e->tissue_out.nodes->y;
+        in.z = e->tissue_out.nodes->z;
+    }
+    (void)sc_state_emit(&e->state_tx, &e->hal->state, &in);
+}
+
+const sc_state_tx *sc_engine_get_state_tx(const sc_engine *e)
+{
+    return &e->state_tx;
+}
+#endif
+
 void sc_engine_step(sc_engine *e, sc_frame_result *out)
 {
     SC_ASSERT(e && e->hal);
@@ -792,6 +862,9 @@ void sc_engine_step(sc_engine *e, sc_frame_result *out)
     sc_sched_stage_done(s, SC_ENGINE_STAGE_IMAGING);
 
     stage_status(e, now_ns(e), &e->probe, &e->tissue_out, &e->image);
+#if SC_STATE_STREAM
+    state_stream(e, now_ns(e));
+#endif
     sc_sched_stage_done(s, SC_ENGINE_STAGE_STATUS);
 
     control_step(e);

@@ -34,6 +34,9 @@
  *            O(contacts), sc_tissue_probe_force_n).
  *   status   sc_image_out -> CAN status frames every status_period_ms: the four status
  *            frames and the three assessment frames (0x210..0x212). O(1).
+ *            Then, when hal->state is present, the console state stream (sc_state.h): at most
+ *            every state_period_ms a few fixed records handed to the state device, never
+ *            waiting (O(state_vert_records x 112) vertex interpolations).
  *   control  between this frame and the next, in the frame's slack: the queued commands
  *            (O(SC_CAN_CMD_QUEUE_MAX)), then at most one slice of a pending case switch:
  *              open      the storage mapping, the file's framing (O(sections));
@@ -78,6 +81,7 @@
 #include "sc_hal.h"
 #include "sc_health.h"
 #include "sc_sched.h"
+#include "sc_state.h"
 #include "sc_status_tx.h"
 #include "sc_tissue.h"
 #include "sc_tracker.h"
@@ -141,6 +145,10 @@ typedef struct sc_engine_def {
     /* Case catalogue: catalogue index i (CmdSelectCase) names case_names[i] in storage. */
     const char *case_names[SC_ENGINE_MAX_CASES];
     uint32_t case_count;
+    /* Console state stream (sc_state.h, through hal->state when present): records at most
+     * every state_period_ms (0: off), state_vert_records surface-vertex records per period. */
+    uint32_t state_period_ms;
+    uint32_t state_vert_records;
 } sc_engine_def;
 
 typedef struct sc_engine_counters {
@@ -264,6 +272,9 @@ typedef struct sc_engine {
     sc_engine_hook_fn hook;
     void *hook_user;
     sc_assess assess;         /* the compression exam's assessment, updated every frame */
+#if SC_STATE_STREAM
+    sc_state_tx state_tx; /* console state stream (sc_state.h) */
+#endif
     sc_bscan bscan;
     sc_tissue tissue[SC_ENGINE_TISSUE_SLOTS]; /* the large ones last */
 } sc_engine;
@@ -325,5 +336,9 @@ const sc_probe_in *sc_engine_get_probe(const sc_engine *e);
  * imaging stage (O(1) plus sc_tissue_probe_force_n, O(contacts)); reset by CmdAssessment's
  * reset and at every case swap (with the new case's finding). Never NULL. O(1). */
 const sc_assess_report *sc_engine_assessment(const sc_engine *e);
+#if SC_STATE_STREAM
+/* The state stream's counters (records sent, dropped). O(1). */
+const sc_state_tx *sc_engine_get_state_tx(const sc_engine *e);
+#endif
 
 #endif /* SC_ENGINE_H */

@@ -11,7 +11,8 @@ base=(build-essential cmake pkg-config libccd-dev libcmocka-dev libpng-dev zlib1
       libdrm-dev
       python3-pydicom python3-numpy
       libdcmtk-dev libteem-dev teem-apps libmbedtls-dev
-      python3 python3-canmatrix libsdl2-dev xvfb xauth can-utils)
+      python3 python3-canmatrix libsdl2-dev xvfb xauth can-utils
+      libwebsockets-dev chromium)
 cross=(gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi
        gcc-aarch64-linux-gnu qemu-user-static dpkg-dev)
 cross_arm64=(libcmocka-dev:arm64 libccd-dev:arm64 zlib1g-dev:arm64 libpng-dev:arm64
@@ -46,10 +47,26 @@ apt_install() {
     apt-get install -y -q --no-install-recommends $need >/dev/null
 }
 
+# The console page and its browser tests: node and npm (Debian's, unless a node is already
+# installed: nodesource's nodejs carries its own npm and conflicts with Debian's npm package),
+# then the page's npm packages (three, playwright-core) exactly as package-lock.json pins them.
+console_npm() {
+    if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+        apt_install nodejs npm
+    fi
+    local dir
+    dir=$(cd "$(dirname "$0")/console" && pwd)
+    if [ ! -d "$dir/node_modules/three" ] || [ ! -d "$dir/node_modules/playwright-core" ] ||
+       [ "$dir/package-lock.json" -nt "$dir/node_modules/.package-lock.json" ]; then
+        (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
+    fi
+}
+
 want=${1:-base}
 case "$want" in
 base)
     apt_install "${base[@]}"
+    console_npm
     ;;
 cross)
     apt_install "${base[@]}"

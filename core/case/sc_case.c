@@ -655,7 +655,17 @@ int sc_case_load(const uint8_t *bytes, size_t size, sc_case *out)
     if (rc != SC_OK) {
         return rc;
     }
-    return parse_case(sec, case_id, -1, out);
+    sc_case c;
+    const int prc = parse_case(sec, case_id, -1, &c);
+    if (prc != SC_OK) {
+        return prc;
+    }
+    const int src = sc_case_surf_find(bytes, size, &c.mesh, &c.surf);
+    if (src != SC_OK) {
+        return src;
+    }
+    *out = c;
+    return SC_OK;
 }
 
 /* ---- the same validation in slices ------------------------------------------------------- */
@@ -744,7 +754,17 @@ int sc_case_check_finish(const sc_case_check *k, sc_case *out)
         sec[s].p = k->known_p[s];
         sec[s].size = k->known_size[s];
     }
-    return parse_case(sec, k->case_id, (int)k->label_max, out);
+    sc_case c;
+    const int prc = parse_case(sec, k->case_id, (int)k->label_max, &c);
+    if (prc != SC_OK) {
+        return prc;
+    }
+    const int src = sc_case_surf_find(k->bytes, k->size, &c.mesh, &c.surf);
+    if (src != SC_OK) {
+        return src;
+    }
+    *out = c;
+    return SC_OK;
 }
 
 void sc_case_label_histogram(const sc_case *c, uint64_t counts[SC_MAX_LABELS])

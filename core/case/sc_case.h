@@ -30,6 +30,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "sc_case_surf.h"
 #include "sc_config.h"
 #include "sc_hal_storage.h"
 #include "sc_mesh.h"
@@ -126,6 +127,7 @@ typedef struct sc_case {
     uint32_t case_id; /* CRC-32 over the file and section headers (without their
                        * own CRC fields; they hold the payload CRCs): identifies
                        * the case content */
+    sc_case_surf surf; /* optional SURF section (console surfaces); surf.count 0: none */
 } sc_case;
 
 /* What the writer encodes. volume.voxels and volume.labels must both be non-NULL. */

@@ -34,6 +34,7 @@
 #include "sc_err.h"
 #include "sc_cpu.h"
 #include "sc_hs_faults.h"
+#include "sc_hs_live.h"
 #include "sc_hs_rig.h"
 #include "sc_labels.h"
 #include "sc_png_write.h"
@@ -74,6 +75,7 @@ typedef struct options {
     uint8_t call;             /* --call: SC_ASSESS_CALL_*, NONE: no call */
     double call_t_s;          /* its time; < 0: 0.5 s before the end */
     int case_set, seconds_set, faults_set;
+    sc_hs_live_def live; /* --live, --can-udp, --state-udp, --dlink-udp, --state-out */
 } options;
 
 static void usage(FILE *f)
@@ -109,6 +111,14 @@ static void usage(FILE *f)
             "  --png-size WxH       PNG raster (default 480x640)\n"
             "  --frame-raw FILE     also write the deepest-compression frame as a raw frame file\n"
             "  --quiet              no per-second progress\n"
+            "  --live               release frames at wall-clock time (the engine keeps the\n"
+            "                       virtual clock) for the console gateway (tools/gateway)\n"
+            "  --can-udp PORT       CAN frames in over UDP on 127.0.0.1:PORT (sc_udpcan.h:\n"
+            "                       sc-tracker-emu --udp, the gateway's commands) instead of\n"
+            "                       the built-in emulator script\n"
+            "  --state-udp H:P      the console state stream to UDP H:P (docs/state-stream.md)\n"
+            "  --state-out FILE     the state stream's records into FILE (u16 length + record)\n"
+            "  --dlink-udp H:P      scan lines over the UDP display link to H:P as well\n"
             "  --help, --version\n");
 }
 
@@ -154,7 +164,8 @@ static int parse_args(int argc, char **argv, options *o)
     (void)sc_hs_fault_plan_parse("", &o->faults, NULL, 0);
     enum { O_CASE = 256, O_CASES_DIR, O_OUT, O_SCRIPT, O_CSV, O_SECONDS, O_METHOD, O_POINT,
            O_DEPTH, O_FD, O_FAULTS, O_SEED, O_RECORD, O_REPLAY, O_EVERY, O_PNG, O_RAW, O_QUIET,
-           O_HELP, O_VERSION, O_RX_COST, O_BUNDLE, O_LIST, O_CALL };
+           O_HELP, O_VERSION, O_RX_COST, O_BUNDLE, O_LIST, O_CALL,
+           O_LIVE, O_CAN_UDP, O_STATE_UDP, O_STATE_OUT, O_DLINK_UDP };
     static const struct option opts[] = {
         {"case", required_argument, 0, O_CASE},     {"cases-dir", required_argument, 0, O_CASES_DIR},
         {"out", required_argument, 0, O_OUT},       {"script", required_argument, 0, O_SCRIPT},
@@ -170,6 +181,10 @@ static int parse_args(int argc, char **argv, options *o)
         {"record-bundle", required_argument, 0, O_BUNDLE},
         {"list-bundles", required_argument, 0, O_LIST},
         {"call", required_argument, 0, O_CALL},
+        {"live", no_argument, 0, O_LIVE},           {"can-udp", required_argument, 0, O_CAN_UDP},
+        {"state-udp", required_argument, 0, O_STATE_UDP},
+        {"state-out", required_argument, 0, O_STATE_OUT},
+        {"dlink-udp", required_argument, 0, O_DLINK_UDP},
         {0, 0, 0, 0}};
     int c;
     opterr = 0;
@@ -284,6 +299,31 @@ static int parse_args(int argc, char **argv, options *o)
             break;
         }
         case O_QUIET: o->quiet = 1; break;
+        case O_LIVE: o->live.pace = 1; break;
+        case O_CAN_UDP:
+            if (parse_u64(optarg, 65535u, &u) || u == 0u) {
+                fprintf(stderr, "sc-hostsim: --can-udp wants a port 1..65535, got '%s'\n", optarg);
+                return 2;
+            }
+            o->live.can_port = (uint16_t)u;
+            break;
+        case O_STATE_UDP:
+        case O_DLINK_UDP: {
+            char host[256];
+            uint16_t port;
+            if (sc_udp_parse_target(optarg, host, sizeof host, &port) != 0) {
+                fprintf(stderr, "sc-hostsim: --%s wants HOST:PORT or PORT, got '%s'\n",
+                        c == O_STATE_UDP ? "state-udp" : "dlink-udp", optarg);
+                return 2;
+            }
+            if (c == O_STATE_UDP) {
+                o->live.state_target = optarg;
+            } else {
+                o->live.dlink_target = optarg;
+            }
+            break;
+        }
+        case O_STATE_OUT: o->live.state_file = optarg; break;
         case O_HELP: usage(stdout); return -1;
         case O_VERSION: printf("sc-hostsim %s\n", SC_HOSTSIM_VERSION); return -1;
         default:
@@ -294,6 +334,10 @@ static int parse_args(int argc, char **argv, options *o)
     }
     if (optind != argc) {
         fprintf(stderr, "sc-hostsim: unexpected argument '%s'\n", argv[optind]);
+        return 2;
+    }
+    if (o->live.can_port && (o->replay_path || o->csv_path)) {
+        fprintf(stderr, "sc-hostsim: --can-udp cannot be combined with --replay or --csv\n");
         return 2;
     }
     if (o->replay_path && (o->csv_path || o->record_path || o->bundle_path || o->call)) {
@@ -568,6 +612,7 @@ static sc_emu emu;
 static sc_emu_row csv_rows[100000];
 
 static sc_hs_fault_run faults;
+static sc_hs_live live;
 
 /* sc_emu_send_fn over a CAN device (the simulated tracker node); a silence episode discards */
 static int send_peer(void *ctx, const sc_can_frame *f)
@@ -831,8 +876,22 @@ int main(int argc, char **argv)
         fprintf(stderr, "sc-hostsim: no bus node left for the flood\n");
         return 1;
     }
-    const uint32_t frames = bundle_replay ? (uint32_t)binfo.meta.frames
-                                          : (uint32_t)ceil(o.seconds * 1e9 / (double)period);
+    const int live_on = o.live.pace || o.live.can_port || o.live.state_target ||
+                        o.live.dlink_target || o.live.state_file;
+    if (live_on) {
+        char why[256];
+        if (sc_hs_live_open(&live, &o.live, &rig, why, sizeof why) != SC_OK) {
+            fprintf(stderr, "sc-hostsim: %s\n", why);
+            return 1;
+        }
+        if (o.live.pace) {
+            printf("sc-hostsim: live, case %s, %.0f s at most (SIGINT/SIGTERM stop)\n", case_name,
+                   o.seconds);
+            fflush(stdout);
+        }
+    }
+    uint32_t frames = bundle_replay ? (uint32_t)binfo.meta.frames
+                                    : (uint32_t)ceil(o.seconds * 1e9 / (double)period);
     if (bundle_replay) {
         o.seconds = (double)frames * (double)period * 1e-9;
     }
@@ -843,7 +902,16 @@ int main(int argc, char **argv)
         /* release time of the frame about to run */
         const uint64_t release = sc_engine_next_release_ns(&rig.engine);
         sc_hs_fault_run_before(&faults, release);
-        if (bundle_replay) {
+        if (live_on) {
+            sc_hs_live_before_frame(&live, &rig, release);
+            if (sc_hs_live_stop()) {
+                frames = i;
+                break;
+            }
+        }
+        if (o.live.can_port) {
+            /* the probe and the commands come in over UDP */
+        } else if (bundle_replay) {
             const char *line;
             size_t len;
             for (;;) {
@@ -1057,8 +1125,8 @@ int main(int argc, char **argv)
                 cs->mesh.nx, cs->mesh.ny, cs->mesh.nz, tis ? tis->mesh.node_count : 0u,
                 tis ? tis->mesh.tet_count : 0u);
         fprintf(f, "probe           %s%s, %.2f s simulated, %u frames at %u Hz\n",
-                replay ? "replay of " : (o.csv_path ? "csv " : "script "),
-                replay ? o.replay_path : (o.csv_path ? o.csv_path : o.script), o.seconds,
+                o.live.can_port ? "CAN over UDP, " : (replay ? "replay of " : (o.csv_path ? "csv " : "script ")),
+                o.live.can_port ? "live" : (replay ? o.replay_path : (o.csv_path ? o.csv_path : o.script)), o.seconds,
                 frames, def.sched.rate_hz);
         fprintf(f, "method          %s\n", st.method == SC_TISSUE_FEM ? "fem" : "msds");
         fprintf(f, "display         %" PRIu64 " complete frames, %" PRIu64
@@ -1160,9 +1228,15 @@ int main(int argc, char **argv)
             fprintf(f, "; recorded score %u/%u, replayed %u/%u\n", binfo.meta.score,
                     binfo.meta.score_max, ar->score, ar->score_max);
         }
+        if (live_on) {
+            sc_hs_live_summary(&live, &rig, f);
+        }
     }
     if (sf) {
         fclose(sf);
+    }
+    if (live_on) {
+        sc_hs_live_close(&live);
     }
     sc_scanconv_free(&conv);
     free(raster);

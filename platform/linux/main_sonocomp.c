@@ -34,6 +34,8 @@
 #include "sc_socketcan.h"
 #include "sc_storage_linux.h"
 #include "sc_udp_display.h"
+#include "sc_udp_state.h"
+#include "sc_udpcan.h"
 
 #ifndef SONOCOMP_VERSION
 #define SONOCOMP_VERSION "0.1.0"
@@ -103,6 +105,8 @@ typedef struct cli {
     const char *case_dir;
     uint32_t inject_loss_permille; /* test option: display link lines lost on purpose */
     const char *can_replay_path;   /* --can-replay: a candump -l log instead of SocketCAN */
+    const char *state_target;      /* --state-udp: the console state stream's UDP target */
+    uint16_t can_udp_port;         /* --can-udp: CAN over UDP instead of SocketCAN */
 } cli;
 
 static void usage(FILE *f)
@@ -123,6 +127,10 @@ static void usage(FILE *f)
            "      --can-replay FILE play a candump -l log (sc-tracker-emu --log) in real\n"
            "                        time as the CAN bus, for hosts without SocketCAN;\n"
            "                        can.interface is then ignored; the log's end is a lift\n"
+           "      --can-udp PORT    CAN frames over UDP on 127.0.0.1:PORT (sc_udpcan.h), for\n"
+           "                        hosts without SocketCAN; can.interface is then ignored\n"
+           "      --state-udp H:P   the console state stream (docs/state-stream.md) to UDP H:P\n"
+           "                        (sc-gateway --state-port P)\n"
            "  -h, --help            this help\n"
            "  -V, --version         version\n\n"
            "Stops cleanly on SIGINT or SIGTERM and prints its final statistics on stdout.\n"
@@ -480,7 +488,8 @@ static int parse_cli(int argc, char **argv, cli *a)
 {
     memset(a, 0, sizeof *a);
     optind = 0; /* glibc: a full re-initialisation, so that it can be called again */
-    enum { OPT_CHECK = 1000, OPT_HELP_CONFIG, OPT_CASE_DIR, OPT_INJECT, OPT_CAN_REPLAY };
+    enum { OPT_CHECK = 1000, OPT_HELP_CONFIG, OPT_CASE_DIR, OPT_INJECT, OPT_CAN_REPLAY,
+           OPT_STATE_UDP, OPT_CAN_UDP };
     static const struct option lo[] = {{"config", required_argument, NULL, 'c'},
                                        {"set", required_argument, NULL, 's'},
                                        {"check-config", no_argument, NULL, OPT_CHECK},
@@ -488,6 +497,8 @@ static int parse_cli(int argc, char **argv, cli *a)
                                        {"case-dir", required_argument, NULL, OPT_CASE_DIR},
                                        {"inject-loss", required_argument, NULL, OPT_INJECT},
                                        {"can-replay", required_argument, NULL, OPT_CAN_REPLAY},
+                                       {"state-udp", required_argument, NULL, OPT_STATE_UDP},
+                                       {"can-udp", required_argument, NULL, OPT_CAN_UDP},
                                        {"frames", required_argument, NULL, 'n'},
                                        {"seconds", required_argument, NULL, 't'},
                                        {"help", no_argument, NULL, 'h'},
@@ -529,6 +540,26 @@ static int parse_cli(int argc, char **argv, cli *a)
         case OPT_CAN_REPLAY:
             a->can_replay_path = optarg;
             break;
+        case OPT_STATE_UDP: {
+            char host[256];
+            uint16_t port;
+            if (sc_udp_parse_target(optarg, host, sizeof host, &port) != 0) {
+                fprintf(stderr, "sonocomp: --state-udp %s: expected HOST:PORT or PORT\n", optarg);
+                return EXIT_USAGE;
+            }
+            a->state_target = optarg;
+            break;
+        }
+        case OPT_CAN_UDP: {
+            errno = 0;
+            const unsigned long v = strtoul(optarg, &end, 10);
+            if (errno || !end || *end || optarg[0] == '-' || v == 0u || v > 65535u) {
+                fprintf(stderr, "sonocomp: --can-udp %s: expected a port 1..65535\n", optarg);
+                return EXIT_USAGE;
+            }
+            a->can_udp_port = (uint16_t)v;
+            break;
+        }
         case 'n':
             errno = 0;
             a->frames = strtoull(optarg, &end, 10);
@@ -641,8 +672,19 @@ int main(int argc, char **argv)
 
     static sc_socketcan can;
     static sc_can_replay replay;
+    static sc_udpcan can_udp;
     int can_open = 0, replay_open = 0;
-    if (a.can_replay_path) {
+    if (a.can_udp_port && !a.can_replay_path) {
+        if (sc_udpcan_open_rx(&can_udp, a.can_udp_port) != 0) {
+            fprintf(stderr, "sonocomp: --can-udp %u: %s\n", (unsigned)a.can_udp_port,
+                    strerror(can_udp.last_errno));
+            sc_log_linux_stop(&g_log);
+            return EXIT_RUNTIME;
+        }
+        hal.can = sc_udpcan_dev(&can_udp);
+        sc_log_linux_msg(&g_log, SC_LOG_INFO, "can_udp", "port=%u can_interface_ignored=%s",
+                         (unsigned)a.can_udp_port, cfg.can_interface);
+    } else if (a.can_replay_path) {
         errno = 0;
         int rc = sc_can_replay_open(&replay, a.can_replay_path, NULL, NULL);
         if (rc != 0) {
@@ -743,6 +785,21 @@ int main(int argc, char **argv)
     case SC_RTCFG_TARGET_NONE:
         hal.display.ops = &k_null_display;
         break;
+    }
+
+    /* the console state stream (optional, off the deadline: one datagram per record) */
+    static sc_udp_state state_udp;
+    if (a.state_target) {
+        char host[256];
+        uint16_t port = 0;
+        (void)sc_udp_parse_target(a.state_target, host, sizeof host, &port);
+        if (sc_udp_state_open(&state_udp, host, port) != 0) {
+            sc_log_linux_msg(&g_log, SC_LOG_ERROR, "state_open_failed", "target=udp:%s:%u",
+                             host, (unsigned)port);
+            exit_code = EXIT_RUNTIME;
+        } else {
+            hal.state = sc_udp_state_dev(&state_udp);
+        }
     }
 
     static sc_storage_linux storage;

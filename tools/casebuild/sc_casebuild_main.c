@@ -29,6 +29,7 @@
 #include <time.h>
 
 #include "sc_case.h"
+#include "sc_casesurf.h"
 #include "sc_caseimport.h"
 #include "sc_err.h"
 #include "sc_isosurface.h"
@@ -94,6 +95,26 @@ static int write_case_file(const sc_case_def *def, const char *path)
         /* the writer does not validate semantics: the loader must accept what we ship */
         sc_case c;
         rc = sc_case_load(buf, n, &c);
+    }
+    if (rc == SC_OK) {
+        /* the console's surfaces (SURF), embedded in the rest mesh, then the whole reloaded */
+        uint8_t *surf = NULL;
+        size_t surf_n = 0;
+        rc = sc_casesurf_build(def, &surf, &surf_n);
+        uint8_t *grown = rc == SC_OK ? realloc(buf, need + surf_n + 2u * SC_CASE_ALIGN) : NULL;
+        if (rc == SC_OK && grown == NULL) {
+            rc = SC_ERR_NO_SPACE;
+        }
+        if (rc == SC_OK) {
+            buf = grown;
+            rc = sc_case_append_section(buf, need + surf_n + 2u * SC_CASE_ALIGN, &n,
+                                        SC_CASE_TAG_SURF_U32, surf, surf_n);
+        }
+        free(surf);
+        if (rc == SC_OK) {
+            sc_case c;
+            rc = sc_case_load(buf, n, &c);
+        }
     }
     if (rc != SC_OK) {
         fprintf(stderr, "sc-casebuild: refusing to write an invalid case: %s (%s)\n",

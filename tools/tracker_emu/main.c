@@ -9,7 +9,7 @@
  *                                                        silence implausible
  *                  [--silence-ms 300]
  *                  [--command KIND=VALUE[@T_S]]... [--auth-key bench|HEX32] [--sender 0..3]
- *                  (--iface vcan0 | --log FILE|- [--log-iface vcan0] [--t0 1700000000])
+ *                  (--iface vcan0 | --udp HOST:PORT | --log FILE|- [--log-iface vcan0] [--t0 ...])
  * Commands (the console's messages, docs/can-protocol.md) are authenticated: a freshness sync
  * before the first, then each command and its cryptographic PDU, signed with Mbed TLS's
  * AES-CMAC (sc_cmdsign.h) under the given key (default: the bench key). KIND=VALUE:
@@ -29,6 +29,8 @@
 #include "sc_cmdsign.h"
 #include "sc_err.h"
 #include "sc_socketcan.h"
+#include "sc_udp_state.h"
+#include "sc_udpcan.h"
 #include "sc_trkemu.h"
 
 #define MAX_ROWS 100000u
@@ -49,7 +51,8 @@ static void usage(void)
             "       [--hover-mm MM] [--length-mm MM] [--period-s S] [--angle-deg DEG]\n"
             "       [--no-force] [--fault KIND[:PERIOD[:START_S]]]... [--silence-ms MS]\n"
             "       [--command KIND=VALUE[@T_S]]... [--auth-key bench|HEX32] [--sender 0..3]\n"
-            "       (--iface IFNAME | --log FILE|- [--log-iface IFNAME] [--t0 SECONDS])\n"
+            "       (--iface IFNAME | --udp HOST:PORT | --log FILE|- [--log-iface IFNAME]\n"
+            "        [--t0 SECONDS])   (--udp: CAN over UDP to sc-hostsim --live --can-udp)\n"
             "faults: bad-crc counter-jump repeat silence implausible\n"
             "commands: case=N method=msds|fem reset=tissue|faults|all\n"
             "          imaging=DEPTH_MM:GAIN_DB:DYN_RANGE_DB:TGC_DB_PER_CM:linear|curvilinear\n"
@@ -197,6 +200,7 @@ static int parse_command(const char *arg, timed_cmd *out)
 typedef struct emu_cli {
     sc_emu_def def;
     const char *iface, *log_path, *log_iface, *csv;
+    const char *udp; /* --udp HOST:PORT: CAN over UDP (sc_udpcan.h), paced like --iface */
     double t0_s;
     timed_cmd cmds[MAX_CMDS];
     uint32_t n_cmds;
@@ -242,6 +246,7 @@ static int parse_cli(int argc, char **argv, emu_cli *a)
         {"fault", required_argument, 0, 'f'},
         {"silence-ms", required_argument, 0, 'S'},
         {"iface", required_argument, 0, 'i'},
+        {"udp", required_argument, 0, 'U'},
         {"log", required_argument, 0, 'l'},
         {"log-iface", required_argument, 0, 'I'},
         {"t0", required_argument, 0, 't'},
@@ -313,6 +318,13 @@ static int parse_cli(int argc, char **argv, emu_cli *a)
         case 'l':
             a->log_path = optarg;
             break;
+        case 'U': {
+            char host[256];
+            uint16_t port;
+            bad = sc_udp_parse_target(optarg, host, sizeof host, &port) != 0;
+            a->udp = optarg;
+            break;
+        }
         case 'I':
             a->log_iface = optarg;
             break;
@@ -344,7 +356,8 @@ static int parse_cli(int argc, char **argv, emu_cli *a)
             return 2;
         }
     }
-    if (!have_script || (a->iface == NULL) == (a->log_path == NULL) || optind != argc) {
+    if (!have_script ||
+        (a->iface != NULL) + (a->log_path != NULL) + (a->udp != NULL) != 1 || optind != argc) {
         usage();
         return 2;
     }
@@ -359,7 +372,9 @@ int main(int argc, char **argv)
         return parsed;
     }
     sc_emu_def def = a.def;
-    const char *const iface = a.iface, *const log_path = a.log_path, *const log_iface = a.log_iface;
+    const char *const log_path = a.log_path, *const log_iface = a.log_iface;
+    /* a live bus: SocketCAN or CAN over UDP (paced in real time either way) */
+    const char *const iface = a.iface ? a.iface : a.udp;
     const char *const csv = a.csv;
     const double t0_s = a.t0_s;
     timed_cmd *const cmds = a.cmds;
@@ -393,7 +408,17 @@ int main(int argc, char **argv)
     sc_socketcan node;
     sc_can_dev dev = {0};
     FILE *log = NULL;
-    if (iface) {
+    static sc_udpcan udp;
+    if (a.udp) {
+        char host[256];
+        uint16_t port = 0;
+        if (sc_udp_parse_target(a.udp, host, sizeof host, &port) != 0 ||
+            sc_udpcan_open_tx(&udp, host, port) != SC_OK) {
+            fprintf(stderr, "sc-tracker-emu: cannot open UDP CAN to %s\n", a.udp);
+            return 1;
+        }
+        dev = sc_udpcan_dev(&udp);
+    } else if (iface) {
         const int rc = sc_socketcan_open(&node, sc_socketcan_sys_posix(), NULL, iface);
         if (rc != 0) {
             fprintf(stderr, "sc-tracker-emu: cannot open CAN interface %s: %s (%s)\n", iface,
@@ -492,7 +517,9 @@ int main(int argc, char **argv)
             return 1;
         }
     }
-    if (iface) {
+    if (a.udp) {
+        sc_udpcan_close(&udp);
+    } else if (iface) {
         sc_socketcan_close(&node);
     }
     fprintf(stderr,

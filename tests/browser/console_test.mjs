@@ -1,0 +1,207 @@
+// console_test.mjs: the console in a real browser (Debian's chromium driven by playwright-core)
+// against sc-gateway and a running engine: sc-hostsim --live (the engine on the host simulator,
+// paced to the wall clock, its deadline on the virtual clock; CAN over UDP because this host has
+// no SocketCAN). Scenarios (argv[2]):
+//   controls  switch case, method and gain from the page; the engine's status (its state stream)
+//             reflects each; a refused command (answered, counted); a second client that can view
+//             but not control without the pass phrase; zero deadline misses with clients connected
+//   press     the tracker emulator presses the probe; a screenshot of the 3D view shows the vein
+//             narrower than at rest
+// Exit 0 pass, 1 fail, 77 skipped (chromium genuinely unavailable).
+import { spawn, spawnSync } from 'node:child_process';
+import { existsSync, mkdirSync, readFileSync, writeFileSync } from 'node:fs';
+import { createServer } from 'node:net';
+import { createSocket } from 'node:dgram';
+import { createRequire } from 'node:module';
+import path from 'node:path';
+
+const scenario = process.argv[2] ?? 'controls';
+const build = process.env.SC_BUILD_DIR;
+const outDir = path.join(process.env.SC_OUT_DIR ?? path.join(build ?? '.', 'browser'), scenario);
+const consoleDir = process.env.SC_CONSOLE_SRC; // tools/console (node_modules)
+mkdirSync(outDir, { recursive: true });
+
+function skip(why) { console.log(`SKIPPED: ${why}`); process.exit(77); }
+async function fail(why) {
+  console.log(`FAIL: ${why}`);
+  cleanup();
+  // the programs' own reports (the engine's summary comes at its exit)
+  await Promise.race([Promise.all(procs.map((p) => stopped(p))), sleep(4000)]);
+  for (const p of procs) console.log(`--- ${p.name}:\n${p.out.slice(-2500)}`);
+  process.exit(1);
+}
+function ok(what) { console.log(`ok: ${what}`); }
+
+const chromium = [process.env.CHROMIUM, '/usr/bin/chromium', '/usr/bin/chromium-browser'].find((p) => p && existsSync(p));
+if (!chromium) skip('chromium not installed (apt-get install chromium; tools/install-deps.sh installs it)');
+let playwright;
+try {
+  playwright = createRequire(path.join(consoleDir, 'package.json'))('playwright-core');
+} catch (e) {
+  await fail(`playwright-core not installed in ${consoleDir} (npm ci there; tools/install-deps.sh does it): ${e.message}`);
+}
+for (const f of ['platform/hostsim/sc-hostsim', 'tools/gateway/sc-gateway', 'tools/tracker_emu/sc-tracker-emu', 'console/index.html', 'cases/neck-ijv.scase']) {
+  if (!existsSync(path.join(build, f))) await fail(`${f} not built in ${build}`);
+}
+
+const freeTcp = () => new Promise((res) => { const s = createServer(); s.listen(0, '127.0.0.1', () => { const p = s.address().port; s.close(() => res(p)); }); });
+const freeUdp = () => new Promise((res) => { const s = createSocket('udp4'); s.bind(0, '127.0.0.1', () => { const p = s.address().port; s.close(() => res(p)); }); });
+function sleep(ms) { return new Promise((r) => setTimeout(r, ms)); }
+
+const procs = [];
+function start(name, args) {
+  const p = spawn(args[0], args.slice(1), { stdio: ['ignore', 'pipe', 'pipe'] });
+  p.out = '';
+  p.stdout.on('data', (d) => { p.out += d; });
+  p.stderr.on('data', (d) => { p.out += d; });
+  p.name = name;
+  procs.push(p);
+  return p;
+}
+function cleanup() { for (const p of procs) if (p.exitCode === null) p.kill('SIGTERM'); }
+function stopped(p) { return new Promise((res) => { if (p.exitCode !== null) res(); else p.on('exit', () => res()); }); }
+
+async function waitFor(page, fn, arg, what, ms = 20000) {
+  try {
+    await page.waitForFunction(fn, arg, { timeout: ms, polling: 100 });
+  } catch (e) {
+    const st = await page.evaluate(() => JSON.stringify({ frame: window.sc?.frame, errors: window.sc?.errors })).catch(() => '?');
+    await fail(`${what}: not within ${ms} ms (page state ${st})`);
+  }
+}
+
+const [canPort, statePort, dlinkPort, httpPort] = [await freeUdp(), await freeUdp(), await freeUdp(), await freeTcp()];
+const pass = 'instructor';
+const engine = start('sc-hostsim', [path.join(build, 'platform/hostsim/sc-hostsim'), '--live', '--case', 'neck-ijv',
+  '--cases-dir', path.join(build, 'cases'), '--can-udp', String(canPort), '--state-udp', `127.0.0.1:${statePort}`,
+  '--dlink-udp', `127.0.0.1:${dlinkPort}`, '--seconds', '300', '--every', '0', '--quiet', '--out', path.join(outDir, 'engine')]);
+const gateway = start('sc-gateway', [path.join(build, 'tools/gateway/sc-gateway'), '--port', String(httpPort),
+  '--www', path.join(build, 'console'), '--state-port', String(statePort), '--dlink-port', String(dlinkPort),
+  '--can-udp', `127.0.0.1:${canPort}`, '--cases-dir', path.join(build, 'cases'), '--pass', pass]);
+process.on('exit', cleanup);
+// a playwright error (a timeout, a lost page) fails the test with the programs' reports
+process.on('uncaughtException', (e) => { fail(`unexpected error: ${e.message.split('\n')[0]}`); });
+process.on('unhandledRejection', (e) => { fail(`unexpected error: ${String(e?.message ?? e).split('\n')[0]}`); });
+const url = `http://127.0.0.1:${httpPort}/`;
+
+let browser;
+try {
+  browser = await playwright.chromium.launch({ executablePath: chromium, args: ['--no-sandbox', '--use-gl=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist'] });
+} catch (e) {
+  skip(`chromium at ${chromium} does not start: ${e.message.split('\n')[0]}`);
+}
+const page = await browser.newPage({ viewport: { width: 1100, height: 700 } });
+page.on('pageerror', (e) => console.log(`page error: ${e.message}`));
+for (let i = 0; i < 50; i++) {
+  try { await page.goto(url); break; } catch (e) { await sleep(200); if (i === 49) await fail(`gateway at ${url} not answering: ${gateway.out}`); }
+}
+await waitFor(page, () => window.sc?.frame?.caseLoaded === 1 && window.sc.catalogue.length === 3 && window.sc.bscanFrames > 0,
+  null, 'the page shows the running engine (state stream, catalogue, B-scan)');
+ok(`page up: ${await page.evaluate(() => `${sc.records} records, ${sc.bscanFrames} B-scan frames, catalogue ${sc.catalogue.map((e) => e.name).join(' | ')}`)}`);
+await page.fill('#pass', pass);
+await page.click('#unlock');
+await waitFor(page, () => window.sc.replies.some((m) => m.type === 'ack' && m.op === 'auth'), null, 'unlock with the pass phrase');
+
+async function veinHeight(label) {
+  // a screenshot of the 3D view in the measurement view; the vein is pure blue, unlit
+  await page.evaluate(() => window.scMeasureView(4));
+  await sleep(100);
+  const png = await page.locator('#scene').screenshot({ path: path.join(outDir, `vein-${label}.png`) });
+  return page.evaluate(async (b64) => {
+    const img = await createImageBitmap(await (await fetch(`data:image/png;base64,${b64}`)).blob());
+    const c = new OffscreenCanvas(img.width, img.height), x = c.getContext('2d');
+    x.drawImage(img, 0, 0);
+    const d = x.getImageData(0, 0, img.width, img.height).data;
+    let top = -1, bottom = -1, px = 0;
+    for (let y = 0; y < img.height; y++) {
+      let row = 0;
+      for (let xx = 0; xx < img.width; xx++) {
+        const o = (y * img.width + xx) * 4;
+        if (d[o + 2] > 150 && d[o] < 80 && d[o + 1] < 80) row++;
+      }
+      if (row > 0) { if (top < 0) top = y; bottom = y; px += row; }
+    }
+    return { height: top < 0 ? 0 : bottom - top + 1, pixels: px };
+  }, png.toString('base64'));
+}
+
+if (scenario === 'press') {
+  await waitFor(page, () => window.sc.surf && window.sc.surf.count >= 2, null, 'surfaces of the case');
+  await sleep(2500); // every triangle and vertex round has arrived
+  const rest = await veinHeight('rest');
+  ok(`vein at rest: ${rest.height} px high, ${rest.pixels} px`);
+  if (rest.height < 20) await fail(`the vein is not visible at rest (${rest.height} px)`);
+  // the probe over the default point (tracker frame, beam down; the skin at z = 0): from 30 mm
+  // above to 2 mm above in 1 s, then slowly (2 mm/s) to 10 mm below the skin, held 6 s, lifted.
+  // Slowly, because the sanitizer build on a loaded host (chromium's software GL beside it) may
+  // run the engine at a fraction of real time: a fast press would reach it as a jump of the
+  // probe into the tissue in one frame instead of a press
+  const csv = path.join(outDir, 'press.csv');
+  const rows = [[0, 30], [0.5, 30], [1.5, 2], [7.5, -10], [13.5, -10], [14.5, 30]];
+  writeFileSync(csv, rows.map(([t, z]) => `${t},0,0,${z},0,1,0,0,${(Math.max(0, -z) * 0.5).toFixed(2)}`).join('\n') + '\n');
+  const emu = start('sc-tracker-emu', [path.join(build, 'tools/tracker_emu/sc-tracker-emu'), '--csv', csv,
+    '--udp', `127.0.0.1:${canPort}`]);
+  await waitFor(page, () => window.sc.frame.contact === 1 && window.sc.frame.vein >= 0 && window.sc.frame.vein < 0.3, null,
+    'the engine reports the vein compressed (area ratio < 0.3)', 30000);
+  await sleep(1000); // the press held: the surfaces' vertex rounds (about 130 ms each) catch up
+  const pressed = await veinHeight('pressed');
+  const ratio = await page.evaluate(() => window.sc.frame.vein);
+  ok(`vein pressed: ${pressed.height} px high, ${pressed.pixels} px (engine's vein area ratio ${ratio.toFixed(3)})`);
+  if (!(pressed.height < 0.7 * rest.height)) await fail(`the vein is not visibly narrower: ${pressed.height} px vs ${rest.height} px at rest`);
+  ok(`the vein in the 3D view is ${(100 * (1 - pressed.height / rest.height)).toFixed(0)} % narrower (screenshots in ${outDir})`);
+  await stopped(emu);
+  await page.evaluate(() => window.scNormalView());
+} else {
+  // switch the case
+  const applied0 = await page.evaluate(() => window.sc.frame.commandsApplied);
+  await page.click('[data-testid=case-1]');
+  await waitFor(page, () => window.sc.frame.caseId === 1 && window.sc.frame.caseLoaded === 1 && !window.sc.frame.switching, null, 'case 1 running', 30000);
+  await waitFor(page, () => window.sc.surf && window.sc.surf.name === window.sc.catalogue[1].name, null, 'the view shows case 1');
+  ok(`case switched to #1 (${await page.evaluate(() => window.sc.surf.name)})`);
+  // method
+  await page.click('[data-testid=method-fem]');
+  await waitFor(page, () => window.sc.frame.method === 'fem', null, 'method FEM');
+  ok('method switched to FEM');
+  // gain
+  await page.locator('#gain').fill('12');
+  await waitFor(page, () => Math.abs(window.sc.frame.gainDb - 12) < 0.01, null, 'gain 12 dB');
+  ok('gain set to 12 dB');
+  const applied1 = await page.evaluate(() => window.sc.frame.commandsApplied);
+  if (applied1 - applied0 < 3) await fail(`the engine counted ${applied1 - applied0} applied commands, want >= 3`);
+  ok(`engine applied ${applied1 - applied0} commands`);
+  // a refused command: answered and counted, the engine untouched
+  await page.evaluate(() => window.scSend('{"op":"method","value":"magic"}'));
+  await page.evaluate(() => window.scSend('{"op":"imaging","depth_mm":5000,"gain_db":0,"dyn_range_db":60,"tgc_db_per_cm":0,"geometry":"linear"}'));
+  await waitFor(page, () => window.sc.errors.length >= 2, null, 'two refusals answered');
+  const errs = await page.evaluate(() => window.sc.errors.map((e) => `${e.reason} (refused ${e.refused})`));
+  ok(`refused: ${errs.join('; ')}`);
+  await sleep(300);
+  if (await page.evaluate(() => window.sc.frame.method) !== 'fem') await fail('a refused command changed the method');
+  // a second client: views at once, cannot control without the pass phrase
+  const page2 = await browser.newPage({ viewport: { width: 900, height: 600 } });
+  await page2.goto(url);
+  await waitFor(page2, () => window.sc?.frame?.caseId === 1 && window.sc.bscanFrames > 2 && window.sc.catalogue.length === 3, null, 'second client sees the engine');
+  await page2.click('[data-testid=case-0]');
+  await waitFor(page2, () => window.sc.errors.some((e) => /locked/.test(e.reason)), null, 'second client refused without the pass phrase');
+  await sleep(500);
+  if (await page.evaluate(() => window.sc.frame.caseId) !== 1) await fail('the locked client switched the case');
+  const f1 = await page.evaluate(() => window.sc.frame.frames);
+  await sleep(1000);
+  const [f2, b2] = await page2.evaluate(() => [window.sc.frame.frames, window.sc.bscanFrames]);
+  if (!(f2 > f1)) await fail('the first client stopped updating while the second was connected');
+  ok(`second client: viewing (${b2} B-scan frames), its command refused (controls locked); both clients updated`);
+  await page2.close();
+}
+const misses = await page.evaluate(() => window.sc.frame.misses);
+await browser.close();
+for (const p of [gateway, engine]) p.kill('SIGTERM');
+await Promise.all([stopped(gateway), stopped(engine)]);
+writeFileSync(path.join(outDir, 'engine.txt'), engine.out);
+writeFileSync(path.join(outDir, 'gateway.txt'), gateway.out);
+const m = /deadline\s+(\d+) misses on the virtual clock/.exec(engine.out);
+if (!m) await fail(`no engine summary: ${engine.out.slice(-500)}`);
+if (+m[1] !== 0 || misses !== 0) await fail(`deadline misses with clients connected: ${m[1]} (engine summary), ${misses} (state stream)`);
+ok(`zero deadline misses on the virtual clock with clients connected (${/frames at/.test(engine.out) ? engine.out.match(/probe .*frames at \d+ Hz/)[0] : ''})`);
+const gw = gateway.out.trim().split('\n').pop();
+ok(gw);
+console.log('PASS');

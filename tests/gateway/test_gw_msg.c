@@ -1,0 +1,86 @@
+/* test_gw_msg.c: the console gateway's client messages (tools/gateway/gw_msg.h): each command
+ * the CAN protocol defines parses to that command; malformed, unknown, out-of-range and
+ * over-long messages are refused with a reason. */
+#include "sc_test.h"
+
+#include <string.h>
+
+#include "gw_msg.h"
+
+static int parse(const char *s, gw_msg *m, const char **why)
+{
+    return gw_msg_parse(s, strlen(s), m, why);
+}
+
+static void each_protocol_command_parses(void **state)
+{
+    (void)state;
+    gw_msg m;
+    const char *why = NULL;
+    assert_int_equal(parse("{\"op\":\"case\",\"id\":2}", &m, &why), 0);
+    assert_int_equal(m.cmd.kind, SC_CMD_SELECT_CASE);
+    assert_int_equal(m.cmd.case_id, 2);
+    assert_int_equal(parse(" {\"value\" : \"fem\", \"op\":\"method\"} ", &m, &why), 0);
+    assert_int_equal(m.cmd.kind, SC_CMD_SET_METHOD);
+    assert_int_equal(m.cmd.method, SC_METHOD_FEM);
+    assert_int_equal(parse("{\"op\":\"imaging\",\"depth_mm\":45,\"gain_db\":-3.5,\"dyn_range_db\":70,"
+                           "\"tgc_db_per_cm\":1.5,\"geometry\":\"curvilinear\"}", &m, &why), 0);
+    assert_int_equal(m.cmd.kind, SC_CMD_SET_IMAGING);
+    assert_true(m.cmd.imaging.gain_db < -3.49f && m.cmd.imaging.gain_db > -3.51f);
+    assert_int_equal(m.cmd.imaging.geometry, SC_SCAN_CURVILINEAR);
+    assert_int_equal(parse("{\"op\":\"reset\",\"target\":\"all\"}", &m, &why), 0);
+    assert_int_equal(m.cmd.reset_target, SC_RESET_ALL);
+    assert_int_equal(parse("{\"op\":\"auth\",\"pass\":\"a\\\"b\"}", &m, &why), 0);
+    assert_int_equal(m.op, GW_OP_AUTH);
+    assert_string_equal(m.pass, "a\"b");
+    assert_int_equal(parse("{\"op\":\"ping\"}", &m, &why), 0);
+    assert_int_equal(m.op, GW_OP_PING);
+}
+
+static void bad_messages_are_refused_with_a_reason(void **state)
+{
+    (void)state;
+    static const char *const bad[] = {
+        "",
+        "[1]",
+        "{\"op\":\"case\",\"id\":2",                       /* unterminated */
+        "{\"op\":\"case\",\"id\":2} x",                    /* trailing bytes */
+        "{\"op\":\"case\",\"id\":255}",                    /* outside the DBC range */
+        "{\"op\":\"case\",\"id\":1.5}",
+        "{\"op\":\"case\",\"id\":\"1\"}",                  /* wrong type */
+        "{\"op\":\"case\",\"id\":1,\"id\":2}",             /* duplicate key */
+        "{\"op\":\"case\",\"id\":1,\"extra\":0}",          /* unknown key */
+        "{\"op\":\"method\",\"value\":\"magic\"}",
+        /* depth outside the DBC range */
+        "{\"op\":\"imaging\",\"depth_mm\":5000,\"gain_db\":0,\"dyn_range_db\":60,\"tgc_db_per_cm\":0,\"geometry\":\"linear\"}",
+        "{\"op\":\"imaging\",\"depth_mm\":40}",             /* fields missing */
+        "{\"op\":\"reset\",\"target\":\"engine\"}",
+        "{\"op\":\"shutdown\"}",                           /* not a protocol command */
+        "{\"op\":\"case\",\"id\":1e999}",
+        "{\"op\":\"auth\",\"pass\":\"\\u0041\"}",          /* unsupported escape */
+        "{\"op\":{\"nested\":1}}",
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        gw_msg m;
+        const char *why = NULL;
+        if (parse(bad[i], &m, &why) != -1 || why == NULL || why[0] == '\0') {
+            fail_msg("accepted or no reason: %s", bad[i]);
+        }
+    }
+    char big[GW_MSG_MAX + 2];
+    memset(big, ' ', sizeof big);
+    memcpy(big, "{\"op\":\"ping\"}", 13);
+    gw_msg m;
+    const char *why = NULL;
+    assert_int_equal(gw_msg_parse(big, sizeof big, &m, &why), -1);
+    assert_string_equal(why, "message too long");
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(each_protocol_command_parses),
+        cmocka_unit_test(bad_messages_are_refused_with_a_reason),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,845 @@
+/*
+ * gateway.c: sc-gateway, the instructor console's gateway (docs/console.md). It serves the
+ * console page (static files built at build time) over HTTP and bridges, over WebSockets:
+ *   - the engine's state stream (UDP records, core/sc_state.h) to every client, as is;
+ *   - the display link (UDP line packets, platform/dlink) assembled into B-scan frames, at most
+ *     --bscan-hz per client (the newest frame; older ones are skipped, never queued);
+ *   - client commands (gw_msg.h: only what the CAN protocol defines, each validated) to the
+ *     engine as authenticated CAN frames (sc_cmdsign: AES-CMAC, freshness), on SocketCAN
+ *     (--can IFACE, the appliance) or CAN over UDP (--can-udp HOST:PORT, sc-hostsim --live on a
+ *     host without SocketCAN). Refused messages are answered with an error and counted.
+ * Several clients at once; viewing is open, the controls need the pass phrase when one is set
+ * (--pass / --pass-file). The gateway is a separate process: nothing it or its clients do
+ * reaches the engine's frame but CAN frames, so the engine's deadline does not depend on it.
+ *
+ * Threads: a receive thread (UDP state + display link) fills a ring and the newest frame under
+ * a mutex and wakes libwebsockets' service thread (lws_cancel_service), which alone writes to
+ * clients and sends CAN frames.
+ */
+#include <errno.h>
+#include <getopt.h>
+#include <inttypes.h>
+#include <libwebsockets.h>
+#include <math.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "gw_msg.h"
+#include "sc_case.h"
+#include "sc_cmdsign.h"
+#include "sc_dlink.h"
+#include "sc_err.h"
+#include "sc_socketcan.h"
+#include "sc_state.h"
+#include "sc_udp_state.h"
+#include "sc_udpcan.h"
+
+#define RING 2048u
+#define MAX_CAT 32u
+#define BSCAN_HDR 32u
+#define BSCAN_MAX (BSCAN_HDR + SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES)
+#define TEXT_MAX 16384u
+
+typedef struct gw_opts {
+    int port;
+    const char *www;
+    uint16_t state_port, dlink_port;
+    const char *can_iface, *can_udp;
+    uint8_t key[16];
+    unsigned sender;
+    char pass[GW_MSG_PASS_MAX];
+    int have_pass;
+    const char *cases_dir;
+    double bscan_hz;
+    double seconds;
+} gw_opts;
+
+/* ---- shared between the receive thread and the service thread (under g.lock) -------------- */
+static struct {
+    pthread_mutex_t lock;
+    uint8_t ring[RING][SC_STATE_RECORD_MAX + 1u]; /* 'S' + record */
+    uint16_t ring_len[RING];
+    uint64_t ring_head; /* records pushed so far */
+    uint8_t bscan[BSCAN_MAX];
+    uint32_t bscan_len;
+    uint64_t bscan_gen;
+    char cat_file[MAX_CAT][256];
+    char cat_json[TEXT_MAX];
+    uint64_t cat_gen;
+    uint32_t cat_count;
+    /* counters */
+    uint64_t state_records, state_rejected, state_gaps, dlink_frames, dlink_rejected;
+    uint32_t last_seq;
+    int have_seq;
+} g = {.lock = PTHREAD_MUTEX_INITIALIZER};
+
+/* ---- service-thread state ----------------------------------------------------------------- */
+static gw_opts opt;
+static struct lws_context *ctx;
+static volatile sig_atomic_t stop;
+static sc_cmdsign signer;
+static sc_can_dev can_dev;
+static sc_socketcan can_sock;
+static sc_udpcan can_udp;
+static uint64_t cmds_sent, cmds_refused, can_tx_failed, clients_now, clients_total;
+static int udp_state_fd = -1, udp_dlink_fd = -1;
+
+typedef struct client {
+    uint64_t next_rec;   /* ring index of the next record to send */
+    uint64_t bscan_gen;  /* last frame sent */
+    double bscan_t;      /* when */
+    uint64_t cat_gen;
+    int unlocked;
+    uint64_t refused, skipped;
+    char rx[GW_MSG_MAX + 1u];
+    size_t rx_len;
+    int rx_overflow;
+    char out[8][512];    /* replies waiting (ack / error / hello) */
+    int out_n;
+    uint8_t *buf;        /* LWS_PRE + largest message */
+} client;
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+/* ---- catalogue: names from the engine's CATALOGUE records, text from the case files --------- */
+
+static void json_str(char *dst, size_t cap, const char *s)
+{
+    size_t n = 0;
+    if (cap < 3u) {
+        return;
+    }
+    dst[n++] = '"';
+    for (; *s && n + 8u < cap; s++) {
+        const unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\') {
+            dst[n++] = '\\';
+            dst[n++] = (char)c;
+        } else if (c == '\n') {
+            dst[n++] = '\\';
+            dst[n++] = 'n';
+        } else if (c < 0x20u || c >= 0x7fu) {
+            n += (size_t)snprintf(dst + n, cap - n, "\\u%04x", c < 0x20u ? c : '?');
+        } else {
+            dst[n++] = (char)c;
+        }
+    }
+    dst[n++] = '"';
+    dst[n] = '\0';
+}
+
+/* name and description of a case file's INFO section (the first section), best effort */
+static void case_info(const char *file, char *name, size_t ncap, char *desc, size_t dcap)
+{
+    snprintf(name, ncap, "%s", file);
+    desc[0] = '\0';
+    if (opt.cases_dir == NULL || strchr(file, '/') != NULL) {
+        return;
+    }
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", opt.cases_dir, file);
+    FILE *f = fopen(path, "rb");
+    if (f == NULL) {
+        snprintf(desc, dcap, "(case file not readable by the gateway)");
+        return;
+    }
+    uint8_t b[SC_CASE_HEADER_SIZE + SC_CASE_SECTION_HEADER_SIZE + SC_CASE_INFO_SIZE];
+    const size_t n = fread(b, 1, sizeof b, f);
+    fclose(f);
+    const uint8_t *h = b + SC_CASE_HEADER_SIZE;
+    if (n != sizeof b || memcmp(b, SC_CASE_MAGIC, SC_CASE_MAGIC_LEN) != 0 ||
+        memcmp(h, "INFO", 4) != 0) {
+        snprintf(desc, dcap, "(not a case file)");
+        return;
+    }
+    const char *nm = (const char *)(h + SC_CASE_SECTION_HEADER_SIZE);
+    const char *ds = nm + SC_CASE_NAME_LEN;
+    const size_t nl = strnlen(nm, SC_CASE_NAME_LEN), dl = strnlen(ds, SC_CASE_DESCRIPTION_LEN);
+    if (nl > 0u && nl < SC_CASE_NAME_LEN && nl < ncap) {
+        memcpy(name, nm, nl);
+        name[nl] = '\0';
+    }
+    if (dl < SC_CASE_DESCRIPTION_LEN && dl < dcap) {
+        memcpy(desc, ds, dl);
+        desc[dl] = '\0';
+    }
+}
+
+static void catalogue_entry(uint32_t index, uint32_t count, const char *file)
+{
+    if (index >= MAX_CAT || count > MAX_CAT) {
+        return;
+    }
+    if (g.cat_count == count && strcmp(g.cat_file[index], file) == 0) {
+        return;
+    }
+    g.cat_count = count;
+    snprintf(g.cat_file[index], sizeof g.cat_file[index], "%s", file);
+    size_t n = (size_t)snprintf(g.cat_json, sizeof g.cat_json, "{\"type\":\"catalogue\",\"entries\":[");
+    for (uint32_t i = 0; i < count && n < sizeof g.cat_json - 3000u; i++) {
+        char name[128], desc[1024], jf[600], jn[300], jd[2400];
+        if (g.cat_file[i][0] == '\0') {
+            continue;
+        }
+        case_info(g.cat_file[i], name, sizeof name, desc, sizeof desc);
+        json_str(jf, sizeof jf, g.cat_file[i]);
+        json_str(jn, sizeof jn, name);
+        json_str(jd, sizeof jd, desc);
+        n += (size_t)snprintf(g.cat_json + n, sizeof g.cat_json - n,
+                              "%s{\"index\":%u,\"file\":%s,\"name\":%s,\"description\":%s}",
+                              n > 33u ? "," : "", i, jf, jn, jd);
+    }
+    snprintf(g.cat_json + n, sizeof g.cat_json - n, "]}");
+    g.cat_gen++;
+}
+
+/* ---- receive thread ------------------------------------------------------------------------ */
+
+static int bind_udp(uint16_t port)
+{
+    const int fd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons(port)};
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (fd < 0 || bind(fd, (struct sockaddr *)&a, sizeof a) != 0) {
+        if (fd >= 0) {
+            close(fd);
+        }
+        return -1;
+    }
+    int rcv = 4 << 20;
+    (void)setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &rcv, sizeof rcv);
+    return fd;
+}
+
+static void on_state(const uint8_t *b, size_t n)
+{
+    uint32_t seq = 0, fno = 0;
+    const int type = n <= SC_STATE_RECORD_MAX ? sc_state_check(b, (uint32_t)n, &seq, &fno) : -1;
+    pthread_mutex_lock(&g.lock);
+    if (type <= 0) {
+        g.state_rejected++;
+        pthread_mutex_unlock(&g.lock);
+        return;
+    }
+    if (g.have_seq && seq != g.last_seq + 1u) {
+        g.state_gaps++;
+    }
+    g.have_seq = 1;
+    g.last_seq = seq;
+    g.state_records++;
+    if (type == SC_STATE_CATALOGUE && n >= SC_STATE_HEADER_SIZE + 12u + 240u) {
+        const uint8_t *p = b + SC_STATE_HEADER_SIZE;
+        const uint32_t idx = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+        const uint32_t cnt = (uint32_t)p[4] | (uint32_t)p[5] << 8 | (uint32_t)p[6] << 16 | (uint32_t)p[7] << 24;
+        char file[241];
+        memcpy(file, p + 12, 240);
+        file[240] = '\0';
+        catalogue_entry(idx, cnt, file);
+    }
+    const uint64_t slot = g.ring_head % RING;
+    g.ring[slot][0] = 'S';
+    memcpy(g.ring[slot] + 1, b, n);
+    g.ring_len[slot] = (uint16_t)(n + 1u);
+    g.ring_head++;
+    pthread_mutex_unlock(&g.lock);
+}
+
+static void put_u16(uint8_t *p, uint16_t v)
+{
+    p[0] = (uint8_t)v;
+    p[1] = (uint8_t)(v >> 8);
+}
+
+static void on_frame(const sc_dlink_done *d)
+{
+    const uint32_t lines = d->frame.line_count, samples = d->frame.samples;
+    if (lines * samples + BSCAN_HDR > BSCAN_MAX) {
+        return;
+    }
+    pthread_mutex_lock(&g.lock);
+    uint8_t *h = g.bscan;
+    memset(h, 0, BSCAN_HDR);
+    h[0] = 'B';
+    memcpy(h + 4, &d->frame.frame_no, 4);
+    put_u16(h + 8, (uint16_t)lines);
+    put_u16(h + 10, (uint16_t)samples);
+    put_u16(h + 12, d->frame.geometry_id);
+    put_u16(h + 14, d->frame.flags);
+    memcpy(h + 16, &d->begin.depth_mm, 4);
+    memcpy(h + 20, &d->begin.width_mm, 4);
+    memcpy(h + 24, &d->begin.radius_mm, 4);
+    put_u16(h + 28, d->end.compression_pm);
+    put_u16(h + 30, d->end.artery_compression_pm);
+    memcpy(h + BSCAN_HDR, d->image, (size_t)lines * samples);
+    g.bscan_len = BSCAN_HDR + lines * samples;
+    g.bscan_gen++;
+    g.dlink_frames++;
+    pthread_mutex_unlock(&g.lock);
+}
+
+static void *rx_thread(void *arg)
+{
+    (void)arg;
+    static sc_dlink_asm as;
+    static uint8_t buf[65536];
+    sc_dlink_asm_init(&as);
+    while (!stop) {
+        struct pollfd pf[2] = {{udp_state_fd, POLLIN, 0}, {udp_dlink_fd, POLLIN, 0}};
+        if (poll(pf, 2, 100) <= 0) {
+            continue;
+        }
+        int woke = 0;
+        for (int k = 0; k < 256; k++) {
+            const ssize_t n = recv(udp_state_fd, buf, sizeof buf, MSG_DONTWAIT);
+            if (n < 0) {
+                break;
+            }
+            on_state(buf, (size_t)n);
+            woke = 1;
+        }
+        for (int k = 0; k < 4096; k++) {
+            const ssize_t n = recv(udp_dlink_fd, buf, sizeof buf, MSG_DONTWAIT);
+            if (n < 0) {
+                break;
+            }
+            const int r = sc_dlink_asm_push(&as, buf, (size_t)n);
+            if (r == 1) {
+                on_frame(&as.done);
+                woke = 1;
+            } else if (r < 0) {
+                pthread_mutex_lock(&g.lock);
+                g.dlink_rejected++;
+                pthread_mutex_unlock(&g.lock);
+            }
+        }
+        if (woke && ctx) {
+            lws_cancel_service(ctx);
+        }
+    }
+    return NULL;
+}
+
+/* ---- commands ------------------------------------------------------------------------------ */
+
+static int send_frames(const sc_can_frame *f, int n)
+{
+    for (int i = 0; i < n; i++) {
+        int rc = sc_can_send(&can_dev, &f[i]);
+        for (int retry = 0; rc == SC_ERR_WOULD_BLOCK && retry < 10; retry++) {
+            const struct timespec ws = {0, 200000};
+            nanosleep(&ws, NULL);
+            rc = sc_can_send(&can_dev, &f[i]);
+        }
+        if (rc != SC_OK) {
+            can_tx_failed++;
+            return rc;
+        }
+    }
+    return SC_OK;
+}
+
+/* a freshness sync then the command: the engine accepts it whether or not it saw this sender */
+static int send_command(const sc_cmd *c)
+{
+    sc_can_frame f[4];
+    int rc = sc_cmdsign_sync(&signer, &f[0]);
+    if (rc == SC_OK) {
+        rc = sc_cmdsign_command(&signer, c, &f[2]);
+    }
+    if (rc == SC_OK) {
+        rc = send_frames(f, 4);
+    }
+    return rc;
+}
+
+static void reply(client *cl, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void reply(client *cl, const char *fmt, ...)
+{
+    if (cl->out_n >= 8) {
+        return; /* a client that floods gets no more replies until it reads */
+    }
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(cl->out[cl->out_n++], sizeof cl->out[0], fmt, ap);
+    va_end(ap);
+}
+
+static void refuse(client *cl, const char *op, const char *why)
+{
+    cl->refused++;
+    cmds_refused++;
+    char jw[400];
+    json_str(jw, sizeof jw, why);
+    reply(cl, "{\"type\":\"error\",\"op\":\"%s\",\"reason\":%s,\"refused\":%" PRIu64 "}", op, jw,
+          cl->refused);
+}
+
+static int pass_ok(const char *p)
+{
+    /* constant time over the longer of the two */
+    const size_t a = strlen(p), b = strlen(opt.pass), n = a > b ? a : b;
+    unsigned d = (unsigned)(a != b);
+    for (size_t i = 0; i < n; i++) {
+        d |= (unsigned)((i < a ? p[i] : 0) ^ (i < b ? opt.pass[i] : 0));
+    }
+    return d == 0u;
+}
+
+static void on_message(client *cl, const char *text, size_t len)
+{
+    gw_msg m;
+    const char *why = NULL;
+    if (gw_msg_parse(text, len, &m, &why) != 0) {
+        refuse(cl, "?", why);
+        return;
+    }
+    switch (m.op) {
+    case GW_OP_PING:
+        reply(cl, "{\"type\":\"pong\"}");
+        return;
+    case GW_OP_AUTH:
+        if (!opt.have_pass || pass_ok(m.pass)) {
+            cl->unlocked = 1;
+            reply(cl, "{\"type\":\"ack\",\"op\":\"auth\",\"controls\":true}");
+        } else {
+            refuse(cl, "auth", "wrong pass phrase");
+        }
+        return;
+    case GW_OP_COMMAND:
+        if (opt.have_pass && !cl->unlocked) {
+            refuse(cl, m.name, "controls locked: send the pass phrase first");
+            return;
+        }
+        if (send_command(&m.cmd) != SC_OK) {
+            refuse(cl, m.name, "CAN transmit failed");
+            return;
+        }
+        cmds_sent++;
+        reply(cl, "{\"type\":\"ack\",\"op\":\"%s\",\"sent\":%" PRIu64 "}", m.name, cmds_sent);
+        return;
+    case GW_OP_NONE:
+        break;
+    }
+    refuse(cl, "?", "unknown");
+}
+
+/* ---- WebSocket protocol -------------------------------------------------------------------- */
+
+static int write_msg(struct lws *wsi, client *cl, const void *p, size_t n, enum lws_write_protocol t)
+{
+    memcpy(cl->buf + LWS_PRE, p, n);
+    return lws_write(wsi, cl->buf + LWS_PRE, n, t) < (int)n ? -1 : 0;
+}
+
+static int on_writeable(struct lws *wsi, client *cl)
+{
+    if (cl->out_n > 0) {
+        const char *s = cl->out[0];
+        if (write_msg(wsi, cl, s, strlen(s), LWS_WRITE_TEXT) != 0) {
+            return -1;
+        }
+        memmove(cl->out[0], cl->out[1], sizeof cl->out[0] * (size_t)(cl->out_n - 1));
+        cl->out_n--;
+        lws_callback_on_writable(wsi);
+        return 0;
+    }
+    pthread_mutex_lock(&g.lock);
+    int rc = 0, more = 0;
+    const double t = now_s();
+    const int bscan_due = cl->bscan_gen != g.bscan_gen && g.bscan_len > 0u;
+    if (bscan_due && t - cl->bscan_t >= 1.0 / opt.bscan_hz) {
+        /* the newest frame goes first when due: records never starve the image */
+        cl->bscan_gen = g.bscan_gen;
+        cl->bscan_t = t;
+        rc = write_msg(wsi, cl, g.bscan, g.bscan_len, LWS_WRITE_BINARY);
+        more = cl->next_rec < g.ring_head || cl->cat_gen != g.cat_gen;
+    } else if (cl->cat_gen != g.cat_gen) {
+        cl->cat_gen = g.cat_gen;
+        rc = write_msg(wsi, cl, g.cat_json, strlen(g.cat_json), LWS_WRITE_TEXT);
+        more = 1;
+    } else if (cl->next_rec < g.ring_head) {
+        if (g.ring_head - cl->next_rec > RING) {
+            cl->skipped += g.ring_head - RING - cl->next_rec;
+            cl->next_rec = g.ring_head - RING;
+        }
+        const uint64_t s = cl->next_rec % RING;
+        rc = write_msg(wsi, cl, g.ring[s], g.ring_len[s], LWS_WRITE_BINARY);
+        cl->next_rec++;
+        more = cl->next_rec < g.ring_head;
+    }
+    if (rc == 0 && !more && bscan_due && cl->bscan_gen != g.bscan_gen) {
+        /* a newer frame waits for its turn: wake up then */
+        lws_set_timer_usecs(wsi, (lws_usec_t)((1.0 / opt.bscan_hz - (t - cl->bscan_t)) * 1e6) + 1000);
+    }
+    pthread_mutex_unlock(&g.lock);
+    if (rc == 0 && more) {
+        lws_callback_on_writable(wsi);
+    }
+    return rc;
+}
+
+static int cb_console(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in,
+                      size_t len)
+{
+    client *cl = user;
+    switch ((int)reason) { /* int: lws has ~100 reasons, -Wswitch-enum */
+    case LWS_CALLBACK_ESTABLISHED:
+        memset(cl, 0, sizeof *cl);
+        cl->buf = malloc(LWS_PRE + BSCAN_MAX + TEXT_MAX);
+        if (cl->buf == NULL) {
+            return -1;
+        }
+        pthread_mutex_lock(&g.lock);
+        cl->next_rec = g.ring_head > 64u ? g.ring_head - 64u : 0u; /* a little history */
+        pthread_mutex_unlock(&g.lock);
+        cl->unlocked = !opt.have_pass;
+        clients_now++;
+        clients_total++;
+        reply(cl, "{\"type\":\"hello\",\"version\":1,\"locked\":%s,\"client\":%" PRIu64 "}",
+              opt.have_pass ? "true" : "false", clients_total);
+        lws_callback_on_writable(wsi);
+        break;
+    case LWS_CALLBACK_CLOSED:
+        free(cl->buf);
+        cl->buf = NULL;
+        clients_now--;
+        break;
+    case LWS_CALLBACK_RECEIVE:
+        if (lws_frame_is_binary(wsi)) {
+            refuse(cl, "?", "binary messages are not accepted");
+            lws_callback_on_writable(wsi);
+            break;
+        }
+        if (cl->rx_len + len > GW_MSG_MAX) {
+            cl->rx_overflow = 1;
+        } else {
+            memcpy(cl->rx + cl->rx_len, in, len);
+            cl->rx_len += len;
+        }
+        if (lws_is_final_fragment(wsi)) {
+            if (cl->rx_overflow) {
+                refuse(cl, "?", "message too long");
+            } else {
+                on_message(cl, cl->rx, cl->rx_len);
+            }
+            cl->rx_len = 0;
+            cl->rx_overflow = 0;
+            lws_callback_on_writable(wsi);
+        }
+        break;
+    case LWS_CALLBACK_SERVER_WRITEABLE:
+        return on_writeable(wsi, cl);
+    case LWS_CALLBACK_TIMER:
+        lws_callback_on_writable(wsi);
+        break;
+    case LWS_CALLBACK_EVENT_WAIT_CANCELLED:
+        lws_callback_on_writable_all_protocol(lws_get_context(wsi), lws_get_protocol(wsi));
+        break;
+    default:
+        break;
+    }
+    return 0;
+}
+
+/* ---- gateway status for tests and the page (GET /status is the page's; this is stdout) ----- */
+
+static void print_stats(FILE *f)
+{
+    pthread_mutex_lock(&g.lock);
+    fprintf(f, "sc-gateway: clients %" PRIu64 " now, %" PRIu64 " total; state records %" PRIu64
+               " (%" PRIu64 " gaps, %" PRIu64 " rejected); B-scan frames %" PRIu64 " (%" PRIu64
+               " bad packets); commands sent %" PRIu64 ", refused %" PRIu64 ", CAN tx failed %" PRIu64
+               "\n",
+            clients_now, clients_total, g.state_records, g.state_gaps, g.state_rejected,
+            g.dlink_frames, g.dlink_rejected, cmds_sent, cmds_refused, can_tx_failed);
+    pthread_mutex_unlock(&g.lock);
+    fflush(f);
+}
+
+/* ---- command line ---------------------------------------------------------------------------- */
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: sc-gateway [options]\n"
+            "The instructor console's gateway: serves the page and bridges the engine's state\n"
+            "stream, display link and commands to WebSocket clients (docs/console.md).\n"
+            "  --port N            HTTP + WebSocket port (default 8080)\n"
+            "  --www DIR           the built console page (default " SC_GATEWAY_WWW ")\n"
+            "  --state-port N      UDP port of the state stream (default 47001)\n"
+            "  --dlink-port N      UDP port of the display link (default 47002)\n"
+            "  --can IFACE         commands on SocketCAN (the appliance)\n"
+            "  --can-udp H:P       commands as CAN over UDP (sc-hostsim --live --can-udp P)\n"
+            "  --auth-key K        bench | 32 hex digits: the command key (default bench)\n"
+            "  --sender N          authenticated sender id 0..3 (default 1)\n"
+            "  --pass PHRASE       pass phrase for the controls (viewing stays open)\n"
+            "  --pass-file FILE    the same, read from the first line of FILE\n"
+            "  --cases-dir DIR     where the case files are (catalogue names, descriptions)\n"
+            "  --bscan-hz HZ       B-scan frames per second per client, 1..60 (default 20)\n"
+            "  --seconds S         stop after S seconds (default: run until SIGINT/SIGTERM)\n"
+            "  --help\n");
+}
+
+static int parse_port(const char *s, int lo, long *out)
+{
+    char *e;
+    errno = 0;
+    const long v = strtol(s, &e, 10);
+    if (errno || e == s || *e || v < lo || v > 65535) {
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+/* 0 go on, -1 after --help (exit 0), 2 usage error */
+static int parse_args(int argc, char **argv, gw_opts *o)
+{
+    *o = (gw_opts){.port = 8080, .www = SC_GATEWAY_WWW, .state_port = 47001, .dlink_port = 47002,
+                   .sender = 1u, .bscan_hz = 20.0};
+    memcpy(o->key, sc_secoc_bench_key, sizeof o->key);
+    enum { O_PORT = 256, O_WWW, O_SP, O_DP, O_CAN, O_CANUDP, O_KEY, O_SENDER, O_PASS, O_PASSF,
+           O_CASES, O_BHZ, O_SEC, O_HELP };
+    static const struct option lo[] = {
+        {"port", required_argument, 0, O_PORT},      {"www", required_argument, 0, O_WWW},
+        {"state-port", required_argument, 0, O_SP},  {"dlink-port", required_argument, 0, O_DP},
+        {"can", required_argument, 0, O_CAN},        {"can-udp", required_argument, 0, O_CANUDP},
+        {"auth-key", required_argument, 0, O_KEY},   {"sender", required_argument, 0, O_SENDER},
+        {"pass", required_argument, 0, O_PASS},      {"pass-file", required_argument, 0, O_PASSF},
+        {"cases-dir", required_argument, 0, O_CASES}, {"bscan-hz", required_argument, 0, O_BHZ},
+        {"seconds", required_argument, 0, O_SEC},    {"help", no_argument, 0, O_HELP},
+        {0, 0, 0, 0}};
+    int c;
+    opterr = 0;
+    optind = 0;
+    while ((c = getopt_long(argc, argv, "", lo, NULL)) != -1) {
+        long v;
+        char *e;
+        switch (c) {
+        case O_PORT:
+            if (parse_port(optarg, 1, &v)) {
+                fprintf(stderr, "sc-gateway: --port wants 1..65535, got '%s'\n", optarg);
+                return 2;
+            }
+            o->port = (int)v;
+            break;
+        case O_WWW: o->www = optarg; break;
+        case O_SP:
+        case O_DP:
+            if (parse_port(optarg, 1, &v)) {
+                fprintf(stderr, "sc-gateway: UDP ports are 1..65535, got '%s'\n", optarg);
+                return 2;
+            }
+            if (c == O_SP) {
+                o->state_port = (uint16_t)v;
+            } else {
+                o->dlink_port = (uint16_t)v;
+            }
+            break;
+        case O_CAN: o->can_iface = optarg; break;
+        case O_CANUDP: {
+            char host[256];
+            uint16_t port;
+            if (sc_udp_parse_target(optarg, host, sizeof host, &port) != 0) {
+                fprintf(stderr, "sc-gateway: --can-udp wants HOST:PORT, got '%s'\n", optarg);
+                return 2;
+            }
+            o->can_udp = optarg;
+            break;
+        }
+        case O_KEY:
+            if (strcmp(optarg, "bench") == 0) {
+                memcpy(o->key, sc_secoc_bench_key, sizeof o->key);
+            } else if (sc_cmdsign_parse_key(optarg, o->key) != 0) {
+                fprintf(stderr, "sc-gateway: --auth-key wants bench or 32 hex digits\n");
+                return 2;
+            }
+            break;
+        case O_SENDER:
+            if (parse_port(optarg, 0, &v) || v >= (long)SC_SECOC_SENDERS) {
+                fprintf(stderr, "sc-gateway: --sender wants 0..%u\n", SC_SECOC_SENDERS - 1u);
+                return 2;
+            }
+            o->sender = (unsigned)v;
+            break;
+        case O_PASS:
+            if (strlen(optarg) == 0u || strlen(optarg) >= sizeof o->pass) {
+                fprintf(stderr, "sc-gateway: --pass wants 1..%u bytes\n", GW_MSG_PASS_MAX - 1u);
+                return 2;
+            }
+            snprintf(o->pass, sizeof o->pass, "%s", optarg);
+            o->have_pass = 1;
+            break;
+        case O_PASSF: {
+            FILE *f = fopen(optarg, "r");
+            if (f == NULL || fgets(o->pass, sizeof o->pass, f) == NULL) {
+                fprintf(stderr, "sc-gateway: cannot read a pass phrase from %s\n", optarg);
+                if (f) {
+                    fclose(f);
+                }
+                return 2;
+            }
+            fclose(f);
+            o->pass[strcspn(o->pass, "\r\n")] = '\0';
+            if (o->pass[0] == '\0') {
+                fprintf(stderr, "sc-gateway: %s: empty pass phrase\n", optarg);
+                return 2;
+            }
+            o->have_pass = 1;
+            break;
+        }
+        case O_CASES: o->cases_dir = optarg; break;
+        case O_BHZ:
+        case O_SEC: {
+            errno = 0;
+            const double d = strtod(optarg, &e);
+            const double hi = c == O_BHZ ? 60.0 : 86400.0;
+            if (errno || e == optarg || *e || !isfinite(d) || d < (c == O_BHZ ? 1.0 : 0.1) || d > hi) {
+                fprintf(stderr, "sc-gateway: --%s out of range: '%s'\n",
+                        c == O_BHZ ? "bscan-hz" : "seconds", optarg);
+                return 2;
+            }
+            if (c == O_BHZ) {
+                o->bscan_hz = d;
+            } else {
+                o->seconds = d;
+            }
+            break;
+        }
+        case O_HELP: usage(stdout); return -1;
+        default:
+            fprintf(stderr, "sc-gateway: unknown or incomplete option '%s'\n", argv[optind - 1]);
+            usage(stderr);
+            return 2;
+        }
+    }
+    if (optind != argc) {
+        fprintf(stderr, "sc-gateway: unexpected argument '%s'\n", argv[optind]);
+        return 2;
+    }
+    if ((o->can_iface != NULL) == (o->can_udp != NULL)) {
+        fprintf(stderr, "sc-gateway: give exactly one of --can IFACE and --can-udp HOST:PORT\n");
+        return 2;
+    }
+    return 0;
+}
+
+static void on_signal(int s)
+{
+    (void)s;
+    stop = 1;
+    if (ctx) {
+        lws_cancel_service(ctx);
+    }
+}
+
+int main(int argc, char **argv)
+{
+    const int pr = parse_args(argc, argv, &opt);
+    if (pr) {
+        return pr < 0 ? 0 : pr;
+    }
+    if (opt.can_udp) {
+        char host[256];
+        uint16_t port = 0;
+        (void)sc_udp_parse_target(opt.can_udp, host, sizeof host, &port);
+        if (sc_udpcan_open_tx(&can_udp, host, port) != SC_OK) {
+            fprintf(stderr, "sc-gateway: cannot open CAN over UDP to %s\n", opt.can_udp);
+            return 1;
+        }
+        can_dev = sc_udpcan_dev(&can_udp);
+    } else {
+        const int rc = sc_socketcan_open(&can_sock, sc_socketcan_sys_posix(), NULL, opt.can_iface);
+        if (rc != SC_OK) {
+            fprintf(stderr, "sc-gateway: cannot open CAN interface %s: %s (%s)\n", opt.can_iface,
+                    sc_err_str(rc), strerror(errno));
+            return 1;
+        }
+        can_dev = sc_socketcan_dev(&can_sock);
+    }
+    (void)sc_cmdsign_init(&signer, opt.key, (uint8_t)opt.sender, sc_cmdsign_fv_now(), 1);
+    udp_state_fd = bind_udp(opt.state_port);
+    udp_dlink_fd = bind_udp(opt.dlink_port);
+    if (udp_state_fd < 0 || udp_dlink_fd < 0) {
+        fprintf(stderr, "sc-gateway: cannot bind UDP ports %u/%u on 127.0.0.1: %s\n",
+                (unsigned)opt.state_port, (unsigned)opt.dlink_port, strerror(errno));
+        return 1;
+    }
+
+    static const struct lws_http_mount mount = {
+        .mountpoint = "/",
+        .mountpoint_len = 1,
+        .origin_protocol = LWSMPRO_FILE,
+        .def = "index.html",
+    };
+    struct lws_http_mount m = mount;
+    m.origin = opt.www;
+    static struct lws_protocols protocols[] = {
+        {"http", lws_callback_http_dummy, 0, 0, 0, NULL, 0},
+        {"sonocomp-console", cb_console, sizeof(client), GW_MSG_MAX, 0, NULL, 0},
+        {NULL, NULL, 0, 0, 0, NULL, 0}};
+    struct lws_context_creation_info info;
+    memset(&info, 0, sizeof info);
+    info.port = opt.port;
+    info.mounts = &m;
+    info.protocols = protocols;
+    info.options = 0; /* lws's "best practices" CSP would refuse the page's inline import map */
+    lws_set_log_level(LLL_ERR, NULL);
+    ctx = lws_create_context(&info);
+    if (ctx == NULL) {
+        fprintf(stderr, "sc-gateway: cannot start the server on port %d\n", opt.port);
+        return 1;
+    }
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    pthread_t th;
+    if (pthread_create(&th, NULL, rx_thread, NULL) != 0) {
+        fprintf(stderr, "sc-gateway: cannot start the receive thread\n");
+        return 1;
+    }
+    printf("sc-gateway: console at http://127.0.0.1:%d/ (state UDP %u, display link UDP %u, "
+           "commands on %s%s%s)\n",
+           opt.port, (unsigned)opt.state_port, (unsigned)opt.dlink_port,
+           opt.can_udp ? "CAN over UDP " : "SocketCAN ", opt.can_udp ? opt.can_udp : opt.can_iface,
+           opt.have_pass ? ", controls locked by a pass phrase" : "");
+    fflush(stdout);
+    const double t0 = now_s();
+    double last_stats = t0;
+    while (!stop && lws_service(ctx, 0) >= 0) {
+        const double t = now_s();
+        if (opt.seconds > 0.0 && t - t0 >= opt.seconds) {
+            break;
+        }
+        if (t - last_stats >= 5.0) {
+            last_stats = t;
+            print_stats(stdout);
+        }
+    }
+    stop = 1;
+    pthread_join(th, NULL);
+    print_stats(stdout);
+    lws_context_destroy(ctx);
+    if (opt.can_udp) {
+        sc_udpcan_close(&can_udp);
+    } else {
+        sc_socketcan_close(&can_sock);
+    }
+    return 0;
+}
