@@ -33,6 +33,9 @@ sc_engine_def sc_engine_default_def(void)
     d.tracker = sc_tracker_default_def();
     d.tissue = sc_tissue_default_def();
     d.bscan = sc_bscan_default_def();
+#if SC_ENABLE_DOPPLER
+    d.doppler = sc_doppler_default_def();
+#endif
     d.case_count = 0u;
     return d;
 }
@@ -175,6 +178,11 @@ static void stage_imaging(sc_engine *e, const sc_probe_in *probe, const sc_tissu
     *out = (sc_image_out){.rc = SC_OK,
                           .vein_area_ratio = SC_AREA_RATIO_NOT_AVAILABLE,
                           .artery_area_ratio = SC_AREA_RATIO_NOT_AVAILABLE};
+#if SC_ENABLE_DOPPLER
+    /* colour and spectrum come from the B-scan's own pass (a line hook) */
+    sc_doppler_advance(&e->doppler, 1.0f / (float)e->def.sched.rate_hz);
+    (void)sc_doppler_frame_begin(&e->doppler, &e->bscan, &e->hal->display, e->frame_no);
+#endif
     if (in->mesh != NULL) {
         out->rc = sc_bscan_frame(&e->bscan, in->mesh, in->nodes, &e->slot.c.volume,
                                  &probe->to_volume, in->contact, &e->hal->display, e->frame_no);
@@ -405,11 +413,20 @@ static int swap_case(sc_engine *e, uint32_t slot)
     if (rc == SC_OK) {
         rc = sc_bscan_attach_mesh(&e->bscan, &e->tissue[slot].mesh);
     }
+#if SC_ENABLE_DOPPLER
+    if (rc == SC_OK) {
+        /* the flow model of the new case: a bounded strided pass over its label map */
+        rc = sc_doppler_attach_volume(&e->doppler, &e->sw.c.volume);
+    }
+#endif
     if (rc != SC_OK) {
         /* imaging cannot show the new mesh: keep the running case if it is intact */
         if (e->case_loaded && slot != e->active) {
             (void)sc_bscan_set_def(&e->bscan, &running_def);
             (void)sc_bscan_attach_mesh(&e->bscan, &running_tissue(e)->mesh);
+#if SC_ENABLE_DOPPLER
+            (void)sc_doppler_attach_volume(&e->doppler, &e->slot.c.volume);
+#endif
         } else {
             sc_case_slot_close(&e->slot);
             set_no_case(e);
@@ -615,6 +632,11 @@ int sc_engine_init(sc_engine *e, const sc_engine_def *def, const sc_hal *hal)
     if (rc == SC_OK) {
         rc = sc_bscan_init(&e->bscan, &def->bscan);
     }
+#if SC_ENABLE_DOPPLER
+    if (rc == SC_OK) {
+        rc = sc_doppler_init(&e->doppler, &def->doppler);
+    }
+#endif
     if (rc == SC_OK) {
         rc = set_filters(e);
     }
@@ -807,3 +829,28 @@ const sc_probe_in *sc_engine_get_probe(const sc_engine *e)
 {
     return &e->probe;
 }
+
+#if SC_ENABLE_DOPPLER
+/* ==== colour and spectral Doppler settings (issue 18) ==================================== */
+
+int sc_engine_set_doppler(sc_engine *e, const sc_doppler_def *def)
+{
+    if (e == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    return sc_doppler_set_def(&e->doppler, def);
+}
+
+int sc_engine_set_flow_phase(sc_engine *e, float cardiac_phase, float resp_phase)
+{
+    if (e == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    return sc_doppler_set_phase(&e->doppler, cardiac_phase, resp_phase);
+}
+
+const sc_doppler_status *sc_engine_get_doppler_status(const sc_engine *e)
+{
+    return sc_doppler_status_get(&e->doppler);
+}
+#endif

@@ -69,6 +69,7 @@
 #include <stdint.h>
 
 #include "sc_bscan.h"
+#include "sc_doppler.h"
 #include "sc_case.h"
 #include "sc_config.h"
 #include "sc_hal.h"
@@ -133,6 +134,9 @@ typedef struct sc_engine_def {
     sc_tracker_def tracker;
     sc_tissue_def tissue;          /* mesh region and materials come from the case */
     sc_bscan_def bscan;            /* calibration comes from the case */
+#if SC_ENABLE_DOPPLER
+    sc_doppler_def doppler;        /* colour and pulsed-wave Doppler (sc_doppler.h) */
+#endif
     /* Case catalogue: catalogue index i (CmdSelectCase) names case_names[i] in storage. */
     const char *case_names[SC_ENGINE_MAX_CASES];
     uint32_t case_count;
@@ -258,6 +262,9 @@ typedef struct sc_engine {
     uint32_t misses_unlogged; /* misses since then that got no line of their own */
     sc_engine_hook_fn hook;
     void *hook_user;
+#if SC_ENABLE_DOPPLER
+    sc_doppler doppler; /* flow model of the running case, colour and spectrum per frame */
+#endif
     sc_bscan bscan;
     sc_tissue tissue[SC_ENGINE_TISSUE_SLOTS]; /* the large ones last */
 } sc_engine;
@@ -313,5 +320,20 @@ const sc_bscan_status *sc_engine_get_bscan_status(const sc_engine *e);
 uint64_t sc_engine_next_release_ns(const sc_engine *e);
 /* This frame's probe as the rx stage produced it. */
 const sc_probe_in *sc_engine_get_probe(const sc_engine *e);
+
+#if SC_ENABLE_DOPPLER
+/* Colour/spectral Doppler settings (box, steering, scale, gain, gate, flow), applied from the
+ * next frame. O(1). Errors: SC_ERR_INVALID_ARG, those of sc_doppler_def_validate (the previous
+ * settings stay). */
+int sc_engine_set_doppler(sc_engine *e, const sc_doppler_def *def);
+
+/* The cardiac and respiratory phases ([0, 1)) of the next frame's flow, e.g. from the pulsation
+ * model; without a call the Doppler's own clocks run (def.doppler heart and breathing rates).
+ * O(1). Errors: SC_ERR_INVALID_ARG, SC_ERR_NOT_FINITE. */
+int sc_engine_set_flow_phase(sc_engine *e, float cardiac_phase, float resp_phase);
+
+/* The last frame's Doppler status (colour pixels, aliasing, gate velocity). O(1). */
+const sc_doppler_status *sc_engine_get_doppler_status(const sc_engine *e);
+#endif
 
 #endif /* SC_ENGINE_H */

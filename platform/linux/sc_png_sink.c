@@ -159,7 +159,8 @@ static int png_link_state(void *ctx, sc_display_link_state *st)
     return 0;
 }
 
-static const sc_display_ops k_png_ops = {png_frame_begin, png_line, png_frame_end, png_link_state};
+static const sc_display_ops k_png_ops = {png_frame_begin, png_line, png_frame_end, png_link_state,
+                                         NULL,            NULL};
 
 int sc_png_sink_open(sc_png_sink **out, const sc_png_sink_def *def)
 {

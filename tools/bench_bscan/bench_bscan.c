@@ -53,7 +53,7 @@ static int kd_end(void *ctx, const sc_display_end_info *end)
     return SC_OK;
 }
 
-static const sc_display_ops kd_ops = {kd_begin, kd_line, kd_end, NULL};
+static const sc_display_ops kd_ops = {kd_begin, kd_line, kd_end, NULL, NULL, NULL};
 static keep_display g_kd;
 static const sc_display_dev g_dev = {&kd_ops, &g_kd};
 
