@@ -325,7 +325,7 @@ int sc_dlink_decode_as(const uint8_t *pkt, size_t len, uint8_t max_version, sc_d
     }
     /* the colour types exist in version 3 only; version 3 carries nothing else */
     if ((d.type >= SC_DLINK_COLOUR_LINE) != (ver == SC_DLINK_VERSION_COLOUR)) {
-        return SC_ERR_DLINK_VERSION;
+        return SC_ERR_DLINK_TYPE;
     }
     if (plen != expect_len) {
         return SC_ERR_DLINK_LENGTH;

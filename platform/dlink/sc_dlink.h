@@ -152,7 +152,7 @@ int sc_dlink_decode(const uint8_t *pkt, size_t len, sc_dlink_header *h, const ui
 /* sc_dlink_decode as a receiver of protocol version max_version (2 or 3) does it: a version-2
  * receiver accepts version 2 only (exactly the version-2 rules: a colour packet is refused with
  * SC_ERR_DLINK_VERSION before anything else is read); a version-3 receiver accepts version 2 for
- * types 1-3 and version 3 for types 4-5 (any other pairing: SC_ERR_DLINK_VERSION). Payload checks
+ * types 1-3 and version 3 for types 4-5 (any other pairing: SC_ERR_DLINK_TYPE). Payload checks
  * of the new types: COLOUR_LINE payload 4 + count, count >= 1, first + count <= samples,
  * line_index < line_count; DOPPLER payload 28 + bins, the DOPPLER ranges above. sc_dlink_decode is
  * this with max_version 3. */
