@@ -491,6 +491,10 @@ static sc_trk_outcome classify_and_handle(sc_tracker *t, const sc_can_frame *f, 
     case SC_MSG_AUTH_IMAGING:
     case SC_MSG_AUTH_RESET:
     case SC_MSG_AUTH_SYNC:
+    case SC_MSG_NEEDLE_POS: /* the needle has its own receiver (sc_needle_rx.h) */
+    case SC_MSG_NEEDLE_DIR:
+    case SC_MSG_NEEDLE_AUX:
+    case SC_MSG_NEEDLE_STATUS:
     case SC_MSG_COUNT:
         break;
     }
