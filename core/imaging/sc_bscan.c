@@ -1158,7 +1158,8 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
             .line = c->line, .lines_n = b->def.scan.lines_n, .samples_n = n,
             .labels = b->line_label, .runs = b->runs, .run_count = b->run_count,
             .f0 = {c->f0[0], c->f0[1], c->f0[2]}, .fd = {c->fd[0], c->fd[1], c->fd[2]},
-            .dir_x = c->dx, .dir_z = c->dz, .img2vol = &c->img2vol};
+            .org_x = c->ox, .org_z = c->oz, .dir_x = c->dx, .dir_z = c->dz, .out = b->line_out,
+            .img2vol = &c->img2vol};
         b->line_hook(b->line_hook_ctx, &lv);
     }
     if (vc->lab == NULL) {

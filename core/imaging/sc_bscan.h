@@ -166,7 +166,10 @@ typedef struct sc_bscan_line_view {
     const sc_bscan_run *runs;    /* run_count runs, increasing k, disjoint */
     uint32_t run_count;
     float f0[3], fd[3];          /* rigid position of sample k: f0 + k fd (voxel units) */
+    float org_x, org_z;          /* sample 0's position in the image frame (y = 0), mm */
     float dir_x, dir_z;          /* the line's direction in the image frame, mm per sample */
+    uint8_t *out;                /* the displayed samples, before they leave: a hook may draw
+                                  * into them (the tracked needle) */
     const sc_xform *img2vol;     /* image frame -> volume frame of this frame */
 } sc_bscan_line_view;
 
