@@ -103,6 +103,12 @@ static void stage_rx(sc_engine *e, uint64_t now, sc_probe_in *out)
             break;
         }
         e->counters.can_rx_frames++;
+#if SC_ENABLE_NEEDLE
+        if (sc_needle_rx_is_needle(&f)) {
+            (void)sc_needle_rx_on_frame(&e->needle_rx, &f, now);
+            continue;
+        }
+#endif
         (void)sc_tracker_on_frame(&e->tracker, &f, now);
     }
     if (n == SC_CAN_RX_BURST_MAX) {
@@ -124,6 +130,20 @@ static void stage_rx(sc_engine *e, uint64_t now, sc_probe_in *out)
         out->to_volume = sc_xform_compose(&e->slot.c.tracker_to_volume, &t);
         out->pose_volume = sc_pose_from_xform(&out->to_volume);
     }
+#if SC_ENABLE_NEEDLE
+    {
+        /* the needle in the volume frame, through the same registration as the probe */
+        sc_needle_sample ns;
+        if (e->case_loaded && sc_needle_rx_poll(&e->needle_rx, now, &ns)) {
+            float tip[3], dir[3];
+            sc_xform_apply(&e->slot.c.tracker_to_volume, ns.tip_mm, tip);
+            sc_xform_rotate(&e->slot.c.tracker_to_volume, ns.dir, dir);
+            sc_needle_set(&e->needle, 1, tip, dir, ns.depth_mm);
+        } else {
+            sc_needle_set(&e->needle, 0, NULL, NULL, 0.0f);
+        }
+    }
+#endif
     update_tracker_faults(e, now, out->tracked);
 }
 
@@ -172,6 +192,21 @@ static void stage_physics(sc_engine *e, uint64_t now, const sc_probe_in *in, sc_
 
 /* ==== stage imaging: the deformed mesh -> scan lines and the compression measure ========= */
 
+#if SC_ENABLE_NEEDLE
+/* Both per-line consumers of the B-scan's pass: colour Doppler (when on this frame) and the
+ * needle, which draws into the displayed samples. */
+static void engine_line_hook(void *ctx, const sc_bscan_line_view *v)
+{
+    sc_engine *e = ctx;
+#if SC_ENABLE_DOPPLER
+    if (e->doppler_on) {
+        sc_doppler_line_hook(&e->doppler, v);
+    }
+#endif
+    sc_needle_line(&e->needle, v);
+}
+#endif
+
 static void stage_imaging(sc_engine *e, const sc_probe_in *probe, const sc_tissue_out *in,
                           sc_image_out *out)
 {
@@ -182,6 +217,15 @@ static void stage_imaging(sc_engine *e, const sc_probe_in *probe, const sc_tissu
     /* colour and spectrum come from the B-scan's own pass (a line hook) */
     sc_doppler_advance(&e->doppler, 1.0f / (float)e->def.sched.rate_hz);
     (void)sc_doppler_frame_begin(&e->doppler, &e->bscan, &e->hal->display, e->frame_no);
+    e->doppler_on = (uint8_t)(e->bscan.line_hook == sc_doppler_line_hook);
+#endif
+#if SC_ENABLE_NEEDLE
+    {
+        const sc_xform img2vol =
+            sc_xform_compose(&probe->to_volume, &e->bscan.def.scan.image_to_probe);
+        sc_needle_frame_begin(&e->needle, &img2vol);
+        sc_bscan_set_line_hook(&e->bscan, engine_line_hook, e);
+    }
 #endif
     if (in->mesh != NULL) {
         out->rc = sc_bscan_frame(&e->bscan, in->mesh, in->nodes, &e->slot.c.volume,
@@ -189,6 +233,14 @@ static void stage_imaging(sc_engine *e, const sc_probe_in *probe, const sc_tissu
         if (out->rc != SC_OK) {
             e->counters.imaging_errors++;
         }
+#if SC_ENABLE_NEEDLE
+        if (sc_needle_frame_end(&e->needle, &e->slot.c.volume)) {
+            const sc_needle_status *ns = sc_needle_status_get(&e->needle);
+            sc_log(&e->hal->log, ns->last_puncture == SC_LABEL_ARTERY ? SC_LOG_WARN : SC_LOG_INFO,
+                   "needle_puncture", SC_OK, (int64_t)ns->last_puncture,
+                   (int64_t)(ns->vein_punctures + ns->artery_punctures));
+        }
+#endif
         const sc_bscan_status *b = sc_bscan_status_get(&e->bscan);
         if (b->areas_valid) {
             if (b->area_ratio[SC_LABEL_VEIN] >= 0.0f) {
@@ -240,6 +292,30 @@ static void stage_status(sc_engine *e, uint64_t now, const sc_probe_in *probe,
             e->counters.can_tx_failed++;
         }
     }
+#if SC_ENABLE_NEEDLE
+    {
+        const sc_needle_status *ns = sc_needle_status_get(&e->needle);
+        const uint32_t rej = e->needle_rx.rejected;
+        const sc_needle_status_msg m = {
+            .tip_vessel = (ns->present && (ns->tip_label == SC_LABEL_VEIN ||
+                                           ns->tip_label == SC_LABEL_ARTERY))
+                              ? ns->tip_label
+                              : 0u,
+            .needle_tracked = ns->present,
+            .last_puncture = ns->last_puncture,
+            .vein_punctures = (uint8_t)(ns->vein_punctures > 255u ? 255u : ns->vein_punctures),
+            .artery_punctures =
+                (uint8_t)(ns->artery_punctures > 255u ? 255u : ns->artery_punctures),
+            .needle_rejected = (uint16_t)(rej > 65535u ? 65535u : rej),
+        };
+        sc_can_frame nf;
+        if (sc_canproto_encode_needle_status(&m, e->needle_status_counter, &nf) != SC_OK ||
+            sc_can_send(&e->hal->can, &nf) != SC_OK) {
+            e->counters.can_tx_failed++;
+        }
+        e->needle_status_counter = (uint8_t)((e->needle_status_counter + 1u) & 0x0Fu);
+    }
+#endif
 }
 
 /* ==== control step: commands and case switches, between frames ========================== */
@@ -581,6 +657,10 @@ static int set_filters(sc_engine *e)
         {.id = SC_CANID_POSE_POS, .mask = 0x7FEu, .flags = 0},  /* 0x100..0x101 */
         {.id = SC_CANID_POSE_AUX, .mask = 0x7FFu, .flags = 0},  /* 0x102 */
         {.id = SC_CANID_POSE_FD, .mask = 0x7FFu, .flags = 0},
+#if SC_ENABLE_NEEDLE
+        {.id = SC_CANID_NEEDLE_POS, .mask = 0x7FEu, .flags = 0}, /* 0x120..0x121 */
+        {.id = SC_CANID_NEEDLE_AUX, .mask = 0x7FFu, .flags = 0}, /* 0x122 */
+#endif
     };
     const int rc = sc_can_set_filters(&e->hal->can, f, SC_COUNT_OF(f));
     return rc == SC_ERR_NOT_SUPPORTED ? SC_OK : rc;
@@ -635,6 +715,16 @@ int sc_engine_init(sc_engine *e, const sc_engine_def *def, const sc_hal *hal)
 #if SC_ENABLE_DOPPLER
     if (rc == SC_OK) {
         rc = sc_doppler_init(&e->doppler, &def->doppler);
+    }
+#endif
+#if SC_ENABLE_NEEDLE
+    if (rc == SC_OK) {
+        const sc_needle_rx_def nrd = sc_needle_rx_default_def();
+        rc = sc_needle_rx_init(&e->needle_rx, &nrd);
+    }
+    if (rc == SC_OK) {
+        const sc_needle_def nd = sc_needle_default_def();
+        rc = sc_needle_init(&e->needle, &nd);
     }
 #endif
     if (rc == SC_OK) {
@@ -852,5 +942,17 @@ int sc_engine_set_flow_phase(sc_engine *e, float cardiac_phase, float resp_phase
 const sc_doppler_status *sc_engine_get_doppler_status(const sc_engine *e)
 {
     return sc_doppler_status_get(&e->doppler);
+}
+#endif
+
+#if SC_ENABLE_NEEDLE
+const sc_needle_status *sc_engine_get_needle_status(const sc_engine *e)
+{
+    return sc_needle_status_get(&e->needle);
+}
+
+const sc_needle_rx *sc_engine_get_needle_rx(const sc_engine *e)
+{
+    return &e->needle_rx;
 }
 #endif

@@ -70,6 +70,8 @@
 
 #include "sc_bscan.h"
 #include "sc_doppler.h"
+#include "sc_needle.h"
+#include "sc_needle_rx.h"
 #include "sc_case.h"
 #include "sc_config.h"
 #include "sc_hal.h"
@@ -264,6 +266,12 @@ typedef struct sc_engine {
     void *hook_user;
 #if SC_ENABLE_DOPPLER
     sc_doppler doppler; /* flow model of the running case, colour and spectrum per frame */
+    uint8_t doppler_on; /* this frame */
+#endif
+#if SC_ENABLE_NEEDLE
+    sc_needle_rx needle_rx; /* the tracked needle's CAN receiver */
+    sc_needle needle;       /* drawn in the B-scan, punctures */
+    uint8_t needle_status_counter;
 #endif
     sc_bscan bscan;
     sc_tissue tissue[SC_ENGINE_TISSUE_SLOTS]; /* the large ones last */
@@ -334,6 +342,13 @@ int sc_engine_set_flow_phase(sc_engine *e, float cardiac_phase, float resp_phase
 
 /* The last frame's Doppler status (colour pixels, aliasing, gate velocity). O(1). */
 const sc_doppler_status *sc_engine_get_doppler_status(const sc_engine *e);
+#endif
+
+#if SC_ENABLE_NEEDLE
+/* The tracked needle's last frame: presence, tip label, punctures (each lumen entry once; an
+ * artery entry is a fault of the exam), pixels drawn; and its receiver's counters. O(1). */
+const sc_needle_status *sc_engine_get_needle_status(const sc_engine *e);
+const sc_needle_rx *sc_engine_get_needle_rx(const sc_engine *e);
 #endif
 
 #endif /* SC_ENGINE_H */
