@@ -12,6 +12,7 @@
 #include "sc_hs_display.h"
 #include "sc_needle.h"
 #include "sc_needle_rx.h"
+#include "sc_trkemu.h"
 
 #define VSP 0.5f
 #define VNX 100u /* x -10 .. 40 */
@@ -349,6 +350,42 @@ static void needle_status_frame_round_trips(void **state)
     assert_int_equal(sc_e2e_crc(SC_CANID_NEEDLE_STATUS, f.data, f.len), f.data[0]);
 }
 
+static void the_emulated_needle_goes_in_holds_and_comes_out(void **state)
+{
+    (void)state;
+    sc_emu_needle_def d = sc_emu_needle_default_def();
+    d.entry_mm[0] = 15.0f;
+    d.dir[0] = 1.0f; /* normalised by init: (1, 0, 1) / sqrt 2 */
+    sc_emu_needle en;
+    assert_int_equal(sc_emu_needle_init(&en, &d), SC_OK);
+    const sc_needle_rx_def rd = sc_needle_rx_default_def();
+    assert_int_equal(sc_needle_rx_init(&g_rx, &rd), SC_OK);
+    float max_depth = 0.0f, last_depth = -1.0f;
+    for (int i = 0; i < 650; i++) { /* 6.5 s at 100 Hz: 0.5 s, then 2.5 s in, 1 s, 2.5 s out */
+        sc_can_frame f[3];
+        uint64_t t;
+        assert_int_equal(sc_emu_needle_next(&en, f, 3u, &t), 3);
+        for (int k = 0; k < 3; k++) {
+            const sc_needle_outcome o = sc_needle_rx_on_frame(&g_rx, &f[k], t);
+            assert_int_equal(o, k < 2 ? SC_NEEDLE_PART : SC_NEEDLE_ACCEPTED);
+        }
+        sc_needle_sample smp;
+        assert_int_equal(sc_needle_rx_poll(&g_rx, t, &smp), 1);
+        /* the tip is where the script says, within the signals' resolution */
+        const sc_needle_msg m = sc_emu_needle_at(&en.def, (double)t * 1e-9);
+        for (int a = 0; a < 3; a++) {
+            assert_true(fabsf(smp.tip_mm[a] - m.tip_mm[a]) <= 0.03f);
+        }
+        max_depth = fmaxf(max_depth, smp.depth_mm);
+        last_depth = smp.depth_mm;
+    }
+    assert_true(fabsf(max_depth - 25.0f) <= 0.03f);
+    assert_true(last_depth < 1.0f); /* withdrawn at the end of the cycle */
+    assert_int_equal(g_rx.rejected, 0u);
+    d.speed_mm_s = 0.0f;
+    assert_int_equal(sc_emu_needle_init(&en, &d), SC_ERR_RANGE);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -359,6 +396,7 @@ int main(void)
         cmocka_unit_test(needle_image_is_deterministic),
         cmocka_unit_test(needle_frames_assemble_and_bad_ones_are_refused_and_counted),
         cmocka_unit_test(needle_status_frame_round_trips),
+        cmocka_unit_test(the_emulated_needle_goes_in_holds_and_comes_out),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
