@@ -293,7 +293,9 @@ static void stage_status(sc_engine *e, uint64_t now, const sc_probe_in *probe,
         }
     }
 #if SC_ENABLE_NEEDLE
-    {
+    /* NeedleStatus once a needle tool has spoken on the bus (a frame accepted or refused):
+     * without one the bus carries what it always did */
+    if (e->needle_rx.outcome[SC_NEEDLE_ACCEPTED] != 0u || e->needle_rx.rejected != 0u) {
         const sc_needle_status *ns = sc_needle_status_get(&e->needle);
         const uint32_t rej = e->needle_rx.rejected;
         const sc_needle_status_msg m = {
