@@ -158,6 +158,18 @@ static void stage_physics(sc_engine *e, uint64_t now, const sc_probe_in *in, sc_
     sc_tissue *t = running_tissue(e);
     const int frozen = sc_health_is_active(&e->health, SC_FAULT_PHYS_REPEATED);
     const sc_pose *probe = (in->tracked && !frozen) ? &in->pose_volume : NULL;
+#if SC_ENABLE_NEEDLE
+    /* the inserted needle's tip pushes tissue aside: a sphere of 0.6 node spacings (at least
+     * 1 mm), so that the mesh's nodes, not the 1.2 mm tip itself, resolve it */
+    {
+        const float *cm = t->mesh.cell_mm;
+        float cell = cm[0] > cm[1] ? cm[0] : cm[1];
+        cell = cell > cm[2] ? cell : cm[2];
+        const float radius = 0.6f * cell > 1.0f ? 0.6f * cell : 1.0f;
+        sc_tissue_set_tip(t, e->needle.present && e->needle.depth_mm > 0.0f && !frozen,
+                          e->needle.tip_mm, radius);
+    }
+#endif
     const int rc = sc_tissue_step(t, probe);
     if (rc == SC_ERR_PHYS_UNSTABLE) {
         out->reset = 1;

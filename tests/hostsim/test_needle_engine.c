@@ -37,6 +37,8 @@ typedef struct needle_seen {
     uint32_t status_frames;
     sc_needle_status_msg last;
     uint32_t max_drawn;
+    uint32_t max_tip_contacts; /* tissue nodes the tip pushed */
+    float max_moved_mm;        /* largest node displacement seen (the probe only hovers) */
 } needle_seen;
 
 /* n frames; probe and needle samples due before each frame go on the bus, the engine's
@@ -74,6 +76,17 @@ static void run(uint32_t n, needle_seen *seen)
                           rig.engine.needle_rx.rejected);
         }
         seen->max_drawn = ns->drawn_pixels > seen->max_drawn ? ns->drawn_pixels : seen->max_drawn;
+        const uint32_t tc = rig.engine.tissue[rig.engine.active].tip_contacts;
+        seen->max_tip_contacts = tc > seen->max_tip_contacts ? tc : seen->max_tip_contacts;
+        if (tc > 0u) {
+            const sc_tissue *tt = &rig.engine.tissue[rig.engine.active];
+            for (uint32_t k = 0; k < tt->mesh.node_count; k++) {
+                const float ux = tt->nodes.x[k] - tt->mesh.rest_x[k];
+                const float uy = tt->nodes.y[k] - tt->mesh.rest_y[k];
+                const float uz = tt->nodes.z[k] - tt->mesh.rest_z[k];
+                seen->max_moved_mm = fmaxf(seen->max_moved_mm, sqrtf(ux * ux + uy * uy + uz * uz));
+            }
+        }
         sc_can_frame r;
         while (sc_can_recv(&rig.peer, &r) == SC_OK) {
             if (r.id == SC_CANID_NEEDLE_STATUS) {
@@ -131,6 +144,27 @@ static void a_needle_into_the_vein_is_reported_once_per_entry_on_can(void **stat
     assert_int_equal(seen.last.needle_tracked, 1u);
     assert_int_equal(seen.last.needle_rejected, 0u);
     assert_true(seen.max_drawn > 20u); /* the shaft is in the image */
+    /* the tip pushed tissue: nodes near it held on its sphere, moved from rest */
+    {
+        const sc_tissue *t = &rig.engine.tissue[rig.engine.active];
+        const float *tip = rig.engine.needle.tip_mm;
+        float moved = 0.0f;
+        for (uint32_t i = 0; i < t->mesh.node_count; i++) {
+            const float dx = t->nodes.x[i] - tip[0], dy = t->nodes.y[i] - tip[1],
+                        dz = t->nodes.z[i] - tip[2];
+            if (dx * dx + dy * dy + dz * dz < 3.0f * 3.0f) { /* the 2.2 mm tip sphere and beyond */
+                const float ux = t->nodes.x[i] - t->mesh.rest_x[i];
+                const float uy = t->nodes.y[i] - t->mesh.rest_y[i];
+                const float uz = t->nodes.z[i] - t->mesh.rest_z[i];
+                moved = fmaxf(moved, sqrtf(ux * ux + uy * uy + uz * uz));
+            }
+        }
+        print_message("tip contacts up to %u, nodes moved up to %.2f mm while pushed (%.2f mm "
+                      "near the held tip now)\n",
+                      seen.max_tip_contacts, (double)seen.max_moved_mm, (double)moved);
+        assert_true(seen.max_tip_contacts > 0u);
+        assert_true(seen.max_moved_mm > 0.1f); /* the probe hovers: only the tip moves them */
+    }
     run(180, &seen); /* out (3.3 .. 4.7 s) and in again */
     print_message("after 6 s: vein %u artery %u\n", seen.last.vein_punctures,
                   seen.last.artery_punctures);
