@@ -217,6 +217,23 @@ _Static_assert(SC_TRK_AUTH_PAIR_MS >= 1u && SC_TRK_AUTH_PAIR_MS <= 1000u,
 _Static_assert(SC_SOCKETCAN_CLOCK_READINGS >= 1u && SC_SOCKETCAN_CLOCK_READINGS <= 64u,
                "1..64 clock readings per time stamp offset estimate");
 
+/* ---- vessel cues (issue 18): colour/spectral Doppler and the tracked needle ---- */
+/* 1: the engine carries colour and pulsed-wave Doppler (core/imaging/sc_doppler.h); 0 leaves
+ * it out (an MCU short of RAM): the engine then sends B-mode only. */
+#ifndef SC_ENABLE_DOPPLER
+#define SC_ENABLE_DOPPLER 1
+#endif
+/* Bins of the pulsed-wave spectrum column sent with each frame (<= 128, the display link's). */
+#ifndef SC_DOPPLER_SPECTRUM_BINS
+#define SC_DOPPLER_SPECTRUM_BINS 128u
+#endif
+/* 1: the tracked needle (second tool on CAN, drawn in the B-scan, puncture reports). */
+#ifndef SC_ENABLE_NEEDLE
+#define SC_ENABLE_NEEDLE 1
+#endif
+_Static_assert(SC_DOPPLER_SPECTRUM_BINS >= 8u && SC_DOPPLER_SPECTRUM_BINS <= 128u,
+               "8..128 spectrum bins");
+
 _Static_assert(SC_FRAME_RATE_DEFAULT_HZ >= SC_FRAME_RATE_MIN_HZ &&
                    SC_FRAME_RATE_DEFAULT_HZ <= SC_FRAME_RATE_MAX_HZ,
                "default frame rate outside its range");

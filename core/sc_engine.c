@@ -34,6 +34,9 @@ sc_engine_def sc_engine_default_def(void)
     d.tissue = sc_tissue_default_def();
     d.bscan = sc_bscan_default_def();
     d.assess = sc_assess_default_def();
+#if SC_ENABLE_DOPPLER
+    d.doppler = sc_doppler_default_def();
+#endif
     d.case_count = 0u;
     d.state_period_ms = 33u;
     d.state_vert_records = 16u;
@@ -103,6 +106,12 @@ static void stage_rx(sc_engine *e, uint64_t now, sc_probe_in *out)
             break;
         }
         e->counters.can_rx_frames++;
+#if SC_ENABLE_NEEDLE
+        if (sc_needle_rx_is_needle(&f)) {
+            (void)sc_needle_rx_on_frame(&e->needle_rx, &f, now);
+            continue;
+        }
+#endif
         (void)sc_tracker_on_frame(&e->tracker, &f, now);
     }
     if (n == SC_CAN_RX_BURST_MAX) {
@@ -124,6 +133,20 @@ static void stage_rx(sc_engine *e, uint64_t now, sc_probe_in *out)
         out->to_volume = sc_xform_compose(&e->slot.c.tracker_to_volume, &t);
         out->pose_volume = sc_pose_from_xform(&out->to_volume);
     }
+#if SC_ENABLE_NEEDLE
+    {
+        /* the needle in the volume frame, through the same registration as the probe */
+        sc_needle_sample ns;
+        if (e->case_loaded && sc_needle_rx_poll(&e->needle_rx, now, &ns)) {
+            float tip[3], dir[3];
+            sc_xform_apply(&e->slot.c.tracker_to_volume, ns.tip_mm, tip);
+            sc_xform_rotate(&e->slot.c.tracker_to_volume, ns.dir, dir);
+            sc_needle_set(&e->needle, 1, tip, dir, ns.depth_mm);
+        } else {
+            sc_needle_set(&e->needle, 0, NULL, NULL, 0.0f);
+        }
+    }
+#endif
     update_tracker_faults(e, now, out->tracked);
 }
 
@@ -138,6 +161,18 @@ static void stage_physics(sc_engine *e, uint64_t now, const sc_probe_in *in, sc_
     sc_tissue *t = running_tissue(e);
     const int frozen = sc_health_is_active(&e->health, SC_FAULT_PHYS_REPEATED);
     const sc_pose *probe = (in->tracked && !frozen) ? &in->pose_volume : NULL;
+#if SC_ENABLE_NEEDLE
+    /* the inserted needle's tip pushes tissue aside: a sphere of 0.6 node spacings (at least
+     * 1 mm), so that the mesh's nodes, not the 1.2 mm tip itself, resolve it */
+    {
+        const float *cm = t->mesh.cell_mm;
+        float cell = cm[0] > cm[1] ? cm[0] : cm[1];
+        cell = cell > cm[2] ? cell : cm[2];
+        const float radius = 0.6f * cell > 1.0f ? 0.6f * cell : 1.0f;
+        sc_tissue_set_tip(t, e->needle.present && e->needle.depth_mm > 0.0f && !frozen,
+                          e->needle.tip_mm, radius);
+    }
+#endif
     const int rc = sc_tissue_step(t, probe);
     if (rc == SC_ERR_PHYS_UNSTABLE) {
         out->reset = 1;
@@ -172,18 +207,55 @@ static void stage_physics(sc_engine *e, uint64_t now, const sc_probe_in *in, sc_
 
 /* ==== stage imaging: the deformed mesh -> scan lines and the compression measure ========= */
 
+#if SC_ENABLE_NEEDLE
+/* Both per-line consumers of the B-scan's pass: colour Doppler (when on this frame) and the
+ * needle, which draws into the displayed samples. */
+static void engine_line_hook(void *ctx, const sc_bscan_line_view *v)
+{
+    sc_engine *e = ctx;
+#if SC_ENABLE_DOPPLER
+    if (e->doppler_on) {
+        sc_doppler_line_hook(&e->doppler, v);
+    }
+#endif
+    sc_needle_line(&e->needle, v);
+}
+#endif
+
 static void stage_imaging(sc_engine *e, const sc_probe_in *probe, const sc_tissue_out *in,
                           sc_image_out *out)
 {
     *out = (sc_image_out){.rc = SC_OK,
                           .vein_area_ratio = SC_AREA_RATIO_NOT_AVAILABLE,
                           .artery_area_ratio = SC_AREA_RATIO_NOT_AVAILABLE};
+#if SC_ENABLE_DOPPLER
+    /* colour and spectrum come from the B-scan's own pass (a line hook) */
+    sc_doppler_advance(&e->doppler, 1.0f / (float)e->def.sched.rate_hz);
+    (void)sc_doppler_frame_begin(&e->doppler, &e->bscan, &e->hal->display, e->frame_no);
+    e->doppler_on = (uint8_t)(e->bscan.line_hook == sc_doppler_line_hook);
+#endif
+#if SC_ENABLE_NEEDLE
+    {
+        const sc_xform img2vol =
+            sc_xform_compose(&probe->to_volume, &e->bscan.def.scan.image_to_probe);
+        sc_needle_frame_begin(&e->needle, &img2vol);
+        sc_bscan_set_line_hook(&e->bscan, engine_line_hook, e);
+    }
+#endif
     if (in->mesh != NULL) {
         out->rc = sc_bscan_frame(&e->bscan, in->mesh, in->nodes, &e->slot.c.volume,
                                  &probe->to_volume, in->contact, &e->hal->display, e->frame_no);
         if (out->rc != SC_OK) {
             e->counters.imaging_errors++;
         }
+#if SC_ENABLE_NEEDLE
+        if (sc_needle_frame_end(&e->needle, &e->slot.c.volume)) {
+            const sc_needle_status *ns = sc_needle_status_get(&e->needle);
+            sc_log(&e->hal->log, ns->last_puncture == SC_LABEL_ARTERY ? SC_LOG_WARN : SC_LOG_INFO,
+                   "needle_puncture", SC_OK, (int64_t)ns->last_puncture,
+                   (int64_t)(ns->vein_punctures + ns->artery_punctures));
+        }
+#endif
         const sc_bscan_status *b = sc_bscan_status_get(&e->bscan);
         if (b->areas_valid) {
             if (b->area_ratio[SC_LABEL_VEIN] >= 0.0f) {
@@ -270,6 +342,32 @@ static void stage_status(sc_engine *e, uint64_t now, const sc_probe_in *probe,
         }
     }
     send_assessment(e);
+#if SC_ENABLE_NEEDLE
+    /* NeedleStatus once a needle tool has spoken on the bus (a frame accepted or refused):
+     * without one the bus carries what it always did */
+    if (e->needle_rx.outcome[SC_NEEDLE_ACCEPTED] != 0u || e->needle_rx.rejected != 0u) {
+        const sc_needle_status *ns = sc_needle_status_get(&e->needle);
+        const uint32_t rej = e->needle_rx.rejected;
+        const sc_needle_status_msg m = {
+            .tip_vessel = (ns->present && (ns->tip_label == SC_LABEL_VEIN ||
+                                           ns->tip_label == SC_LABEL_ARTERY))
+                              ? ns->tip_label
+                              : 0u,
+            .needle_tracked = ns->present,
+            .last_puncture = ns->last_puncture,
+            .vein_punctures = (uint8_t)(ns->vein_punctures > 255u ? 255u : ns->vein_punctures),
+            .artery_punctures =
+                (uint8_t)(ns->artery_punctures > 255u ? 255u : ns->artery_punctures),
+            .needle_rejected = (uint16_t)(rej > 65535u ? 65535u : rej),
+        };
+        sc_can_frame nf;
+        if (sc_canproto_encode_needle_status(&m, e->needle_status_counter, &nf) != SC_OK ||
+            sc_can_send(&e->hal->can, &nf) != SC_OK) {
+            e->counters.can_tx_failed++;
+        }
+        e->needle_status_counter = (uint8_t)((e->needle_status_counter + 1u) & 0x0Fu);
+    }
+#endif
 }
 
 /* ==== control step: commands and case switches, between frames ========================== */
@@ -478,11 +576,20 @@ static int swap_case(sc_engine *e, uint32_t slot)
     if (rc == SC_OK) {
         rc = sc_bscan_attach_mesh(&e->bscan, &e->tissue[slot].mesh);
     }
+#if SC_ENABLE_DOPPLER
+    if (rc == SC_OK) {
+        /* the flow model of the new case: a bounded strided pass over its label map */
+        rc = sc_doppler_attach_volume(&e->doppler, &e->sw.c.volume);
+    }
+#endif
     if (rc != SC_OK) {
         /* imaging cannot show the new mesh: keep the running case if it is intact */
         if (e->case_loaded && slot != e->active) {
             (void)sc_bscan_set_def(&e->bscan, &running_def);
             (void)sc_bscan_attach_mesh(&e->bscan, &running_tissue(e)->mesh);
+#if SC_ENABLE_DOPPLER
+            (void)sc_doppler_attach_volume(&e->doppler, &e->slot.c.volume);
+#endif
         } else {
             sc_case_slot_close(&e->slot);
             set_no_case(e);
@@ -639,6 +746,10 @@ static int set_filters(sc_engine *e)
         {.id = SC_CANID_POSE_POS, .mask = 0x7FEu, .flags = 0},  /* 0x100..0x101 */
         {.id = SC_CANID_POSE_AUX, .mask = 0x7FFu, .flags = 0},  /* 0x102 */
         {.id = SC_CANID_POSE_FD, .mask = 0x7FFu, .flags = 0},
+#if SC_ENABLE_NEEDLE
+        {.id = SC_CANID_NEEDLE_POS, .mask = 0x7FEu, .flags = 0}, /* 0x120..0x121 */
+        {.id = SC_CANID_NEEDLE_AUX, .mask = 0x7FFu, .flags = 0}, /* 0x122 */
+#endif
     };
     const int rc = sc_can_set_filters(&e->hal->can, f, SC_COUNT_OF(f));
     return rc == SC_ERR_NOT_SUPPORTED ? SC_OK : rc;
@@ -697,6 +808,21 @@ int sc_engine_init(sc_engine *e, const sc_engine_def *def, const sc_hal *hal)
     if (rc == SC_OK) {
         rc = sc_bscan_init(&e->bscan, &def->bscan);
     }
+#if SC_ENABLE_DOPPLER
+    if (rc == SC_OK) {
+        rc = sc_doppler_init(&e->doppler, &def->doppler);
+    }
+#endif
+#if SC_ENABLE_NEEDLE
+    if (rc == SC_OK) {
+        const sc_needle_rx_def nrd = sc_needle_rx_default_def();
+        rc = sc_needle_rx_init(&e->needle_rx, &nrd);
+    }
+    if (rc == SC_OK) {
+        const sc_needle_def nd = sc_needle_default_def();
+        rc = sc_needle_init(&e->needle, &nd);
+    }
+#endif
     if (rc == SC_OK) {
         rc = sc_assess_init(&e->assess, &def->assess);
     }
@@ -962,3 +1088,40 @@ const sc_assess_report *sc_engine_assessment(const sc_engine *e)
 {
     return sc_assess_get(&e->assess);
 }
+
+#if SC_ENABLE_DOPPLER
+/* ==== colour and spectral Doppler settings (issue 18) ==================================== */
+
+int sc_engine_set_doppler(sc_engine *e, const sc_doppler_def *def)
+{
+    if (e == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    return sc_doppler_set_def(&e->doppler, def);
+}
+
+int sc_engine_set_flow_phase(sc_engine *e, float cardiac_phase, float resp_phase)
+{
+    if (e == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    return sc_doppler_set_phase(&e->doppler, cardiac_phase, resp_phase);
+}
+
+const sc_doppler_status *sc_engine_get_doppler_status(const sc_engine *e)
+{
+    return sc_doppler_status_get(&e->doppler);
+}
+#endif
+
+#if SC_ENABLE_NEEDLE
+const sc_needle_status *sc_engine_get_needle_status(const sc_engine *e)
+{
+    return sc_needle_status_get(&e->needle);
+}
+
+const sc_needle_rx *sc_engine_get_needle_rx(const sc_engine *e)
+{
+    return &e->needle_rx;
+}
+#endif

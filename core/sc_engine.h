@@ -76,6 +76,9 @@
 
 #include "sc_assess.h"
 #include "sc_bscan.h"
+#include "sc_doppler.h"
+#include "sc_needle.h"
+#include "sc_needle_rx.h"
 #include "sc_case.h"
 #include "sc_config.h"
 #include "sc_hal.h"
@@ -142,6 +145,9 @@ typedef struct sc_engine_def {
     sc_tissue_def tissue;          /* mesh region and materials come from the case */
     sc_bscan_def bscan;            /* calibration comes from the case */
     sc_assess_def assess;          /* the compression exam's assessment (sc_assess.h) */
+#if SC_ENABLE_DOPPLER
+    sc_doppler_def doppler;        /* colour and pulsed-wave Doppler (sc_doppler.h) */
+#endif
     /* Case catalogue: catalogue index i (CmdSelectCase) names case_names[i] in storage. */
     const char *case_names[SC_ENGINE_MAX_CASES];
     uint32_t case_count;
@@ -275,6 +281,15 @@ typedef struct sc_engine {
 #if SC_STATE_STREAM
     sc_state_tx state_tx; /* console state stream (sc_state.h) */
 #endif
+#if SC_ENABLE_DOPPLER
+    sc_doppler doppler; /* flow model of the running case, colour and spectrum per frame */
+    uint8_t doppler_on; /* this frame */
+#endif
+#if SC_ENABLE_NEEDLE
+    sc_needle_rx needle_rx; /* the tracked needle's CAN receiver */
+    sc_needle needle;       /* drawn in the B-scan, punctures */
+    uint8_t needle_status_counter;
+#endif
     sc_bscan bscan;
     sc_tissue tissue[SC_ENGINE_TISSUE_SLOTS]; /* the large ones last */
 } sc_engine;
@@ -339,6 +354,28 @@ const sc_assess_report *sc_engine_assessment(const sc_engine *e);
 #if SC_STATE_STREAM
 /* The state stream's counters (records sent, dropped). O(1). */
 const sc_state_tx *sc_engine_get_state_tx(const sc_engine *e);
+#endif
+
+#if SC_ENABLE_DOPPLER
+/* Colour/spectral Doppler settings (box, steering, scale, gain, gate, flow), applied from the
+ * next frame. O(1). Errors: SC_ERR_INVALID_ARG, those of sc_doppler_def_validate (the previous
+ * settings stay). */
+int sc_engine_set_doppler(sc_engine *e, const sc_doppler_def *def);
+
+/* The cardiac and respiratory phases ([0, 1)) of the next frame's flow, e.g. from the pulsation
+ * model; without a call the Doppler's own clocks run (def.doppler heart and breathing rates).
+ * O(1). Errors: SC_ERR_INVALID_ARG, SC_ERR_NOT_FINITE. */
+int sc_engine_set_flow_phase(sc_engine *e, float cardiac_phase, float resp_phase);
+
+/* The last frame's Doppler status (colour pixels, aliasing, gate velocity). O(1). */
+const sc_doppler_status *sc_engine_get_doppler_status(const sc_engine *e);
+#endif
+
+#if SC_ENABLE_NEEDLE
+/* The tracked needle's last frame: presence, tip label, punctures (each lumen entry once; an
+ * artery entry is a fault of the exam), pixels drawn; and its receiver's counters. O(1). */
+const sc_needle_status *sc_engine_get_needle_status(const sc_engine *e);
+const sc_needle_rx *sc_engine_get_needle_rx(const sc_engine *e);
 #endif
 
 #endif /* SC_ENGINE_H */

@@ -4,7 +4,11 @@
  * A frame is frame_begin, then `lines` calls of line (any order, each at most once), then
  * frame_end. Each call is non-blocking and bounded in time; a sink that cannot keep up drops
  * and counts, it never stalls the frame loop. Mandatory: frame_begin, line, frame_end.
- * Optional: link_state (NULL answers SC_ERR_NOT_SUPPORTED).
+ * Optional: link_state, colour_line, doppler (NULL answers SC_ERR_NOT_SUPPORTED; a sink without
+ * the colour ops shows the B-mode image only).
+ * Colour Doppler (core/imaging/sc_doppler.h), when on, adds to a frame between frame_begin and
+ * frame_end: one colour_line per scan line of the colour box (after that line's B-mode line), then
+ * one doppler record (box, scale, steering, sample gate and this frame's spectrum column).
  * The sample buffer passed to line() is owned by the caller and valid only during the call.
  *
  * What the display needs with a frame travels with that frame: the geometry in frame_begin's
@@ -60,6 +64,26 @@ typedef struct sc_display_end_info {
     float artery_area_ratio; /* the same for the artery */
 } sc_display_end_info;
 
+/* Colour Doppler of a frame: the box, the scale and this frame's pulsed-wave spectrum column.
+ * Colour values (colour_line) are signed bytes: v / nyquist_mm_s * 127 of the velocity along the
+ * beam, positive toward the probe (red), negative away (blue), 0 no colour (no flow, wall filter,
+ * outside the lumens). Spectrum bin i covers velocities (toward the probe)
+ * -nyquist + i * 2 nyquist / bins .. one bin further; 0 black .. 255 white (log-compressed). */
+#define SC_DISPLAY_SPECTRUM_MAX_BINS 128u
+typedef struct sc_display_doppler_info {
+    uint32_t frame_no;
+    uint16_t box_line_lo, box_line_hi;     /* colour box: lines [lo, hi) */
+    uint16_t box_sample_lo, box_sample_hi; /* samples [lo, hi) */
+    float nyquist_mm_s;                    /* scale: the velocity that aliases, > 0 */
+    float steer_deg;                       /* colour beam steering, + toward increasing x */
+    float gate_velocity_mm_s;              /* model velocity along the beam at the gate centre
+                                              (before aliasing); 0 outside a lumen */
+    uint16_t gate_line;                    /* pulsed-wave gate: line and samples [lo, hi) */
+    uint16_t gate_sample_lo, gate_sample_hi;
+    uint16_t spectrum_bins;                /* 0 (no spectrum) .. SC_DISPLAY_SPECTRUM_MAX_BINS */
+    const uint8_t *spectrum;               /* spectrum_bins bytes, valid during the call */
+} sc_display_doppler_info;
+
 typedef struct sc_display_link_state {
     uint8_t up;            /* link usable */
     uint32_t lines_sent;   /* since start */
@@ -72,6 +96,11 @@ typedef struct sc_display_ops {
                 uint16_t count);
     int (*frame_end)(void *ctx, const sc_display_end_info *end);
     int (*link_state)(void *ctx, sc_display_link_state *state);
+    /* optional: colour values of samples [first, first + count) of a line (sc_display_doppler_info) */
+    int (*colour_line)(void *ctx, uint32_t frame_no, uint16_t line_index, uint16_t first,
+                       const int8_t *values, uint16_t count);
+    /* optional: the frame's Doppler record, once per frame before frame_end */
+    int (*doppler)(void *ctx, const sc_display_doppler_info *info);
 } sc_display_ops;
 
 typedef struct sc_display_dev {
@@ -106,6 +135,21 @@ static inline int sc_display_get_link_state(const sc_display_dev *dev,
                                             sc_display_link_state *st)
 {
     return dev->ops->link_state ? dev->ops->link_state(dev->ctx, st) : SC_ERR_NOT_SUPPORTED;
+}
+
+static inline int sc_display_colour_line(const sc_display_dev *dev, uint32_t frame_no,
+                                         uint16_t line_index, uint16_t first,
+                                         const int8_t *values, uint16_t count)
+{
+    return dev->ops->colour_line ? dev->ops->colour_line(dev->ctx, frame_no, line_index, first,
+                                                         values, count)
+                                 : SC_ERR_NOT_SUPPORTED;
+}
+
+static inline int sc_display_doppler(const sc_display_dev *dev,
+                                     const sc_display_doppler_info *info)
+{
+    return dev->ops->doppler ? dev->ops->doppler(dev->ctx, info) : SC_ERR_NOT_SUPPORTED;
 }
 
 #endif /* SC_HAL_DISPLAY_H */

@@ -148,6 +148,8 @@ int sc_bscan_init(sc_bscan *b, const sc_bscan_def *def)
         b->tcache[i].epoch = 0u;
     }
     memset(&b->status, 0, sizeof b->status);
+    b->line_hook = NULL;
+    b->line_hook_ctx = NULL;
     return sc_bscan_set_def(b, def);
 }
 
@@ -176,6 +178,14 @@ int sc_bscan_attach_mesh(sc_bscan *b, const sc_mesh *mesh)
     return SC_OK;
 }
 
+void sc_bscan_set_line_hook(sc_bscan *b, sc_bscan_line_hook_fn fn, void *ctx)
+{
+    if (b != NULL) {
+        b->line_hook = fn;
+        b->line_hook_ctx = fn != NULL ? ctx : NULL;
+    }
+}
+
 const sc_bscan_status *sc_bscan_status_get(const sc_bscan *b)
 {
     return &b->status;
@@ -189,6 +199,7 @@ typedef struct frame_ctx {
     float inv_sp[3];   /* 1 / spacing */
     uint32_t n;        /* samples per line */
     uint32_t margin_n; /* samples of the rest reference above the face */
+    uint32_t line;     /* current line */
     /* current line, image frame */
     uint32_t line;
     float ox, oz, dx, dz;
@@ -1315,6 +1326,16 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
     if (b->def.acoustics != 0u) {
         /* along the beam as it runs now: the labels are this frame's (deformed) ones */
         sc_acoustics_line(&b->acou, b->line_label, b->line_out, n);
+    }
+    if (b->line_hook != NULL) {
+        /* the labels are still this frame's (deformed) ones here */
+        const sc_bscan_line_view lv = {
+            .line = c->line, .lines_n = b->def.scan.lines_n, .samples_n = n,
+            .labels = b->line_label, .runs = b->runs, .run_count = b->run_count,
+            .f0 = {c->f0[0], c->f0[1], c->f0[2]}, .fd = {c->fd[0], c->fd[1], c->fd[2]},
+            .org_x = c->ox, .org_z = c->oz, .dir_x = c->dx, .dir_z = c->dz, .out = b->line_out,
+            .img2vol = &c->img2vol};
+        b->line_hook(b->line_hook_ctx, &lv);
     }
     if (vc->lab == NULL) {
         return;

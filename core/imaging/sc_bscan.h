@@ -174,8 +174,31 @@ typedef struct sc_bscan_event {
     uint8_t entry; /* 1: the line enters the mesh here */
 } sc_bscan_event;
 
+/* What a line hook sees of one computed scan line (sc_bscan_set_line_hook): every sample's label
+ * in the deformed configuration (the label at its rest position: a vessel squeezed shut has no
+ * lumen samples left), and its rest position in voxel-index units: a + k b inside the mesh runs,
+ * f0 + k fd elsewhere (rigid). Valid only during the call. */
+typedef struct sc_bscan_line_view {
+    uint32_t line, lines_n, samples_n;
+    const uint8_t *labels;       /* samples_n labels */
+    const sc_bscan_run *runs;    /* run_count runs, increasing k, disjoint */
+    uint32_t run_count;
+    float f0[3], fd[3];          /* rigid position of sample k: f0 + k fd (voxel units) */
+    float org_x, org_z;          /* sample 0's position in the image frame (y = 0), mm */
+    float dir_x, dir_z;          /* the line's direction in the image frame, mm per sample */
+    uint8_t *out;                /* the displayed samples, before they leave: a hook may draw
+                                  * into them (the tracked needle) */
+    const sc_xform *img2vol;     /* image frame -> volume frame of this frame */
+} sc_bscan_line_view;
+
+/* Called once per computed line, in line order, with the probe in contact (never for a dark
+ * frame); it must be bounded (it runs inside the imaging stage) and must not call back into b. */
+typedef void (*sc_bscan_line_hook_fn)(void *ctx, const sc_bscan_line_view *view);
+
 typedef struct sc_bscan {
     sc_bscan_def def;
+    sc_bscan_line_hook_fn line_hook; /* NULL: none (sc_bscan_set_line_hook) */
+    void *line_hook_ctx;
     sc_scan_geom geom;
     float lut_a; /* display: out = lut_a * I + lut_b[k] */
     float lut_b[SC_MAX_SCAN_SAMPLES];
@@ -253,6 +276,10 @@ int sc_bscan_attach_mesh(sc_bscan *b, const sc_mesh *mesh);
 int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, const sc_volume *volume,
                    const sc_xform *probe_to_volume, int contact, const sc_display_dev *display,
                    uint32_t frame_no);
+
+/* Set (or clear with NULL) the per-line hook, e.g. colour Doppler (sc_doppler.h); kept across
+ * sc_bscan_set_def, cleared by sc_bscan_init. O(1). Never fails (NULL b: nothing happens). */
+void sc_bscan_set_line_hook(sc_bscan *b, sc_bscan_line_hook_fn fn, void *ctx);
 
 /* Status of the last frame (compression measure, work counters). O(1). */
 const sc_bscan_status *sc_bscan_status_get(const sc_bscan *b);

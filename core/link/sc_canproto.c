@@ -157,6 +157,32 @@ static const sc_can_sig sigs_assess_score[] = {
     {"Score", 48, 8, 0, 1.0f, 0.0f, 0.0f, 255.0f, ""},
     {"ScoreMax", 56, 8, 0, 1.0f, 0.0f, 0.0f, 255.0f, ""},
 };
+static const sc_can_sig sigs_needle_pos[] = {
+    E2E_SIGS,
+    SIG_POS("TipX", 16),
+    SIG_POS("TipY", 32),
+    SIG_POS("TipZ", 48),
+};
+static const sc_can_sig sigs_needle_dir[] = {
+    E2E_SIGS,
+    SIG_Q("DirX", 16),
+    SIG_Q("DirY", 32),
+    SIG_Q("DirZ", 48),
+};
+static const sc_can_sig sigs_needle_aux[] = {
+    E2E_SIGS,
+    {"InsertDepth", 16, 16, 0, 0.05f, 0.0f, 0.0f, 3276.75f, "mm"},
+    SIG_TRACKING(32),
+};
+static const sc_can_sig sigs_needle_status[] = {
+    E2E_SIGS,
+    {"TipVessel", 16, 4, 0, 1.0f, 0.0f, 0.0f, 15.0f, ""},
+    {"NeedleTracked", 20, 1, 0, 1.0f, 0.0f, 0.0f, 1.0f, ""},
+    {"LastPuncture", 24, 4, 0, 1.0f, 0.0f, 0.0f, 15.0f, ""},
+    {"VeinPunctures", 32, 8, 0, 1.0f, 0.0f, 0.0f, 255.0f, ""},
+    {"ArteryPunctures", 40, 8, 0, 1.0f, 0.0f, 0.0f, 255.0f, ""},
+    {"NeedleRejected", 48, 16, 0, 1.0f, 0.0f, 0.0f, 65535.0f, ""},
+};
 
 #define MSG(n, id, len, fd, cyc, to, sigs)                                                         \
     {                                                                                              \
@@ -194,6 +220,11 @@ static const sc_can_msg_info msg_table[SC_MSG_COUNT] = {
         MSG("AssessForce", SC_CANID_ASSESS_FORCE, 8, 0, 100, 0, sigs_assess_force),
     [SC_MSG_ASSESS_SCORE] =
         MSG("AssessScore", SC_CANID_ASSESS_SCORE, 8, 0, 100, 0, sigs_assess_score),
+    [SC_MSG_NEEDLE_POS] = MSG("NeedlePosePos", SC_CANID_NEEDLE_POS, 8, 0, 10, 100, sigs_needle_pos),
+    [SC_MSG_NEEDLE_DIR] = MSG("NeedlePoseDir", SC_CANID_NEEDLE_DIR, 8, 0, 10, 100, sigs_needle_dir),
+    [SC_MSG_NEEDLE_AUX] = MSG("NeedleAux", SC_CANID_NEEDLE_AUX, 8, 0, 10, 100, sigs_needle_aux),
+    [SC_MSG_NEEDLE_STATUS] =
+        MSG("NeedleStatus", SC_CANID_NEEDLE_STATUS, 8, 0, 100, 0, sigs_needle_status),
 };
 _Static_assert(SC_CANID_AUTH_ASSESS == SC_CANID_CMD_ASSESS + SC_CANID_AUTH_OFFSET, "auth ids");
 _Static_assert(SC_MSG_AUTH_ASSESS - SC_MSG_AUTH_CASE == SC_MSG_CMD_ASSESS - SC_MSG_CMD_CASE,
@@ -490,6 +521,10 @@ int sc_canproto_decode_pose_part(const sc_can_frame *f, sc_pose_msg *p)
     case SC_MSG_ASSESS_VESSELS:
     case SC_MSG_ASSESS_FORCE:
     case SC_MSG_ASSESS_SCORE:
+    case SC_MSG_NEEDLE_POS:
+    case SC_MSG_NEEDLE_DIR:
+    case SC_MSG_NEEDLE_AUX:
+    case SC_MSG_NEEDLE_STATUS:
     case SC_MSG_COUNT:
         break;
     }
@@ -659,6 +694,11 @@ int sc_canproto_decode_cmd(const sc_can_frame *f, sc_cmd *out)
     case SC_MSG_ASSESS_VESSELS:
     case SC_MSG_ASSESS_FORCE:
     case SC_MSG_ASSESS_SCORE:
+
+    case SC_MSG_NEEDLE_POS:
+    case SC_MSG_NEEDLE_DIR:
+    case SC_MSG_NEEDLE_AUX:
+    case SC_MSG_NEEDLE_STATUS:
     case SC_MSG_COUNT:
         return SC_ERR_CAN_ID;
     }
@@ -794,6 +834,10 @@ int sc_canproto_decode_status_part(const sc_can_frame *f, sc_status_msg *s)
     case SC_MSG_ASSESS_VESSELS:
     case SC_MSG_ASSESS_FORCE:
     case SC_MSG_ASSESS_SCORE:
+    case SC_MSG_NEEDLE_POS:
+    case SC_MSG_NEEDLE_DIR:
+    case SC_MSG_NEEDLE_AUX:
+    case SC_MSG_NEEDLE_STATUS:
     case SC_MSG_COUNT:
         break;
     }
@@ -884,4 +928,98 @@ int sc_canproto_decode_assess_part(const sc_can_frame *f, sc_assess_msg *a)
         return 0;
     }
     return SC_ERR_CAN_ID;
+}
+/* ---- needle -------------------------------------------------------------------------------- */
+
+int sc_canproto_encode_needle(const sc_needle_msg *m, uint8_t counter, sc_can_frame *out,
+                              size_t cap, size_t *n)
+{
+    *n = 0u;
+    if (cap < 3u) {
+        return SC_ERR_NO_SPACE;
+    }
+    int rc = 0;
+    frame_begin(&out[0], SC_MSG_NEEDLE_POS);
+    frame_begin(&out[1], SC_MSG_NEEDLE_DIR);
+    frame_begin(&out[2], SC_MSG_NEEDLE_AUX);
+    for (unsigned i = 0; i < 3u && rc == 0; i++) {
+        rc = put_phys(&out[0], SC_MSG_NEEDLE_POS, 2u + i, m->tip_mm[i]);
+    }
+    for (unsigned i = 0; i < 3u && rc == 0; i++) {
+        rc = put_phys(&out[1], SC_MSG_NEEDLE_DIR, 2u + i, m->dir[i]);
+    }
+    if (rc == 0) {
+        rc = put_phys(&out[2], SC_MSG_NEEDLE_AUX, 2u, m->depth_mm);
+    }
+    if (rc == 0) {
+        if (m->tracking > 1u) {
+            return SC_ERR_CAN_SIGNAL;
+        }
+        put_u(&out[2], SC_MSG_NEEDLE_AUX, 3u, m->tracking);
+    }
+    for (unsigned i = 0; i < 3u && rc == 0; i++) {
+        rc = protect(&out[i], (sc_msg)((unsigned)SC_MSG_NEEDLE_POS + i), counter);
+    }
+    *n = rc == 0 ? 3u : 0u;
+    return rc;
+}
+
+int sc_canproto_decode_needle_part(const sc_can_frame *f, sc_needle_msg *m)
+{
+    sc_msg msg;
+    const int rc = sc_canproto_classify(f, &msg);
+    if (rc != 0) {
+        return rc;
+    }
+    if (msg == SC_MSG_NEEDLE_POS) {
+        for (unsigned i = 0; i < 3u; i++) {
+            m->tip_mm[i] = get_phys(f, msg, 2u + i);
+        }
+        return 1;
+    }
+    if (msg == SC_MSG_NEEDLE_DIR) {
+        for (unsigned i = 0; i < 3u; i++) {
+            m->dir[i] = get_phys(f, msg, 2u + i);
+        }
+        return 2;
+    }
+    if (msg == SC_MSG_NEEDLE_AUX) {
+        m->depth_mm = get_phys(f, msg, 2u);
+        m->tracking = (uint8_t)get_u(f, msg, 3u);
+        return 4;
+    }
+    return SC_ERR_CAN_ID;
+}
+
+int sc_canproto_encode_needle_status(const sc_needle_status_msg *s, uint8_t counter,
+                                     sc_can_frame *out)
+{
+    const sc_msg m = SC_MSG_NEEDLE_STATUS;
+    frame_begin(out, m);
+    put_u(out, m, 2u, sat_u(s->tip_vessel, 15u));
+    put_u(out, m, 3u, s->needle_tracked ? 1u : 0u);
+    put_u(out, m, 4u, sat_u(s->last_puncture, 15u));
+    put_u(out, m, 5u, s->vein_punctures);
+    put_u(out, m, 6u, s->artery_punctures);
+    put_u(out, m, 7u, s->needle_rejected);
+    return protect(out, m, counter);
+}
+
+int sc_canproto_decode_needle_status(const sc_can_frame *f, sc_needle_status_msg *s)
+{
+    sc_msg m;
+    const int rc = sc_canproto_classify(f, &m);
+    if (rc != 0) {
+        return rc;
+    }
+    if (m != SC_MSG_NEEDLE_STATUS) {
+        return SC_ERR_CAN_ID;
+    }
+    s->tip_vessel = (uint8_t)get_u(f, m, 2u);
+    s->needle_tracked = (uint8_t)get_u(f, m, 3u);
+    s->last_puncture = (uint8_t)get_u(f, m, 4u);
+    s->vein_punctures = (uint8_t)get_u(f, m, 5u);
+    s->artery_punctures = (uint8_t)get_u(f, m, 6u);
+    s->needle_rejected = (uint16_t)get_u(f, m, 7u);
+    return 0;
 }

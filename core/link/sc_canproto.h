@@ -55,6 +55,11 @@ typedef enum sc_msg {
     SC_MSG_ASSESS_VESSELS, /* the assessment's status frames (out) */
     SC_MSG_ASSESS_FORCE,
     SC_MSG_ASSESS_SCORE,
+    /* the tracked needle (issue 18): a second tool, E2E protected like the probe */
+    SC_MSG_NEEDLE_POS,
+    SC_MSG_NEEDLE_DIR,
+    SC_MSG_NEEDLE_AUX,
+    SC_MSG_NEEDLE_STATUS, /* engine out */
     SC_MSG_COUNT
 } sc_msg;
 
@@ -63,6 +68,8 @@ typedef enum sc_msg {
 #define SC_MSG_IS_CMD(m)  ((unsigned)(m) <= (unsigned)SC_MSG_CMD_ASSESS)
 #define SC_MSG_IS_AUTH(m)                                                                          \
     ((unsigned)(m) >= (unsigned)SC_MSG_AUTH_CASE && (unsigned)(m) <= (unsigned)SC_MSG_AUTH_ASSESS)
+#define SC_MSG_IS_NEEDLE_IN(m)                                                                   \
+    ((unsigned)(m) >= (unsigned)SC_MSG_NEEDLE_POS && (unsigned)(m) <= (unsigned)SC_MSG_NEEDLE_AUX)
 
 #define SC_CANPROTO_MAX_SIGS 12u /* AssessScore */
 
@@ -88,6 +95,12 @@ enum {
     SC_CANID_ASSESS_VESSELS = 0x210, /* the assessment block 0x210..0x212 */
     SC_CANID_ASSESS_FORCE = 0x211,
     SC_CANID_ASSESS_SCORE = 0x212,
+    /* needle block: in 0x120..0x122, out 0x220 (0x120..0x12F and 0x220..0x22F reserved for the
+     * needle and Doppler) */
+    SC_CANID_NEEDLE_POS = 0x120,
+    SC_CANID_NEEDLE_DIR = 0x121,
+    SC_CANID_NEEDLE_AUX = 0x122,
+    SC_CANID_NEEDLE_STATUS = 0x220,
 };
 
 /* One signal as in the DBC: raw little-endian bit field, phys = raw * factor + offset. */
@@ -157,6 +170,37 @@ int sc_canproto_encode_pose(const sc_pose_msg *m, uint8_t counter, int fd, sc_ca
  * sc_canproto_classify, SC_ERR_CAN_ID for a frame that is not a pose. */
 int sc_canproto_decode_pose_part(const sc_can_frame *f, sc_pose_msg *m);
 #define SC_POSE_PARTS_ALL 7u
+
+/* ---- needle pose (in) and needle status (out) ------------------------------------------
+ * One needle sample = NeedlePosePos (tip position), NeedlePoseDir (unit shaft direction, hub to
+ * tip, Q14), NeedleAux (insertion depth: shaft length below the skin; tracking state), back to
+ * back with one E2E counter, like the probe's pose. */
+typedef struct sc_needle_msg {
+    float tip_mm[3];   /* tracker frame */
+    float dir[3];      /* as sent (receiver checks the norm) */
+    float depth_mm;    /* inserted length, [0, 3276.7] */
+    uint8_t tracking;  /* SC_TRACKING_* */
+} sc_needle_msg;
+#define SC_NEEDLE_PARTS_ALL 7u
+/* 3 classic frames (0x120..0x122), counter as given. SC_ERR_NO_SPACE (cap < 3),
+ * SC_ERR_CAN_SIGNAL / SC_ERR_NOT_FINITE for a value outside its signal. O(1). */
+int sc_canproto_encode_needle(const sc_needle_msg *m, uint8_t counter, sc_can_frame *out,
+                              size_t cap, size_t *n);
+/* Writes the fields of one needle frame into *m; returns its part bit (1, 2, 4). Errors of
+ * sc_canproto_classify, SC_ERR_CAN_ID for a frame that is not a needle part. O(1). */
+int sc_canproto_decode_needle_part(const sc_can_frame *f, sc_needle_msg *m);
+
+typedef struct sc_needle_status_msg {
+    uint8_t tip_vessel;         /* label the tip is in now: 0 none, SC_LABEL_VEIN, _ARTERY */
+    uint8_t needle_tracked;     /* a valid needle sample within its timeout */
+    uint8_t last_puncture;      /* label of the last lumen entry (0: none yet) */
+    uint8_t vein_punctures;     /* entries into a vein lumen (saturating at 255) */
+    uint8_t artery_punctures;   /* entries into an artery lumen: faults of the exam */
+    uint16_t needle_rejected;   /* needle frames refused (E2E, plausibility, length) */
+} sc_needle_status_msg;
+int sc_canproto_encode_needle_status(const sc_needle_status_msg *s, uint8_t counter,
+                                     sc_can_frame *out);
+int sc_canproto_decode_needle_status(const sc_can_frame *f, sc_needle_status_msg *s);
 
 /* ---- commands (in) ----------------------------------------------------------------------- */
 typedef enum sc_cmd_kind {

@@ -497,6 +497,10 @@ static sc_trk_outcome classify_and_handle(sc_tracker *t, const sc_can_frame *f, 
     case SC_MSG_ASSESS_VESSELS:
     case SC_MSG_ASSESS_FORCE:
     case SC_MSG_ASSESS_SCORE:
+    case SC_MSG_NEEDLE_POS: /* the needle has its own receiver (sc_needle_rx.h) */
+    case SC_MSG_NEEDLE_DIR:
+    case SC_MSG_NEEDLE_AUX:
+    case SC_MSG_NEEDLE_STATUS:
     case SC_MSG_COUNT:
         break;
     }

@@ -405,3 +405,50 @@ float sc_collider_signed_distance_mm(const sc_collider *c, const float p_mm[3])
     const float box = sqrtf(out2) + (inmax < 0.0f ? inmax : 0.0f);
     return box - rad;
 }
+
+uint32_t sc_collider_append_sphere(const float c_mm[3], float r_mm, float margin_mm,
+                                   uint32_t node_count, const float *x, const float *y,
+                                   const float *z, const uint8_t *fixed, sc_contact_set *out)
+{
+    if (c_mm == NULL || out == NULL || !(r_mm > 0.0f) || !(margin_mm >= 0.0f)) {
+        return 0u;
+    }
+    const float reach = r_mm + margin_mm, reach2 = reach * reach;
+    const uint32_t before = out->count;
+    uint32_t added = 0u;
+    for (uint32_t i = 0; i < node_count; i++) {
+        if (fixed != NULL && fixed[i]) {
+            continue;
+        }
+        const float dx = x[i] - c_mm[0], dy = y[i] - c_mm[1], dz = z[i] - c_mm[2];
+        const float d2 = dx * dx + dy * dy + dz * dz;
+        if (!(d2 < reach2)) {
+            continue;
+        }
+        int held = 0;
+        for (uint32_t k = 0; k < before && !held; k++) {
+            held = out->c[k].node == i;
+        }
+        if (held) {
+            continue; /* the probe already holds it */
+        }
+        if (out->count >= SC_MAX_CONTACTS) {
+            break;
+        }
+        const float d = sqrtf(d2);
+        float n[3] = {0.0f, 0.0f, -1.0f};
+        if (d > 1e-6f) {
+            n[0] = dx / d;
+            n[1] = dy / d;
+            n[2] = dz / d;
+        }
+        sc_contact *ct = &out->c[out->count++];
+        ct->node = i;
+        for (uint32_t a = 0; a < 3u; a++) {
+            ct->p_mm[a] = c_mm[a] + r_mm * n[a];
+            ct->n[a] = n[a];
+        }
+        added++;
+    }
+    return added;
+}

@@ -99,6 +99,17 @@ void sc_collider_detect(const sc_collider *c, const sc_collider_grid *g, const f
                         const float *y, const float *z, const uint8_t *fixed,
                         float max_disp_mm, sc_contact_set *out);
 
+/* A second tool's tip (the tracked needle) as a sphere of radius r_mm at c_mm (volume frame):
+ * appends to out (not cleared) a contact for every free node (fixed[i] == 0, fixed may be NULL)
+ * within r_mm + margin_mm of the centre that out does not hold yet: the point on the sphere
+ * along the node's direction from the centre, the outward normal that direction (straight up,
+ * -z, for a node at the centre), so the tip pushes tissue aside as the probe's face does.
+ * Stops at SC_MAX_CONTACTS. Returns the contacts added. O(nodes + added * out->count).
+ * Never allocates. */
+uint32_t sc_collider_append_sphere(const float c_mm[3], float r_mm, float margin_mm,
+                                   uint32_t node_count, const float *x, const float *y,
+                                   const float *z, const uint8_t *fixed, sc_contact_set *out);
+
 /* Signed penetration (mm, > 0 inside the probe) of a point against a contact plane. O(1). */
 float sc_contact_depth_mm(const sc_contact *ct, float x, float y, float z);
 

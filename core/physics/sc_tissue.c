@@ -73,6 +73,8 @@ int sc_tissue_build_begin(sc_tissue *t, const sc_tissue_def *def, const sc_volum
     t->build_vol = vol;
     t->build_label = default_label;
     memset(&t->stats, 0, sizeof t->stats);
+    t->tip_active = 0u;
+    t->tip_contacts = 0u;
     t->build_phase = SC_TISSUE_BUILD_MESH;
     return SC_OK;
 }
@@ -315,6 +317,12 @@ int sc_tissue_step(sc_tissue *t, const sc_pose *probe)
     const sc_collider_grid g = mesh_grid(&t->mesh);
     sc_collider_detect(&t->collider, &g, t->nodes.x, t->nodes.y, t->nodes.z,
                        t->mesh.node_fixed, t->stats.max_disp_mm, &t->contacts);
+    t->tip_contacts = 0u;
+    if (t->tip_active) {
+        t->tip_contacts = sc_collider_append_sphere(
+            t->tip_mm, t->tip_radius_mm, t->def.collider.margin_mm, t->mesh.node_count,
+            t->nodes.x, t->nodes.y, t->nodes.z, t->mesh.node_fixed, &t->contacts);
+    }
     t->stats.contacts = t->contacts.count;
     if (t->method == SC_TISSUE_MSDS && t->msds.def.integrator == (uint8_t)SC_MSDS_EXPLICIT) {
         t->stats.kinematic = 0u;
@@ -341,6 +349,23 @@ int sc_tissue_step(sc_tissue *t, const sc_pose *probe)
         return SC_ERR_PHYS_UNSTABLE;
     }
     return rc;
+}
+
+void sc_tissue_set_tip(sc_tissue *t, int active, const float tip_mm[3], float radius_mm)
+{
+    if (t == NULL) {
+        return;
+    }
+    t->tip_active = 0u;
+    if (!active || tip_mm == NULL || !isfinite(radius_mm) || !(radius_mm > 0.0f) ||
+        !isfinite(tip_mm[0]) || !isfinite(tip_mm[1]) || !isfinite(tip_mm[2])) {
+        return;
+    }
+    for (uint32_t a = 0; a < 3u; a++) {
+        t->tip_mm[a] = tip_mm[a];
+    }
+    t->tip_radius_mm = radius_mm;
+    t->tip_active = 1u;
 }
 
 static uint64_t fnv(uint64_t h, const float *v, uint32_t count)

@@ -138,6 +138,11 @@ typedef struct sc_tissue {
     uint8_t kinematic[SC_MAX_NODES];
     float box_diag_mm;
     sc_tissue_stats stats;
+    /* a second tool's tip pushing tissue (the tracked needle), sc_tissue_set_tip */
+    uint8_t tip_active;
+    float tip_mm[3];
+    float tip_radius_mm;
+    uint32_t tip_contacts; /* of the last step */
 } sc_tissue;
 
 /* Defaults: default mesh (32x16x16 over 40 x 20 x 30 mm), MSDS, default collider (linear
@@ -168,6 +173,11 @@ int sc_tissue_build_step(sc_tissue *t);
  * Never allocates. Returns 0, SC_ERR_POSE_IMPLAUSIBLE (pose refused: frame run without
  * contact), or SC_ERR_PHYS_UNSTABLE (the guard reset the tissue to rest). */
 int sc_tissue_step(sc_tissue *t, const sc_pose *probe);
+
+/* The tracked needle's tip for the next steps: a sphere of radius_mm at tip_mm (volume frame)
+ * whose contacts join the probe's (sc_collider_append_sphere), so the tip pushes tissue; active
+ * 0 removes it. O(1); the step then costs O(nodes) more. Never fails (bad values: inactive). */
+void sc_tissue_set_tip(sc_tissue *t, int active, const float tip_mm[3], float radius_mm);
 
 /* Switch the solver; the current shape and velocities are kept. O(1) (O(N) on the FEM side:
  * kinematic flags cleared). Errors: SC_ERR_INVALID_ARG (unknown method). */

@@ -82,7 +82,8 @@ static void write_header(uint8_t *buf, const sc_dlink_frame *f, sc_dlink_type ty
                          uint16_t line_index, uint16_t payload_len)
 {
     put32(buf + OFF_MAGIC, SC_DLINK_MAGIC);
-    buf[OFF_VERSION] = (uint8_t)SC_DLINK_VERSION;
+    buf[OFF_VERSION] = (uint8_t)(type >= SC_DLINK_COLOUR_LINE ? SC_DLINK_VERSION_COLOUR
+                                                               : SC_DLINK_VERSION);
     buf[OFF_TYPE] = (uint8_t)type;
     put16(buf + OFF_FLAGS, f->flags);
     put32(buf + OFF_FRAME, f->frame_no);
@@ -234,7 +235,98 @@ void sc_dlink_parse_params(const uint8_t *payload, sc_dlink_params *p)
     }
 }
 
+/* ---- version 3: colour Doppler ---------------------------------------------------------- */
+
+static int doppler_ok(const sc_dlink_frame *f, const sc_dlink_doppler *d)
+{
+    return d->box_line_lo <= d->box_line_hi && d->box_line_hi <= f->line_count &&
+           d->box_sample_lo <= d->box_sample_hi && d->box_sample_hi <= f->samples &&
+           d->nyquist_mm_s > 0.0f && d->steer_deg >= -90.0f && d->steer_deg <= 90.0f &&
+           d->gate_line < f->line_count && d->gate_sample_lo < d->gate_sample_hi &&
+           d->gate_sample_hi <= f->samples && d->bins <= SC_DLINK_SPECTRUM_MAX;
+}
+
+int sc_dlink_encode_colour(uint8_t *buf, size_t cap, const sc_dlink_frame *f, uint16_t line_index,
+                           uint16_t first, const int8_t *values, uint16_t count)
+{
+    if (!buf || !f || !values) {
+        return SC_ERR_INVALID_ARG;
+    }
+    if (!frame_fields_ok(f) || line_index >= f->line_count || count == 0u ||
+        (uint32_t)first + count > f->samples) {
+        return SC_ERR_DLINK_FIELD;
+    }
+    const uint16_t plen = (uint16_t)(SC_DLINK_COLOUR_HEAD + count);
+    if (cap < (size_t)SC_DLINK_HEADER_SIZE + plen) {
+        return SC_ERR_NO_SPACE;
+    }
+    write_header(buf, f, SC_DLINK_COLOUR_LINE, line_index, plen);
+    uint8_t *p = buf + SC_DLINK_HEADER_SIZE;
+    put16(p + 0, first);
+    put16(p + 2, count);
+    memcpy(p + SC_DLINK_COLOUR_HEAD, values, count);
+    return finish(buf, plen);
+}
+
+int sc_dlink_encode_doppler(uint8_t *buf, size_t cap, const sc_dlink_frame *f,
+                            const sc_dlink_doppler *d)
+{
+    if (!buf || !f || !d) {
+        return SC_ERR_INVALID_ARG;
+    }
+    if (!isfinite(d->nyquist_mm_s) || !isfinite(d->steer_deg) ||
+        !isfinite(d->gate_velocity_mm_s)) {
+        return SC_ERR_NOT_FINITE;
+    }
+    if (!frame_fields_ok(f) || !doppler_ok(f, d)) {
+        return SC_ERR_DLINK_FIELD;
+    }
+    const uint16_t plen = (uint16_t)(SC_DLINK_DOPPLER_HEAD + d->bins);
+    if (cap < (size_t)SC_DLINK_HEADER_SIZE + plen) {
+        return SC_ERR_NO_SPACE;
+    }
+    write_header(buf, f, SC_DLINK_DOPPLER, 0u, plen);
+    uint8_t *p = buf + SC_DLINK_HEADER_SIZE;
+    put16(p + 0, d->box_line_lo);
+    put16(p + 2, d->box_line_hi);
+    put16(p + 4, d->box_sample_lo);
+    put16(p + 6, d->box_sample_hi);
+    put32(p + 8, f32_bits(d->nyquist_mm_s));
+    put32(p + 12, f32_bits(d->steer_deg));
+    put32(p + 16, f32_bits(d->gate_velocity_mm_s));
+    put16(p + 20, d->gate_line);
+    put16(p + 22, d->gate_sample_lo);
+    put16(p + 24, d->gate_sample_hi);
+    put16(p + 26, d->bins);
+    memcpy(p + SC_DLINK_DOPPLER_HEAD, d->spectrum, d->bins);
+    return finish(buf, plen);
+}
+
+void sc_dlink_parse_doppler(const uint8_t *pl, sc_dlink_doppler *d)
+{
+    d->box_line_lo = get16(pl + 0);
+    d->box_line_hi = get16(pl + 2);
+    d->box_sample_lo = get16(pl + 4);
+    d->box_sample_hi = get16(pl + 6);
+    d->nyquist_mm_s = f32_from_bits(get32(pl + 8));
+    d->steer_deg = f32_from_bits(get32(pl + 12));
+    d->gate_velocity_mm_s = f32_from_bits(get32(pl + 16));
+    d->gate_line = get16(pl + 20);
+    d->gate_sample_lo = get16(pl + 22);
+    d->gate_sample_hi = get16(pl + 24);
+    d->bins = get16(pl + 26);
+    memset(d->spectrum, 0, sizeof d->spectrum);
+    memcpy(d->spectrum, pl + SC_DLINK_DOPPLER_HEAD,
+           d->bins <= SC_DLINK_SPECTRUM_MAX ? d->bins : SC_DLINK_SPECTRUM_MAX);
+}
+
 int sc_dlink_decode(const uint8_t *pkt, size_t len, sc_dlink_header *h, const uint8_t **payload)
+{
+    return sc_dlink_decode_as(pkt, len, (uint8_t)SC_DLINK_VERSION_COLOUR, h, payload);
+}
+
+int sc_dlink_decode_as(const uint8_t *pkt, size_t len, uint8_t max_version, sc_dlink_header *h,
+                       const uint8_t **payload)
 {
     if (!pkt || !h || !payload) {
         return SC_ERR_INVALID_ARG;
@@ -245,7 +337,9 @@ int sc_dlink_decode(const uint8_t *pkt, size_t len, sc_dlink_header *h, const ui
     if (get32(pkt + OFF_MAGIC) != SC_DLINK_MAGIC) {
         return SC_ERR_DLINK_MAGIC;
     }
-    if (pkt[OFF_VERSION] != SC_DLINK_VERSION) {
+    const uint8_t ver = pkt[OFF_VERSION];
+    if (ver != SC_DLINK_VERSION &&
+        !(ver == SC_DLINK_VERSION_COLOUR && max_version >= SC_DLINK_VERSION_COLOUR)) {
         return SC_ERR_DLINK_VERSION;
     }
     uint16_t plen = get16(pkt + OFF_PAYLOAD_LEN);
@@ -280,7 +374,21 @@ int sc_dlink_decode(const uint8_t *pkt, size_t len, sc_dlink_header *h, const ui
     case SC_DLINK_FRAME_PARAMS:
         expect_len = (uint16_t)SC_DLINK_PARAMS_PAYLOAD;
         break;
+    case SC_DLINK_COLOUR_LINE:
+        expect_len = plen >= SC_DLINK_COLOUR_HEAD
+                         ? (uint16_t)(SC_DLINK_COLOUR_HEAD + get16(pl + 2))
+                         : (uint16_t)SC_DLINK_COLOUR_HEAD;
+        break;
+    case SC_DLINK_DOPPLER:
+        expect_len = plen >= SC_DLINK_DOPPLER_HEAD
+                         ? (uint16_t)(SC_DLINK_DOPPLER_HEAD + get16(pl + 26))
+                         : (uint16_t)SC_DLINK_DOPPLER_HEAD;
+        break;
     default:
+        return SC_ERR_DLINK_TYPE;
+    }
+    /* the colour types exist in version 3 only; version 3 carries nothing else */
+    if ((d.type >= SC_DLINK_COLOUR_LINE) != (ver == SC_DLINK_VERSION_COLOUR)) {
         return SC_ERR_DLINK_TYPE;
     }
     if (plen != expect_len) {
@@ -290,7 +398,7 @@ int sc_dlink_decode(const uint8_t *pkt, size_t len, sc_dlink_header *h, const ui
     if (!frame_fields_ok(&f) || get16(pkt + OFF_RESERVED) != 0u) {
         return SC_ERR_DLINK_FIELD;
     }
-    if (d.type == SC_DLINK_LINE) {
+    if (d.type == SC_DLINK_LINE || d.type == SC_DLINK_COLOUR_LINE) {
         if (d.line_index >= d.line_count) {
             return SC_ERR_DLINK_FIELD;
         }
@@ -316,6 +424,18 @@ int sc_dlink_decode(const uint8_t *pkt, size_t len, sc_dlink_header *h, const ui
         sc_dlink_parse_params(pl, &p);
         params_to_array(&p, v);
         if (!params_ok(v)) { /* NaN fails the range too */
+            return SC_ERR_DLINK_FIELD;
+        }
+    } else if (d.type == SC_DLINK_COLOUR_LINE) {
+        const uint16_t first = get16(pl + 0), count = get16(pl + 2);
+        if (count == 0u || (uint32_t)first + count > d.samples) {
+            return SC_ERR_DLINK_FIELD;
+        }
+    } else if (d.type == SC_DLINK_DOPPLER) {
+        sc_dlink_doppler dd;
+        sc_dlink_parse_doppler(pl, &dd);
+        if (!isfinite(dd.nyquist_mm_s) || !isfinite(dd.steer_deg) ||
+            !isfinite(dd.gate_velocity_mm_s) || !doppler_ok(&f, &dd)) {
             return SC_ERR_DLINK_FIELD;
         }
     }
@@ -360,6 +480,7 @@ static int32_t frame_diff(uint32_t a, uint32_t b)
 void sc_dlink_asm_init(sc_dlink_asm *a)
 {
     memset(a, 0, sizeof *a);
+    a->max_version = (uint8_t)SC_DLINK_VERSION_COLOUR;
     a->end.compression_pm = SC_DLINK_COMPRESSION_UNKNOWN;
     a->end.artery_compression_pm = SC_DLINK_COMPRESSION_UNKNOWN;
 }
@@ -426,6 +547,9 @@ static void close_frame(sc_dlink_asm *a, uint8_t end_seen)
     a->done.image = img;
     a->done.params = a->params;
     a->done.params_known = a->params_known;
+    a->done.colour = a->colour_used[a->cur] ? a->colour[a->cur] : NULL;
+    a->done.doppler_seen = a->doppler_seen;
+    a->done.doppler = a->doppler;
     a->have_done = 1u;
     a->last_closed_no = a->frame.frame_no;
     a->cur ^= 1u;
@@ -438,7 +562,12 @@ static void open_frame(sc_dlink_asm *a, const sc_dlink_frame *f, uint8_t type)
     a->open = 1u;
     a->begin_seen = 0u;
     a->received = 0u;
+    a->doppler_seen = 0u;
     memset(a->got, 0, sizeof a->got);
+    if (a->colour_used[a->cur]) {
+        memset(a->colour[a->cur], 0, sizeof a->colour[a->cur]);
+        a->colour_used[a->cur] = 0u;
+    }
     if (type != SC_DLINK_FRAME_BEGIN) {
         a->stats.begins_missing++;
     }
@@ -446,7 +575,7 @@ static void open_frame(sc_dlink_asm *a, const sc_dlink_frame *f, uint8_t type)
 
 static void count_late(sc_dlink_asm *a, uint8_t type)
 {
-    if (type == SC_DLINK_LINE) {
+    if (type == SC_DLINK_LINE || type == SC_DLINK_COLOUR_LINE) {
         a->stats.lines_late++;
     } else {
         a->stats.frames_late++;
@@ -458,7 +587,7 @@ int sc_dlink_asm_push(sc_dlink_asm *a, const uint8_t *pkt, size_t len)
     sc_dlink_header h;
     const uint8_t *pl = NULL;
     a->stats.packets++;
-    int rc = sc_dlink_decode(pkt, len, &h, &pl);
+    int rc = sc_dlink_decode_as(pkt, len, a->max_version, &h, &pl);
     if (rc < 0) {
         count_reject(&a->stats, rc);
         return rc;
@@ -524,6 +653,19 @@ int sc_dlink_asm_push(sc_dlink_asm *a, const uint8_t *pkt, size_t len)
         closed = 1;
         break;
     }
+    case SC_DLINK_COLOUR_LINE: {
+        const uint16_t first = get16(pl + 0), count = get16(pl + 2);
+        memcpy(a->colour[a->cur] + (size_t)h.line_index * SC_MAX_SCAN_SAMPLES + first,
+               pl + SC_DLINK_COLOUR_HEAD, count);
+        a->colour_used[a->cur] = 1u;
+        a->stats.colour_lines++;
+        break;
+    }
+    case SC_DLINK_DOPPLER:
+        sc_dlink_parse_doppler(pl, &a->doppler);
+        a->doppler_seen = 1u;
+        a->stats.doppler_records++;
+        break;
     }
     return closed;
 }

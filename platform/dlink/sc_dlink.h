@@ -30,6 +30,13 @@
 
 #define SC_DLINK_MAGIC         0x4C444353u /* bytes 'S' 'C' 'D' 'L' on the wire (little-endian) */
 #define SC_DLINK_VERSION       2u /* 2: the compression measure moved to FRAME_END */
+/* Version 3, an extension: colour Doppler (COLOUR_LINE, DOPPLER packets). Only the new packet
+ * types carry version 3; B-mode packets stay version 2, so a version-2 receiver keeps showing
+ * the B-scan and refuses the colour packets by name (SC_ERR_DLINK_VERSION, counted). */
+#define SC_DLINK_VERSION_COLOUR 3u
+#define SC_DLINK_COLOUR_HEAD    4u  /* COLOUR_LINE: first sample, count (u16 each), then values */
+#define SC_DLINK_DOPPLER_HEAD   28u /* DOPPLER: box, scale, steering, gate; then the spectrum */
+#define SC_DLINK_SPECTRUM_MAX   128u
 #define SC_DLINK_HEADER_SIZE   28u
 #define SC_DLINK_BEGIN_PAYLOAD 16u /* depth, width, radius f32; reserved u32 */
 #define SC_DLINK_END_PAYLOAD   8u  /* lines_sent, lines_dropped, vein and artery compression u16 */
@@ -37,7 +44,7 @@
 #define SC_DLINK_PARAMS_TGC     8u
 /* Largest packet: a line of SC_MAX_SCAN_SAMPLES samples (540 bytes with the default limits,
  * below the 1472-byte UDP payload of a 1500-byte Ethernet MTU, so no IP fragmentation). */
-#define SC_DLINK_MAX_PACKET (SC_DLINK_HEADER_SIZE + SC_MAX_SCAN_SAMPLES)
+#define SC_DLINK_MAX_PACKET (SC_DLINK_HEADER_SIZE + SC_DLINK_COLOUR_HEAD + SC_MAX_SCAN_SAMPLES)
 /* Compression measure unknown (the sender has none, e.g. no vessel in view). */
 #define SC_DLINK_COMPRESSION_UNKNOWN 0xFFFFu
 
@@ -53,6 +60,8 @@ typedef enum sc_dlink_type {
      * optional, once between FRAME_BEGIN and FRAME_END. A receiver that predates it rejects
      * it by type (counted) and still shows the frame; 4..7 left to other extensions. */
     SC_DLINK_FRAME_PARAMS = 8,
+    SC_DLINK_COLOUR_LINE = 4, /* version 3 */
+    SC_DLINK_DOPPLER = 5,     /* version 3 */
 } sc_dlink_type;
 
 /* Decoded header. For FRAME_BEGIN and FRAME_END line_index is 0. */
@@ -95,6 +104,19 @@ typedef struct sc_dlink_params {
     float frequency_mhz;
     float tgc_db[SC_DLINK_PARAMS_TGC];
 } sc_dlink_params;
+/* DOPPLER payload (version 3): the frame's colour box, scale and pulsed-wave spectrum column
+ * (as hal/sc_hal_display.h's sc_display_doppler_info). */
+typedef struct sc_dlink_doppler {
+    uint16_t box_line_lo, box_line_hi;     /* lines [lo, hi), hi <= line_count */
+    uint16_t box_sample_lo, box_sample_hi; /* samples [lo, hi), hi <= samples */
+    float nyquist_mm_s;                    /* > 0, finite */
+    float steer_deg;                       /* [-90, 90] */
+    float gate_velocity_mm_s;              /* finite */
+    uint16_t gate_line;                    /* < line_count */
+    uint16_t gate_sample_lo, gate_sample_hi; /* lo < hi <= samples */
+    uint16_t bins;                         /* 0 .. SC_DLINK_SPECTRUM_MAX */
+    uint8_t spectrum[SC_DLINK_SPECTRUM_MAX];
+} sc_dlink_doppler;
 
 /* The compression measure in permille of an area ratio (now / at rest; < 0 or not finite:
  * unknown): 1000 (1 - ratio), clamped to 0..1000. O(1). */
@@ -127,6 +149,15 @@ int sc_dlink_encode_end(uint8_t *buf, size_t cap, const sc_dlink_frame *f, const
 int sc_dlink_encode_params(uint8_t *buf, size_t cap, const sc_dlink_frame *f,
                            const sc_dlink_params *p);
 
+/* Version 3 encoders. COLOUR_LINE: colour values of samples [first, first + count) of a line
+ * (signed bytes, 0 no colour); errors as above plus SC_ERR_DLINK_FIELD for count 0 or
+ * first + count > samples. DOPPLER: SC_ERR_DLINK_FIELD for a box, gate or bin count outside the
+ * frame or the limits above, SC_ERR_NOT_FINITE for a non-finite float. */
+int sc_dlink_encode_colour(uint8_t *buf, size_t cap, const sc_dlink_frame *f, uint16_t line_index,
+                           uint16_t first, const int8_t *values, uint16_t count);
+int sc_dlink_encode_doppler(uint8_t *buf, size_t cap, const sc_dlink_frame *f,
+                            const sc_dlink_doppler *d);
+
 /* Decode and check one received packet of len bytes. On success fills *h, points *payload at
  * the payload inside pkt and returns 0. Checks, in this order: length at least a header
  * (SC_ERR_DLINK_LENGTH), magic (SC_ERR_DLINK_MAGIC), version (SC_ERR_DLINK_VERSION), header
@@ -137,12 +168,23 @@ int sc_dlink_encode_params(uint8_t *buf, size_t cap, const sc_dlink_frame *f,
  * also SC_ERR_INVALID_ARG for NULL pointers. O(len), never allocates. */
 int sc_dlink_decode(const uint8_t *pkt, size_t len, sc_dlink_header *h, const uint8_t **payload);
 
+/* sc_dlink_decode as a receiver of protocol version max_version (2 or 3) does it: a version-2
+ * receiver accepts version 2 only (exactly the version-2 rules: a colour packet is refused with
+ * SC_ERR_DLINK_VERSION before anything else is read); a version-3 receiver accepts version 2 for
+ * types 1-3 and version 3 for types 4-5 (any other pairing: SC_ERR_DLINK_TYPE). Payload checks
+ * of the new types: COLOUR_LINE payload 4 + count, count >= 1, first + count <= samples,
+ * line_index < line_count; DOPPLER payload 28 + bins, the DOPPLER ranges above. sc_dlink_decode is
+ * this with max_version 3. */
+int sc_dlink_decode_as(const uint8_t *pkt, size_t len, uint8_t max_version, sc_dlink_header *h,
+                       const uint8_t **payload);
+
 /* Payload accessors for a packet that sc_dlink_decode accepted with that type (the decoder
  * has checked the payload: finite depth, width and radius >= 0, compression <= 1000 or unknown,
  * lines_sent + lines_dropped <= line_count, reserved bytes zero). O(1), cannot fail. */
 void sc_dlink_parse_begin(const uint8_t *payload, sc_dlink_begin *b);
 void sc_dlink_parse_end(const uint8_t *payload, sc_dlink_end *e);
 void sc_dlink_parse_params(const uint8_t *payload, sc_dlink_params *p);
+void sc_dlink_parse_doppler(const uint8_t *payload, sc_dlink_doppler *d);
 
 /* ---- receiver-side frame assembler ----------------------------------------------------- */
 
@@ -160,6 +202,8 @@ typedef struct sc_dlink_rx_stats {
     uint64_t begins_missing;       /* frame started by a line or end: its FRAME_BEGIN never came */
     uint64_t ends_missing;         /* frame closed by a newer frame: its FRAME_END never came */
     uint64_t frames_late;          /* FRAME_BEGIN/END of a frame older than the current one */
+    uint64_t colour_lines;         /* COLOUR_LINE packets stored */
+    uint64_t doppler_records;      /* DOPPLER packets stored */
 } sc_dlink_rx_stats;
 
 /* A closed frame, ready to show: image rows 0..line_count-1, each `samples` bytes, stride
@@ -175,10 +219,20 @@ typedef struct sc_dlink_done {
     const uint8_t *image; /* valid until the next frame closes */
     sc_dlink_params params; /* FRAME_PARAMS, or the last frame's that had one */
     uint8_t params_known;   /* a FRAME_PARAMS has arrived (this frame or before) */
+    /* colour Doppler (version 3): colour plane like image (signed, 0 no colour), or NULL when
+     * the frame carried no colour; the doppler record when doppler_seen */
+    const int8_t *colour;
+    uint8_t doppler_seen;
+    sc_dlink_doppler doppler;
 } sc_dlink_done;
 
 typedef struct sc_dlink_asm {
     uint8_t image[2][SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES]; /* assembling / last closed */
+    int8_t colour[2][SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES]; /* colour planes, as image */
+    uint8_t colour_used[2];  /* plane holds colour (cleared when a frame opens on it) */
+    uint8_t max_version;     /* receiver's protocol version: 3 (init), 2 as an old receiver */
+    uint8_t doppler_seen;    /* open frame */
+    sc_dlink_doppler doppler; /* open frame's */
     uint32_t got[(SC_MAX_SCAN_LINES + 31u) / 32u];             /* lines of the open frame */
     uint8_t cur;                                               /* plane being assembled */
     uint8_t open;                                              /* a frame is being assembled */

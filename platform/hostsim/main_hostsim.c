@@ -516,6 +516,21 @@ static int write_frame_png(const options *o, sc_scanconv *conv, uint8_t *raster,
 {
     char path[4096];
     snprintf(path, sizeof(path), "%s/frame_%05u.png", o->out_dir, frame_no);
+    if (d->colour_lines > 0u && d->last_info.frame_no == d->info.frame_no) {
+        /* colour Doppler of the same frame: RGB, the colour plane packed to the image stride */
+        static int8_t colour[SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES];
+        uint8_t *rgb = malloc(3u * (size_t)conv->width * conv->height);
+        if (rgb != NULL) {
+            const uint32_t n = d->last_info.samples;
+            for (uint32_t l = 0; l < d->last_info.lines; l++) {
+                memcpy(colour + (size_t)l * n, d->colour + (size_t)l * SC_MAX_SCAN_SAMPLES, n);
+            }
+            sc_scanconv_render_colour(conv, &d->last_info, d->last, colour, n, rgb);
+            const int rc = sc_png_write(path, conv->width, conv->height, 3, rgb, 3u * conv->width);
+            free(rgb);
+            return rc;
+        }
+    }
     sc_scanconv_render(conv, &d->last_info, d->last, d->last_info.samples, raster);
     sc_overlay_draw(raster, conv->width, conv->height, &d->last_info);
     return sc_png_write(path, conv->width, conv->height, 1, raster, conv->width);

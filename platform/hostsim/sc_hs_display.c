@@ -39,6 +39,39 @@ static int hs_begin(void *ctx, const sc_display_frame_info *info)
     d->lines_seen = 0;
     memset(d->line_seen, 0, sizeof(d->line_seen));
     memset(d->image, 0, (size_t)info->lines * info->samples);
+    memset(d->colour, 0, (size_t)info->lines * SC_MAX_SCAN_SAMPLES);
+    return SC_OK;
+}
+
+static int hs_colour_line(void *ctx, uint32_t frame_no, uint16_t line_index, uint16_t first,
+                          const int8_t *values, uint16_t count)
+{
+    sc_hs_display *d = ctx;
+    if (!d->in_frame || frame_no != d->info.frame_no || line_index >= d->info.lines ||
+        count == 0u || (uint32_t)first + count > d->info.samples || values == NULL) {
+        d->protocol_errors++;
+        return SC_ERR_INVALID_ARG;
+    }
+    memcpy(d->colour + (size_t)line_index * SC_MAX_SCAN_SAMPLES + first, values, count);
+    d->colour_lines++;
+    d->colour_hash = sc_hs_hash64(values, count, d->colour_hash ^ line_index);
+    return SC_OK;
+}
+
+static int hs_doppler(void *ctx, const sc_display_doppler_info *info)
+{
+    sc_hs_display *d = ctx;
+    if (!d->in_frame || info == NULL || info->frame_no != d->info.frame_no ||
+        info->spectrum_bins > SC_DISPLAY_SPECTRUM_MAX_BINS ||
+        (info->spectrum_bins > 0u && info->spectrum == NULL)) {
+        d->protocol_errors++;
+        return SC_ERR_INVALID_ARG;
+    }
+    d->doppler = *info;
+    memcpy(d->spectrum, info->spectrum, info->spectrum_bins);
+    d->doppler.spectrum = d->spectrum;
+    d->doppler_records++;
+    d->colour_hash = sc_hs_hash64(d->spectrum, info->spectrum_bins, d->colour_hash);
     return SC_OK;
 }
 
@@ -104,6 +137,8 @@ static const sc_display_ops hs_display_ops = {
     .line = hs_line,
     .frame_end = hs_end,
     .link_state = hs_link_state,
+    .colour_line = hs_colour_line,
+    .doppler = hs_doppler,
 };
 
 void sc_hs_display_init(sc_hs_display *d)

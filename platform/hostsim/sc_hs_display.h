@@ -39,6 +39,14 @@ typedef struct sc_hs_display {
     uint32_t hash_count;
     uint8_t link_down;           /* fault injection: the link is down, every call refused */
     uint64_t calls_refused;      /* begin/line/end refused while down (SC_ERR_IO) */
+    /* colour Doppler (optional ops): the frame's colour plane (line-major, 0 no colour), cleared
+     * at frame_begin, and the last doppler record with its spectrum copied */
+    int8_t colour[SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES];
+    uint64_t colour_lines;
+    uint64_t doppler_records;
+    sc_display_doppler_info doppler;  /* .spectrum points at spectrum below */
+    uint8_t spectrum[SC_DISPLAY_SPECTRUM_MAX_BINS];
+    uint64_t colour_hash;             /* FNV-1a of every colour line and record so far */
 } sc_hs_display;
 
 void sc_hs_display_init(sc_hs_display *d);

@@ -91,7 +91,7 @@ static int null_end(void *ctx, const sc_display_end_info *end)
     return 0;
 }
 
-static const sc_display_ops k_null_display = {null_begin, null_line, null_end, NULL};
+static const sc_display_ops k_null_display = {null_begin, null_line, null_end, NULL, NULL, NULL};
 
 /* ---- command line ----------------------------------------------------------------------- */
 

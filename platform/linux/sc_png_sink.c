@@ -23,6 +23,11 @@ struct sc_png_sink {
     uint32_t max_frames;
     /* frame loop side */
     uint8_t *frame; /* lines being collected */
+    int8_t *colour; /* colour Doppler of the frame (colour_line), NULL-free; has_colour: any */
+    int has_colour;
+    int8_t *handoff_colour;
+    int handoff_has_colour;
+    uint8_t *rgb; /* writer: RGB raster of a frame with colour */
     uint8_t got[SC_MAX_SCAN_LINES];
     uint32_t got_n;
     sc_display_frame_info info;
@@ -55,11 +60,27 @@ static void *writer_main(void *arg)
         }
         const sc_display_frame_info info = s->handoff_info;
         pthread_mutex_unlock(&s->lock);
-        sc_scanconv_render(&s->conv, &info, s->handoff, STRIDE, s->raster);
-        sc_overlay_draw(s->raster, s->conv.width, s->conv.height, &info); /* a scanner's display */
         char path[4200];
         snprintf(path, sizeof path, "%s/frame_%06u.png", s->dir, (unsigned)info.frame_no);
-        int rc = sc_png_write(path, s->conv.width, s->conv.height, 1u, s->raster, s->conv.width);
+        int rc;
+        if (s->handoff_has_colour) { /* colour Doppler over the grey B-scan: an RGB file */
+            sc_scanconv_render_colour(&s->conv, &info, s->handoff, s->handoff_colour, STRIDE,
+                                      s->rgb);
+            /* the scanner's display over the colour image: drawn on a blank grey plane, copied
+             * where it drew */
+            memset(s->raster, 0, (size_t)s->conv.width * s->conv.height);
+            sc_overlay_draw(s->raster, s->conv.width, s->conv.height, &info);
+            for (size_t i = 0; i < (size_t)s->conv.width * s->conv.height; i++) {
+                if (s->raster[i] != 0u) {
+                    s->rgb[3u * i] = s->rgb[3u * i + 1u] = s->rgb[3u * i + 2u] = s->raster[i];
+                }
+            }
+            rc = sc_png_write(path, s->conv.width, s->conv.height, 3u, s->rgb, 3u * s->conv.width);
+        } else {
+            sc_scanconv_render(&s->conv, &info, s->handoff, STRIDE, s->raster);
+            sc_overlay_draw(s->raster, s->conv.width, s->conv.height, &info); /* a scanner's display */
+            rc = sc_png_write(path, s->conv.width, s->conv.height, 1u, s->raster, s->conv.width);
+        }
         pthread_mutex_lock(&s->lock);
         if (rc == 0) {
             s->st.frames_written++;
@@ -93,6 +114,24 @@ static int png_frame_begin(void *ctx, const sc_display_frame_info *info)
     memset(s->got, 0, info->lines);
     s->got_n = 0;
     s->in_frame = 1;
+    if (s->has_colour) {
+        memset(s->colour, 0, FRAME_BYTES);
+        s->has_colour = 0;
+    }
+    return 0;
+}
+
+static int png_colour_line(void *ctx, uint32_t frame_no, uint16_t line_index, uint16_t first,
+                           const int8_t *values, uint16_t count)
+{
+    sc_png_sink *s = ctx;
+    if (!s->in_frame || frame_no != s->info.frame_no || line_index >= s->info.lines ||
+        count == 0u || (uint32_t)first + count > s->info.samples || values == NULL) {
+        count_protocol_error(s);
+        return SC_ERR_STATE;
+    }
+    memcpy(s->colour + (size_t)line_index * STRIDE + first, values, count);
+    s->has_colour = 1;
     return 0;
 }
 
@@ -141,6 +180,10 @@ static int png_frame_end(void *ctx, const sc_display_end_info *end)
             rc = SC_ERR_WOULD_BLOCK;
         } else {
             memcpy(s->handoff, s->frame, FRAME_BYTES);
+            s->handoff_has_colour = s->has_colour;
+            if (s->has_colour) {
+                memcpy(s->handoff_colour, s->colour, FRAME_BYTES);
+            }
             s->handoff_info = s->info;
             s->pending = 1;
             pthread_cond_signal(&s->cond);
@@ -161,7 +204,8 @@ static int png_link_state(void *ctx, sc_display_link_state *st)
     return 0;
 }
 
-static const sc_display_ops k_png_ops = {png_frame_begin, png_line, png_frame_end, png_link_state};
+static const sc_display_ops k_png_ops = {png_frame_begin, png_line,        png_frame_end,
+                                         png_link_state,  png_colour_line, NULL};
 
 int sc_png_sink_open(sc_png_sink **out, const sc_png_sink_def *def)
 {
@@ -185,7 +229,14 @@ int sc_png_sink_open(sc_png_sink **out, const sc_png_sink_def *def)
     s->frame = calloc(1, FRAME_BYTES);
     s->handoff = calloc(1, FRAME_BYTES);
     s->raster = calloc(1, (size_t)w * h);
-    if (!s->frame || !s->handoff || !s->raster || sc_scanconv_init(&s->conv, w, h) != 0) {
+    s->colour = calloc(1, FRAME_BYTES);
+    s->handoff_colour = calloc(1, FRAME_BYTES);
+    s->rgb = calloc(3, (size_t)w * h);
+    if (!s->frame || !s->handoff || !s->raster || !s->colour || !s->handoff_colour || !s->rgb ||
+        sc_scanconv_init(&s->conv, w, h) != 0) {
+        free(s->colour);
+        free(s->handoff_colour);
+        free(s->rgb);
         free(s->frame);
         free(s->handoff);
         free(s->raster);
@@ -196,6 +247,9 @@ int sc_png_sink_open(sc_png_sink **out, const sc_png_sink_def *def)
     pthread_cond_init(&s->cond, NULL);
     if (pthread_create(&s->thread, NULL, writer_main, s) != 0) {
         sc_scanconv_free(&s->conv);
+        free(s->colour);
+        free(s->handoff_colour);
+        free(s->rgb);
         free(s->frame);
         free(s->handoff);
         free(s->raster);
@@ -235,6 +289,9 @@ void sc_png_sink_close(sc_png_sink *s)
     pthread_mutex_destroy(&s->lock);
     pthread_cond_destroy(&s->cond);
     sc_scanconv_free(&s->conv);
+    free(s->colour);
+    free(s->handoff_colour);
+    free(s->rgb);
     free(s->frame);
     free(s->handoff);
     free(s->raster);

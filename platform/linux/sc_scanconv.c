@@ -1,6 +1,8 @@
 /* sc_scanconv.c: B-scan scan conversion, see sc_scanconv.h. */
 #include "sc_scanconv.h"
 
+#include "sc_doppler.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -83,6 +85,41 @@ static void build_sector(sc_scanconv *c, const sc_display_frame_info *g, uint32_
             }
             c->lut[(size_t)y * c->width + x] = v;
         }
+    }
+}
+
+static void ensure_lut(sc_scanconv *c, const sc_display_frame_info *info, uint32_t stride);
+
+void sc_scanconv_render_colour(sc_scanconv *c, const sc_display_frame_info *info,
+                               const uint8_t *image, const int8_t *colour, uint32_t stride,
+                               uint8_t *rgb)
+{
+    ensure_lut(c, info, stride);
+    const size_t n = (size_t)c->width * c->height;
+    for (size_t i = 0; i < n; i++) {
+        const uint32_t v = c->lut[i];
+        uint8_t *px = rgb + 3u * i;
+        if (v == UINT32_MAX) {
+            px[0] = px[1] = px[2] = 0u;
+        } else if (colour[v] != 0) {
+            sc_doppler_colour_rgb(colour[v], px);
+        } else {
+            px[0] = px[1] = px[2] = image[v];
+        }
+    }
+}
+
+static void ensure_lut(sc_scanconv *c, const sc_display_frame_info *info, uint32_t stride)
+{
+    if (!c->valid || c->stride != stride || !same_geom(&c->geom, info)) {
+        if (info->geometry_id == 1u) {
+            build_sector(c, info, stride);
+        } else {
+            build_linear(c, info, stride);
+        }
+        c->geom = *info;
+        c->stride = stride;
+        c->valid = 1;
     }
 }
 

@@ -33,4 +33,11 @@ void sc_scanconv_free(sc_scanconv *c);
 void sc_scanconv_render(sc_scanconv *c, const sc_display_frame_info *info, const uint8_t *image,
                         uint32_t stride, uint8_t *out);
 
+/* As sc_scanconv_render, in RGB (3 bytes per pixel, rows of 3 * width): grey B-mode, and
+ * where the colour plane (same layout as image, signed, 0 none) has a value the scanner's
+ * colour map (sc_doppler_colour_rgb: red toward the probe, blue away) instead. */
+void sc_scanconv_render_colour(sc_scanconv *c, const sc_display_frame_info *info,
+                               const uint8_t *image, const int8_t *colour, uint32_t stride,
+                               uint8_t *rgb);
+
 #endif /* SC_SCANCONV_H */

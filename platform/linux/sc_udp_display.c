@@ -296,7 +296,60 @@ static int udp_link_state(void *ctx, sc_display_link_state *st)
     return 0;
 }
 
-static const sc_display_ops k_udp_ops = {udp_frame_begin, udp_line, udp_frame_end, udp_link_state};
+/* Colour Doppler (display link version 3): a colour line and the frame's record are queued
+ * like lines; a version-2 receiver refuses them by name and keeps the B-scan. */
+static int udp_colour_line(void *ctx, uint32_t frame_no, uint16_t line_index, uint16_t first,
+                           const int8_t *values, uint16_t count)
+{
+    sc_udp_display *u = ctx;
+    if (!u->in_frame || frame_no != u->frame.frame_no) {
+        u->protocol_errors++;
+        return SC_ERR_STATE;
+    }
+    int len = sc_dlink_encode_colour(u->q_pkt[u->queued], SC_DLINK_MAX_PACKET, &u->frame,
+                                     line_index, first, values, count);
+    if (len < 0) {
+        u->protocol_errors++;
+        return len;
+    }
+    return queue(u, SC_DLINK_COLOUR_LINE, len);
+}
+
+static int udp_doppler(void *ctx, const sc_display_doppler_info *info)
+{
+    sc_udp_display *u = ctx;
+    if (!info || !u->in_frame || info->frame_no != u->frame.frame_no ||
+        info->spectrum_bins > SC_DLINK_SPECTRUM_MAX ||
+        (info->spectrum_bins > 0u && info->spectrum == NULL)) {
+        u->protocol_errors++;
+        return SC_ERR_STATE;
+    }
+    sc_dlink_doppler d = {
+        .box_line_lo = info->box_line_lo,
+        .box_line_hi = info->box_line_hi,
+        .box_sample_lo = info->box_sample_lo,
+        .box_sample_hi = info->box_sample_hi,
+        .nyquist_mm_s = info->nyquist_mm_s,
+        .steer_deg = info->steer_deg,
+        .gate_velocity_mm_s = info->gate_velocity_mm_s,
+        .gate_line = info->gate_line,
+        .gate_sample_lo = info->gate_sample_lo,
+        .gate_sample_hi = info->gate_sample_hi,
+        .bins = info->spectrum_bins,
+    };
+    if (info->spectrum_bins > 0u) {
+        memcpy(d.spectrum, info->spectrum, info->spectrum_bins);
+    }
+    int len = sc_dlink_encode_doppler(u->q_pkt[u->queued], SC_DLINK_MAX_PACKET, &u->frame, &d);
+    if (len < 0) {
+        u->protocol_errors++;
+        return len;
+    }
+    return queue(u, SC_DLINK_DOPPLER, len);
+}
+
+static const sc_display_ops k_udp_ops = {udp_frame_begin, udp_line,        udp_frame_end,
+                                         udp_link_state,  udp_colour_line, udp_doppler};
 
 sc_display_dev sc_udp_display_dev(sc_udp_display *u)
 {

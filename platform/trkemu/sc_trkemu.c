@@ -365,3 +365,82 @@ int sc_emu_load_csv(FILE *fp, sc_emu_row *rows, size_t cap, size_t *n, size_t *b
     *n = count;
     return count > 0u ? 0 : SC_ERR_PARSE;
 }
+
+/* ---- the tracked needle --------------------------------------------------------------------- */
+
+sc_emu_needle_def sc_emu_needle_default_def(void)
+{
+    return (sc_emu_needle_def){.rate_hz = 100.0,
+                               .start_s = 0.5,
+                               .entry_mm = {0.0f, 0.0f, 0.0f},
+                               .dir = {0.0f, 0.0f, 1.0f},
+                               .speed_mm_s = 10.0f,
+                               .max_depth_mm = 25.0f,
+                               .hold_s = 1.0};
+}
+
+int sc_emu_needle_init(sc_emu_needle *n, const sc_emu_needle_def *def)
+{
+    if (n == NULL || def == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    const float nn =
+        sqrtf(def->dir[0] * def->dir[0] + def->dir[1] * def->dir[1] + def->dir[2] * def->dir[2]);
+    if (!isfinite(def->rate_hz) || !isfinite(def->start_s) || !isfinite(def->hold_s) ||
+        !isfinite(nn) || !isfinite(def->speed_mm_s) || !isfinite(def->max_depth_mm) ||
+        !isfinite(def->entry_mm[0]) || !isfinite(def->entry_mm[1]) || !isfinite(def->entry_mm[2])) {
+        return SC_ERR_NOT_FINITE;
+    }
+    if (!(def->rate_hz > 0.0 && def->rate_hz <= 1000.0) || def->start_s < 0.0 ||
+        def->hold_s < 0.0 || !(nn > 0.0f) || !(def->speed_mm_s > 0.0f && def->speed_mm_s <= 200.0f) ||
+        !(def->max_depth_mm > 0.0f && def->max_depth_mm <= 200.0f)) {
+        return SC_ERR_RANGE;
+    }
+    memset(n, 0, sizeof *n);
+    n->def = *def;
+    for (unsigned i = 0; i < 3u; i++) {
+        n->def.dir[i] = def->dir[i] / nn;
+    }
+    return 0;
+}
+
+sc_needle_msg sc_emu_needle_at(const sc_emu_needle_def *d, double t_s)
+{
+    const double in_s = (double)d->max_depth_mm / (double)d->speed_mm_s;
+    const double cycle = 2.0 * in_s + d->hold_s;
+    double u = t_s - d->start_s;
+    double depth = 0.0;
+    if (u > 0.0) {
+        u = fmod(u, cycle);
+        depth = u < in_s ? u * d->speed_mm_s
+                         : (u < in_s + d->hold_s ? d->max_depth_mm
+                                                 : (cycle - u) * d->speed_mm_s);
+    }
+    sc_needle_msg m;
+    memset(&m, 0, sizeof m);
+    for (unsigned i = 0; i < 3u; i++) {
+        m.tip_mm[i] = d->entry_mm[i] + (float)depth * d->dir[i];
+        m.dir[i] = d->dir[i];
+    }
+    m.depth_mm = (float)depth;
+    m.tracking = SC_TRACKING_OK;
+    return m;
+}
+
+int sc_emu_needle_next(sc_emu_needle *n, sc_can_frame *out, size_t cap, uint64_t *t_ns)
+{
+    const double t_s = (double)n->sample / n->def.rate_hz;
+    *t_ns = (uint64_t)(t_s * 1e9 + 0.5);
+    const sc_needle_msg m = sc_emu_needle_at(&n->def, t_s);
+    size_t nf = 0;
+    const int rc = sc_canproto_encode_needle(&m, n->counter, out, cap, &nf);
+    if (rc != 0) {
+        return rc;
+    }
+    for (size_t i = 0; i < nf; i++) {
+        out[i].ts_ns = *t_ns;
+    }
+    n->sample++;
+    n->counter = (uint8_t)((n->counter + 1u) & 0x0Fu);
+    return (int)nf;
+}

@@ -133,4 +133,35 @@ const char *sc_emu_fault_name(sc_emu_fault_kind k);
 int sc_emu_script_from_name(const char *name, sc_emu_script *out);
 int sc_emu_fault_from_name(const char *name, sc_emu_fault_kind *out);
 
+/* ---- the tracked needle (issue 18): a second tool, its own frames (0x120..0x122) ----------
+ * Script: from start_s the needle advances from its skin entry point along dir at speed_mm_s
+ * until max_depth_mm, holds for hold_s, then withdraws at the same speed (and repeats). Its
+ * samples carry their own E2E counter. Tracker frame = volume frame of the emulator's
+ * registration (as the probe's point_mm). */
+typedef struct sc_emu_needle_def {
+    double rate_hz;       /* samples per second, (0, 1000] */
+    double start_s;       /* insertion starts */
+    float entry_mm[3];    /* skin entry point */
+    float dir[3];         /* shaft direction, hub to tip (normalised by init) */
+    float speed_mm_s;     /* (0, 200] */
+    float max_depth_mm;   /* (0, 200] */
+    double hold_s;        /* at full depth, >= 0 */
+} sc_emu_needle_def;
+
+typedef struct sc_emu_needle {
+    sc_emu_needle_def def;
+    uint64_t sample;
+    uint8_t counter;
+} sc_emu_needle;
+
+/* 100 Hz from 0.5 s, entry (0, 0, 0), straight down, 10 mm/s to 25 mm, hold 1 s. */
+sc_emu_needle_def sc_emu_needle_default_def(void);
+/* 0, SC_ERR_INVALID_ARG / SC_ERR_RANGE / SC_ERR_NOT_FINITE for a bad definition. */
+int sc_emu_needle_init(sc_emu_needle *n, const sc_emu_needle_def *def);
+/* The scripted needle at t_s (depth 0 before the start). */
+sc_needle_msg sc_emu_needle_at(const sc_emu_needle_def *def, double t_s);
+/* The 3 frames of the next sample into out[cap >= 3]; *t_ns its time from the start. Returns
+ * the frame count (3) or a negative error. */
+int sc_emu_needle_next(sc_emu_needle *n, sc_can_frame *out, size_t cap, uint64_t *t_ns);
+
 #endif /* SC_TRKEMU_H */

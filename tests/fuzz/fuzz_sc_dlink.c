@@ -27,6 +27,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             const sc_dlink_done *d = sc_dlink_asm_done(&rx);
             SC_FUZZ_CHECK(d != NULL);
             SC_FUZZ_CHECK(d->lines_received + d->lines_lost == d->frame.line_count);
+            if (d->doppler_seen) { /* the decoder checked the record against its frame */
+                SC_FUZZ_CHECK(d->doppler.box_line_hi <= d->frame.line_count);
+                SC_FUZZ_CHECK(d->doppler.box_sample_hi <= d->frame.samples);
+                SC_FUZZ_CHECK(d->doppler.bins <= SC_DLINK_SPECTRUM_MAX);
+                SC_FUZZ_CHECK(d->doppler.nyquist_mm_s > 0.0f);
+            }
         }
         off += len;
     }
@@ -36,8 +42,70 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     return 0;
 }
 
+static size_t put_pkt(uint8_t *buf, size_t n, size_t cap, const uint8_t *pkt, int len)
+{
+    if (len <= 0 || n + 2u + (size_t)len > cap) {
+        return 0;
+    }
+    buf[n++] = (uint8_t)(len & 0xFF);
+    buf[n++] = (uint8_t)((unsigned)len >> 8u);
+    memcpy(buf + n, pkt, (size_t)len);
+    return n + (size_t)len;
+}
+
+/* Seeds 3, 4: a frame with colour Doppler (display link version 3): B-mode lines, a colour
+ * line per line, the doppler record with a spectrum, the end. */
+static size_t colour_seed(uint32_t i, uint8_t *buf, size_t cap)
+{
+    sc_dlink_frame f = {.frame_no = 40u + i, .flags = 1, .line_count = 4, .samples = 16,
+                        .geometry_id = (uint16_t)(i & 1u)};
+    sc_dlink_begin b = {.depth_mm = 40.0f, .width_mm = 38.0f, .radius_mm = (i & 1u) ? 40.0f : 0.0f};
+    sc_dlink_end e = {.lines_sent = 4, .lines_dropped = 0, .compression_pm = 100,
+                      .artery_compression_pm = 0};
+    uint8_t pkt[1024], line[16];
+    int8_t col[12];
+    size_t n = put_pkt(buf, 0, cap, pkt, sc_dlink_encode_begin(pkt, sizeof pkt, &f, &b));
+    for (uint16_t l = 0; l < 4u && n; l++) {
+        memset(line, 30 * l, sizeof line);
+        n = put_pkt(buf, n, cap, pkt, sc_dlink_encode_line(pkt, sizeof pkt, &f, l, line, 16));
+        for (int k = 0; k < 12; k++) {
+            col[k] = (int8_t)((k - 6) * 20);
+        }
+        if (n) {
+            n = put_pkt(buf, n, cap, pkt,
+                        sc_dlink_encode_colour(pkt, sizeof pkt, &f, l, 2u, col, 12u));
+        }
+    }
+    sc_dlink_doppler d;
+    memset(&d, 0, sizeof d);
+    d.box_line_lo = 0;
+    d.box_line_hi = 4;
+    d.box_sample_lo = 2;
+    d.box_sample_hi = 14;
+    d.nyquist_mm_s = 308.0f;
+    d.steer_deg = 20.0f;
+    d.gate_velocity_mm_s = -150.0f;
+    d.gate_line = 2;
+    d.gate_sample_lo = 6;
+    d.gate_sample_hi = 9;
+    d.bins = 32;
+    for (uint32_t k = 0; k < 32u; k++) {
+        d.spectrum[k] = (uint8_t)(k * 8u);
+    }
+    if (n) {
+        n = put_pkt(buf, n, cap, pkt, sc_dlink_encode_doppler(pkt, sizeof pkt, &f, &d));
+    }
+    if (n) {
+        n = put_pkt(buf, n, cap, pkt, sc_dlink_encode_end(pkt, sizeof pkt, &f, &e));
+    }
+    return n;
+}
+
 size_t sc_fuzz_seed(uint32_t i, uint8_t *buf, size_t cap)
 {
+    if (i == 3u || i == 4u) {
+        return colour_seed(i, buf, cap);
+    }
     if (i > 2u) {
         return 0;
     }

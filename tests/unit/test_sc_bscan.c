@@ -467,7 +467,7 @@ static void lines_stream_in_order_between_begin_and_end_with_frame_number(void *
 {
     (void)state;
     build_mesh(32, 16, 16);
-    static const sc_display_ops ops = {rec_begin, rec_line, rec_end, NULL};
+    static const sc_display_ops ops = {rec_begin, rec_line, rec_end, NULL, NULL, NULL};
     rec_display rec = {.order_ok = 1, .fail_line = -1};
     const sc_display_dev dev = {&ops, &rec};
     sc_bscan_def d = sc_bscan_default_def();

@@ -214,6 +214,35 @@ static void lifted_or_implausible_probe_has_no_contact(void **state)
     assert_int_equal(sc_collider_def_validate(&d), SC_ERR_NOT_FINITE);
 }
 
+/* The needle's tip as a sphere: free nodes inside it (plus the margin) get a contact on its
+ * surface along their direction, nodes the probe already holds and fixed nodes none. */
+static void a_tip_sphere_appends_contacts_of_the_nodes_it_reaches(void **state)
+{
+    (void)state;
+    const float x[5] = {10.0f, 10.5f, 12.0f, 9.6f, 10.0f};
+    const float y[5] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+    const float z[5] = {5.0f, 5.0f, 5.0f, 5.0f, 4.4f};
+    const uint8_t fixed[5] = {0, 0, 0, 1, 0};
+    const float c[3] = {10.0f, 0.0f, 5.2f};
+    g_set.count = 1u; /* node 4 is the probe's already */
+    g_set.c[0].node = 4u;
+    const uint32_t added = sc_collider_append_sphere(c, 1.0f, 0.1f, 5u, x, y, z, fixed, &g_set);
+    assert_int_equal(added, 2u); /* nodes 0 and 1: 2 is out of reach, 3 fixed, 4 held */
+    assert_int_equal(g_set.count, 3u);
+    assert_int_equal(g_set.c[1].node, 0u);
+    assert_int_equal(g_set.c[2].node, 1u);
+    /* node 0 sits 0.2 mm above the centre: pushed up to the surface */
+    assert_true(fabsf(g_set.c[1].p_mm[2] - 4.2f) < 1e-5f && fabsf(g_set.c[1].n[2] + 1.0f) < 1e-5f);
+    /* node 1: along its direction, on the sphere */
+    const float *p = g_set.c[2].p_mm;
+    const float r = sqrtf((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) +
+                          (p[2] - c[2]) * (p[2] - c[2]));
+    assert_true(fabsf(r - 1.0f) < 1e-5f);
+    /* a penetrating node: positive depth against its contact plane */
+    assert_true(sc_contact_depth_mm(&g_set.c[1], x[0], y[0], z[0]) > 0.7f);
+    assert_int_equal(sc_collider_append_sphere(c, 0.0f, 0.1f, 5u, x, y, z, fixed, &g_set), 0u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -222,6 +251,7 @@ int main(void)
         cmocka_unit_test(broad_phase_cost_does_not_grow_with_the_mesh),
         cmocka_unit_test(forces_push_out_along_the_normal_in_proportion_to_depth),
         cmocka_unit_test(lifted_or_implausible_probe_has_no_contact),
+        cmocka_unit_test(a_tip_sphere_appends_contacts_of_the_nodes_it_reaches),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

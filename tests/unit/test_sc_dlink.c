@@ -113,13 +113,15 @@ static void wire_bytes_match_the_documented_layout(void **state)
 }
 
 /* Expected rejection of a single flipped bit at byte offset i of a line packet. */
-static int expected_error_at(size_t i)
+static int expected_error_at(size_t i, unsigned bit)
 {
     if (i < 4u) {
         return SC_ERR_DLINK_MAGIC;
     }
     if (i == 4u) {
-        return SC_ERR_DLINK_VERSION;
+        /* 2 -> 3 is a version this receiver knows (colour): then the CRC refuses it */
+        return (2u ^ (1u << bit)) == SC_DLINK_VERSION_COLOUR ? SC_ERR_DLINK_CRC
+                                                              : SC_ERR_DLINK_VERSION;
     }
     if (i == 20u || i == 21u) {
         return SC_ERR_DLINK_LENGTH; /* payload_len no longer matches the datagram */
@@ -143,10 +145,10 @@ static void every_single_bit_flip_is_rejected_with_its_named_error(void **state)
             memcpy(pkt, good, (size_t)n);
             pkt[i] = (uint8_t)(pkt[i] ^ (1u << bit));
             int rc = sc_dlink_decode(pkt, (size_t)n, &h, &pl);
-            if (rc != expected_error_at(i)) {
+            if (rc != expected_error_at(i, bit)) {
                 print_error("byte %zu bit %u: got %s\n", i, bit, sc_err_name(rc));
             }
-            assert_int_equal(rc, expected_error_at(i));
+            assert_int_equal(rc, expected_error_at(i, bit));
         }
     }
 }
@@ -553,6 +555,199 @@ static void rejected_packets_are_counted_by_reason_and_change_nothing(void **sta
     assert_int_equal(sc_dlink_asm_done(&g_asm)->lines_lost, 4u);
 }
 
+/* ---- version 3: colour Doppler ---------------------------------------------------------- */
+
+static sc_dlink_doppler sample_doppler(void)
+{
+    sc_dlink_doppler d;
+    memset(&d, 0, sizeof d);
+    d.box_line_lo = 10u;
+    d.box_line_hi = 100u;
+    d.box_sample_lo = 5u;
+    d.box_sample_hi = 150u;
+    d.nyquist_mm_s = 308.0f;
+    d.steer_deg = -20.0f;
+    d.gate_velocity_mm_s = 273.5f;
+    d.gate_line = 64u;
+    d.gate_sample_lo = 70u;
+    d.gate_sample_hi = 80u;
+    d.bins = 128u;
+    for (uint32_t i = 0; i < 128u; i++) {
+        d.spectrum[i] = (uint8_t)(i * 2u);
+    }
+    return d;
+}
+
+static void colour_packets_round_trip_as_version_3(void **state)
+{
+    (void)state;
+    uint8_t buf[SC_DLINK_MAX_PACKET];
+    int8_t vals[145];
+    for (uint32_t i = 0; i < 145u; i++) {
+        vals[i] = (int8_t)((int32_t)i - 72);
+    }
+    sc_dlink_header h;
+    const uint8_t *pl;
+    int n = sc_dlink_encode_colour(buf, sizeof buf, &k_frame, 42u, 5u, vals, 145u);
+    assert_int_equal(n, SC_DLINK_HEADER_SIZE + SC_DLINK_COLOUR_HEAD + 145);
+    assert_int_equal(buf[4], SC_DLINK_VERSION_COLOUR);
+    assert_int_equal(sc_dlink_decode(buf, (size_t)n, &h, &pl), 0);
+    assert_int_equal(h.type, SC_DLINK_COLOUR_LINE);
+    assert_int_equal(h.version, SC_DLINK_VERSION_COLOUR);
+    assert_int_equal(h.line_index, 42u);
+    assert_memory_equal(pl + SC_DLINK_COLOUR_HEAD, vals, 145u);
+    /* out of the line: refused at the encoder */
+    assert_int_equal(sc_dlink_encode_colour(buf, sizeof buf, &k_frame, 42u, 100u, vals, 145u),
+                     SC_ERR_DLINK_FIELD);
+    assert_int_equal(sc_dlink_encode_colour(buf, sizeof buf, &k_frame, 128u, 0u, vals, 1u),
+                     SC_ERR_DLINK_FIELD);
+
+    const sc_dlink_doppler d = sample_doppler();
+    n = sc_dlink_encode_doppler(buf, sizeof buf, &k_frame, &d);
+    assert_int_equal(n, SC_DLINK_HEADER_SIZE + SC_DLINK_DOPPLER_HEAD + 128);
+    assert_int_equal(sc_dlink_decode(buf, (size_t)n, &h, &pl), 0);
+    assert_int_equal(h.type, SC_DLINK_DOPPLER);
+    sc_dlink_doppler d2;
+    sc_dlink_parse_doppler(pl, &d2);
+    assert_memory_equal(&d2, &d, sizeof d);
+    sc_dlink_doppler bad = d;
+    bad.nyquist_mm_s = NAN;
+    assert_int_equal(sc_dlink_encode_doppler(buf, sizeof buf, &k_frame, &bad), SC_ERR_NOT_FINITE);
+    bad = d;
+    bad.box_line_hi = 129u;
+    assert_int_equal(sc_dlink_encode_doppler(buf, sizeof buf, &k_frame, &bad), SC_ERR_DLINK_FIELD);
+    bad = d;
+    bad.gate_sample_hi = bad.gate_sample_lo;
+    assert_int_equal(sc_dlink_encode_doppler(buf, sizeof buf, &k_frame, &bad), SC_ERR_DLINK_FIELD);
+}
+
+static void a_version_2_receiver_refuses_colour_packets_by_name_and_keeps_the_b_scan(void **state)
+{
+    (void)state;
+    static sc_dlink_asm a;
+    sc_dlink_asm_init(&a);
+    a.max_version = (uint8_t)SC_DLINK_VERSION; /* an old receiver */
+    uint8_t buf[SC_DLINK_MAX_PACKET];
+    uint8_t samples[200];
+    int8_t vals[10] = {1, -2, 3, -4, 5, -6, 7, -8, 9, -10};
+    sc_dlink_header h;
+    const uint8_t *pl;
+    const sc_dlink_begin b = {.depth_mm = 40.0f, .width_mm = 60.0f, .radius_mm = 40.0f};
+    int n = sc_dlink_encode_begin(buf, sizeof buf, &k_frame, &b);
+    assert_int_equal(sc_dlink_asm_push(&a, buf, (size_t)n), 0);
+    for (uint16_t l = 0; l < k_frame.line_count; l++) {
+        fill_line(samples, 200u, l);
+        n = sc_dlink_encode_line(buf, sizeof buf, &k_frame, l, samples, 200u);
+        assert_int_equal(sc_dlink_asm_push(&a, buf, (size_t)n), 0);
+        n = sc_dlink_encode_colour(buf, sizeof buf, &k_frame, l, 20u, vals, 10u);
+        assert_int_equal(sc_dlink_decode_as(buf, (size_t)n, 2u, &h, &pl), SC_ERR_DLINK_VERSION);
+        assert_int_equal(sc_dlink_asm_push(&a, buf, (size_t)n), SC_ERR_DLINK_VERSION);
+    }
+    const sc_dlink_doppler d = sample_doppler();
+    n = sc_dlink_encode_doppler(buf, sizeof buf, &k_frame, &d);
+    assert_int_equal(sc_dlink_asm_push(&a, buf, (size_t)n), SC_ERR_DLINK_VERSION);
+    assert_string_equal(sc_err_str(SC_ERR_DLINK_VERSION), "display link version unsupported");
+    const sc_dlink_end e = {128u, 0u, 500u, 20u};
+    n = sc_dlink_encode_end(buf, sizeof buf, &k_frame, &e);
+    assert_int_equal(sc_dlink_asm_push(&a, buf, (size_t)n), 1);
+    const sc_dlink_done *done = sc_dlink_asm_done(&a);
+    assert_non_null(done);
+    assert_int_equal(done->lines_lost, 0u); /* the B-scan is whole */
+    assert_null(done->colour);
+    assert_int_equal(done->doppler_seen, 0u);
+    assert_int_equal(a.stats.rej_version, 129u);
+    assert_int_equal(a.stats.rejected, 129u);
+    assert_int_equal(a.stats.colour_lines, 0u);
+}
+
+static void a_version_3_receiver_assembles_colour_with_its_frame(void **state)
+{
+    (void)state;
+    static sc_dlink_asm a;
+    sc_dlink_asm_init(&a);
+    uint8_t buf[SC_DLINK_MAX_PACKET];
+    uint8_t samples[200];
+    int8_t vals[10] = {1, -2, 3, -4, 5, -6, 7, -8, 9, -10};
+    for (uint32_t fr = 0; fr < 2u; fr++) {
+        sc_dlink_frame f = k_frame;
+        f.frame_no += fr;
+        const sc_dlink_begin b = {.depth_mm = 40.0f, .width_mm = 60.0f, .radius_mm = 40.0f};
+        int n = sc_dlink_encode_begin(buf, sizeof buf, &f, &b);
+        assert_int_equal(sc_dlink_asm_push(&a, buf, (size_t)n), 0);
+        for (uint16_t l = 0; l < f.line_count; l++) {
+            fill_line(samples, 200u, l);
+            n = sc_dlink_encode_line(buf, sizeof buf, &f, l, samples, 200u);
+            assert_int_equal(sc_dlink_asm_push(&a, buf, (size_t)n), 0);
+            if (fr == 0u && l == 7u) { /* colour in the first frame only */
+                n = sc_dlink_encode_colour(buf, sizeof buf, &f, l, 20u, vals, 10u);
+                assert_int_equal(sc_dlink_asm_push(&a, buf, (size_t)n), 0);
+            }
+        }
+        if (fr == 0u) {
+            const sc_dlink_doppler d = sample_doppler();
+            n = sc_dlink_encode_doppler(buf, sizeof buf, &f, &d);
+            assert_int_equal(sc_dlink_asm_push(&a, buf, (size_t)n), 0);
+        }
+        const sc_dlink_end e = {128u, 0u, 500u, 20u};
+        n = sc_dlink_encode_end(buf, sizeof buf, &f, &e);
+        assert_int_equal(sc_dlink_asm_push(&a, buf, (size_t)n), 1);
+        const sc_dlink_done *done = sc_dlink_asm_done(&a);
+        if (fr == 0u) {
+            assert_non_null(done->colour);
+            assert_memory_equal(done->colour + 7u * SC_MAX_SCAN_SAMPLES + 20u, vals, 10u);
+            assert_int_equal(done->colour[7u * SC_MAX_SCAN_SAMPLES + 19u], 0);
+            assert_int_equal(done->doppler_seen, 1u);
+            assert_int_equal(done->doppler.spectrum[10], 20u);
+        } else {
+            assert_null(done->colour); /* colour does not linger into a frame without it */
+            assert_int_equal(done->doppler_seen, 0u);
+        }
+    }
+    assert_int_equal(a.stats.rejected, 0u);
+    assert_int_equal(a.stats.colour_lines, 1u);
+    assert_int_equal(a.stats.doppler_records, 1u);
+}
+
+static void corrupt_colour_packets_are_refused_by_reason(void **state)
+{
+    (void)state;
+    uint8_t buf[SC_DLINK_MAX_PACKET];
+    int8_t vals[10] = {0};
+    sc_dlink_header h;
+    const uint8_t *pl;
+    int n = sc_dlink_encode_colour(buf, sizeof buf, &k_frame, 3u, 20u, vals, 10u);
+    /* a colour type under version 2 does not exist */
+    buf[4] = (uint8_t)SC_DLINK_VERSION;
+    refresh_crc(buf, (size_t)n);
+    assert_int_equal(sc_dlink_decode(buf, (size_t)n, &h, &pl), SC_ERR_DLINK_TYPE);
+    /* count beyond the payload */
+    n = sc_dlink_encode_colour(buf, sizeof buf, &k_frame, 3u, 20u, vals, 10u);
+    buf[SC_DLINK_HEADER_SIZE + 2] = 11u;
+    refresh_crc(buf, (size_t)n);
+    assert_int_equal(sc_dlink_decode(buf, (size_t)n, &h, &pl), SC_ERR_DLINK_LENGTH);
+    /* first + count past the line */
+    n = sc_dlink_encode_colour(buf, sizeof buf, &k_frame, 3u, 20u, vals, 10u);
+    buf[SC_DLINK_HEADER_SIZE + 0] = 195u;
+    refresh_crc(buf, (size_t)n);
+    assert_int_equal(sc_dlink_decode(buf, (size_t)n, &h, &pl), SC_ERR_DLINK_FIELD);
+    /* a doppler record with a negative scale */
+    sc_dlink_doppler d = sample_doppler();
+    n = sc_dlink_encode_doppler(buf, sizeof buf, &k_frame, &d);
+    const float neg = -1.0f;
+    memcpy(buf + SC_DLINK_HEADER_SIZE + 8, &neg, 4u);
+    refresh_crc(buf, (size_t)n);
+    assert_int_equal(sc_dlink_decode(buf, (size_t)n, &h, &pl), SC_ERR_DLINK_FIELD);
+    /* more bins than the limit */
+    n = sc_dlink_encode_doppler(buf, sizeof buf, &k_frame, &d);
+    buf[SC_DLINK_HEADER_SIZE + 26] = 129u;
+    refresh_crc(buf, (size_t)n);
+    assert_int_equal(sc_dlink_decode(buf, (size_t)n, &h, &pl), SC_ERR_DLINK_LENGTH);
+    /* any flipped byte: the CRC */
+    n = sc_dlink_encode_doppler(buf, sizeof buf, &k_frame, &d);
+    buf[SC_DLINK_HEADER_SIZE + 40] ^= 0x10u;
+    assert_int_equal(sc_dlink_decode(buf, (size_t)n, &h, &pl), SC_ERR_DLINK_CRC);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -570,6 +765,10 @@ int main(void)
         cmocka_unit_test(late_duplicate_and_missing_markers_are_counted),
         cmocka_unit_test(frame_numbers_wrap_and_a_restarted_sender_resynchronises),
         cmocka_unit_test(rejected_packets_are_counted_by_reason_and_change_nothing),
+        cmocka_unit_test(colour_packets_round_trip_as_version_3),
+        cmocka_unit_test(a_version_2_receiver_refuses_colour_packets_by_name_and_keeps_the_b_scan),
+        cmocka_unit_test(a_version_3_receiver_assembles_colour_with_its_frame),
+        cmocka_unit_test(corrupt_colour_packets_are_refused_by_reason),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -526,6 +526,62 @@ static void batch_above_the_limit_is_refused(void **state)
     sc_udp_display_close(&u);
 }
 
+/* Colour Doppler over UDP: the colour lines and the frame's Doppler record arrive with their
+ * frame (display link version 3) and the B-mode lines are counted as before. */
+static void colour_lines_and_the_doppler_record_arrive_with_their_frame(void **state)
+{
+    (void)state;
+    uint16_t port;
+    int rx = open_rx(&port, 4 * 1024 * 1024);
+    sc_udp_display u;
+    sc_udp_display_def def = sc_udp_display_default_def();
+    def.port = port;
+    assert_int_equal(sc_udp_display_open(&u, &def), 0);
+    sc_display_dev dev = sc_udp_display_dev(&u);
+    sc_dlink_asm_init(&g_rx);
+    const sc_display_frame_info info = {3u, 64u, 128u, 0u, 1u, 40.0f, 38.0f, 0.0f};
+    uint8_t s[128];
+    int8_t c[100];
+    uint8_t spec[128];
+    for (int k = 0; k < 100; k++) {
+        c[k] = (int8_t)(k - 50);
+    }
+    for (int k = 0; k < 128; k++) {
+        spec[k] = (uint8_t)(2 * k);
+    }
+    assert_int_equal(sc_display_frame_begin(&dev, &info), 0);
+    for (uint16_t l = 0; l < 64u; l++) {
+        memset(s, l, sizeof s);
+        assert_int_equal(sc_display_line(&dev, 3u, l, s, 128u), 0);
+        if (l >= 10u && l < 50u) {
+            assert_int_equal(sc_display_colour_line(&dev, 3u, l, 20u, c, 100u), 0);
+        }
+    }
+    const sc_display_doppler_info di = {.frame_no = 3u, .box_line_lo = 10u, .box_line_hi = 50u,
+                                        .box_sample_lo = 20u, .box_sample_hi = 120u,
+                                        .nyquist_mm_s = 308.0f, .steer_deg = -20.0f,
+                                        .gate_velocity_mm_s = 250.0f, .gate_line = 30u,
+                                        .gate_sample_lo = 60u, .gate_sample_hi = 66u,
+                                        .spectrum_bins = 128u, .spectrum = spec};
+    assert_int_equal(sc_display_doppler(&dev, &di), 0);
+    assert_int_equal(sc_display_frame_end(&dev, SC_DISPLAY_END_PLAIN(3u)), 0);
+    assert_int_equal(drain(rx), 1u);
+    const sc_dlink_done *d = sc_dlink_asm_done(&g_rx);
+    assert_int_equal(d->lines_lost, 0u);
+    assert_non_null(d->colour);
+    assert_memory_equal(d->colour + 30u * SC_MAX_SCAN_SAMPLES + 20u, c, 100u);
+    assert_int_equal(d->colour[9u * SC_MAX_SCAN_SAMPLES + 50u], 0);
+    assert_int_equal(d->doppler_seen, 1u);
+    assert_int_equal(d->doppler.gate_line, 30u);
+    assert_memory_equal(d->doppler.spectrum, spec, 128u);
+    assert_int_equal(g_rx.stats.colour_lines, 40u);
+    assert_int_equal(g_rx.stats.rejected, 0u);
+    assert_int_equal(u.lines_sent, 64u); /* B-mode lines only */
+    assert_int_equal(u.protocol_errors, 0u);
+    sc_udp_display_close(&u);
+    close(rx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -539,6 +595,7 @@ int main(void)
         cmocka_unit_test(injected_losses_are_counted_exactly_by_the_receiver),
         cmocka_unit_test(full_socket_buffer_drops_and_counts_instead_of_blocking),
         cmocka_unit_test(calls_out_of_order_are_refused_and_counted),
+        cmocka_unit_test(colour_lines_and_the_doppler_record_arrive_with_their_frame),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -9,7 +9,11 @@
  *                                                        silence implausible
  *                  [--silence-ms 300]
  *                  [--command KIND=VALUE[@T_S]]... [--auth-key bench|HEX32] [--sender 0..3]
+ *                  [--needle X,Y,Z:DX,DY,DZ[:DEPTH_MM[:SPEED_MM_S]]]
  *                  (--iface vcan0 | --udp HOST:PORT | --log FILE|- [--log-iface vcan0] [--t0 ...])
+ * --needle adds the tracked needle (frames 0x120..0x122, its own E2E counter) at the probe's
+ * rate: from its skin entry point X,Y,Z along DX,DY,DZ (tracker frame) in to DEPTH_MM (25) at
+ * SPEED_MM_S (10) from 0.5 s, held 1 s, out again, repeated (platform/trkemu sc_emu_needle).
  * Commands (the console's messages, docs/can-protocol.md) are authenticated: a freshness sync
  * before the first, then each command and its cryptographic PDU, signed with Mbed TLS's
  * AES-CMAC (sc_cmdsign.h) under the given key (default: the bench key). KIND=VALUE:
@@ -51,6 +55,7 @@ static void usage(void)
             "       [--hover-mm MM] [--length-mm MM] [--period-s S] [--angle-deg DEG]\n"
             "       [--no-force] [--fault KIND[:PERIOD[:START_S]]]... [--silence-ms MS]\n"
             "       [--command KIND=VALUE[@T_S]]... [--auth-key bench|HEX32] [--sender 0..3]\n"
+            "       [--needle X,Y,Z:DX,DY,DZ[:DEPTH_MM[:SPEED_MM_S]]]\n"
             "       (--iface IFNAME | --udp HOST:PORT | --log FILE|- [--log-iface IFNAME]\n"
             "        [--t0 SECONDS])   (--udp: CAN over UDP to sc-hostsim --live --can-udp)\n"
             "faults: bad-crc counter-jump repeat silence implausible\n"
@@ -206,6 +211,8 @@ typedef struct emu_cli {
     uint32_t n_cmds;
     uint8_t auth_key[16];
     unsigned long sender;
+    int have_needle;
+    sc_emu_needle_def needle;
 } emu_cli;
 
 static void sleep_until(const struct timespec *t0, uint64_t t_ns)
@@ -253,6 +260,7 @@ static int parse_cli(int argc, char **argv, emu_cli *a)
         {"command", required_argument, 0, 'C'},
         {"auth-key", required_argument, 0, 'K'},
         {"sender", required_argument, 0, 'N'},
+        {"needle", required_argument, 0, 'E'},
         {"help", no_argument, 0, 'h'},
         {0, 0, 0, 0},
     };
@@ -343,6 +351,20 @@ static int parse_cli(int argc, char **argv, emu_cli *a)
         case 'N':
             bad = parse_uint(optarg, 0u, SC_SECOC_SENDERS - 1u, &a->sender) != 0;
             break;
+        case 'E': {
+            sc_emu_needle_def nd = sc_emu_needle_default_def();
+            double depth = nd.max_depth_mm, speed = nd.speed_mm_s;
+            const int k = sscanf(optarg, "%f,%f,%f:%f,%f,%f:%lf:%lf", &nd.entry_mm[0],
+                                 &nd.entry_mm[1], &nd.entry_mm[2], &nd.dir[0], &nd.dir[1],
+                                 &nd.dir[2], &depth, &speed);
+            nd.max_depth_mm = (float)depth;
+            nd.speed_mm_s = (float)speed;
+            sc_emu_needle probe_def;
+            bad = k < 6 || sc_emu_needle_init(&probe_def, &nd) != 0;
+            a->needle = nd;
+            a->have_needle = !bad;
+            break;
+        }
         case 'h':
             usage();
             return 0;
@@ -442,7 +464,15 @@ int main(int argc, char **argv)
     clock_gettime(CLOCK_MONOTONIC, &start);
     const uint64_t t0_us = (uint64_t)llround(t0_s * 1e6);
     uint64_t tx_failed = 0;
-    sc_can_frame fr[SC_EMU_MAX_FRAMES + 4u];
+    sc_can_frame fr[SC_EMU_MAX_FRAMES + 4u + 3u];
+    sc_emu_needle needle;
+    if (a.have_needle) {
+        a.needle.rate_hz = a.def.rate_hz; /* one needle sample per probe sample */
+        if (sc_emu_needle_init(&needle, &a.needle) != 0) {
+            fprintf(stderr, "sc-tracker-emu: bad --needle for this rate\n");
+            return 2;
+        }
+    }
     uint64_t t_ns;
     int n;
     /* commands in time order (stable: equal times keep their command-line order) */
@@ -482,6 +512,16 @@ int main(int argc, char **argv)
             n += extra;
             next_cmd++;
             cmds_sent++;
+        }
+        if (a.have_needle) {
+            uint64_t tn;
+            const int k = sc_emu_needle_next(&needle, &fr[n], 3u, &tn);
+            if (k > 0) {
+                for (int j = 0; j < k; j++) {
+                    fr[n + j].ts_ns = t_ns;
+                }
+                n += k;
+            }
         }
         for (int k = 0; k < n; k++) {
             if (iface) {

@@ -41,6 +41,7 @@
 #include "sc_scan_overlay.h"
 #include "vw_cine.h"
 #include "sc_scanconv.h"
+#include "sc_doppler.h"
 #include "vw_gif.h"
 #include "vw_overlay.h"
 
@@ -259,7 +260,13 @@ typedef struct vw_render {
     uint8_t *rgb;   /* w*h*3 */
     uint8_t palette[768];
     uint32_t w, h;
+    /* pulsed-wave Doppler: the last VW_SPEC_COLS spectrum columns, scrolling */
+    uint8_t spec[256][SC_DLINK_SPECTRUM_MAX];
+    uint32_t spec_n, spec_head;
+    uint16_t spec_bins;
 } vw_render;
+
+#define VW_SPEC_COLS 256u
 
 static int render_init(vw_render *r, uint32_t w, uint32_t h)
 {
@@ -279,6 +286,51 @@ static void render_free(vw_render *r)
     free(r->grey);
     free(r->index);
     free(r->rgb);
+}
+
+/* Colour Doppler (display link version 3) over the RGB raster: the colour plane through the
+ * scan converter's table (scanner map: red toward the probe, blue away), and the pulsed-wave
+ * spectrum as a scrolling strip at the bottom right (velocity up = toward, zero line marked). */
+static void render_doppler(vw_render *r, const sc_dlink_done *d)
+{
+    if (d->colour != NULL) {
+        const size_t n = (size_t)r->w * r->h;
+        for (size_t i = 0; i < n; i++) {
+            const uint32_t v = r->conv.lut[i];
+            if (v != UINT32_MAX && d->colour[v] != 0) {
+                sc_doppler_colour_rgb(d->colour[v], r->rgb + 3u * i);
+            }
+        }
+    }
+    if (!d->doppler_seen || d->doppler.bins == 0u) {
+        return;
+    }
+    r->spec_bins = d->doppler.bins;
+    memcpy(r->spec[r->spec_head], d->doppler.spectrum, d->doppler.bins);
+    r->spec_head = (r->spec_head + 1u) % VW_SPEC_COLS;
+    r->spec_n = r->spec_n < VW_SPEC_COLS ? r->spec_n + 1u : VW_SPEC_COLS;
+    const uint32_t sh = r->spec_bins / 2u; /* two bins per row */
+    const uint32_t sw = r->w < VW_SPEC_COLS ? r->w : VW_SPEC_COLS;
+    if (r->h < sh + 4u) {
+        return;
+    }
+    const uint32_t y0 = r->h - sh - 2u, x0 = r->w - sw;
+    for (uint32_t c = 0; c < sw; c++) {
+        /* newest column at the right */
+        const uint32_t age = sw - 1u - c;
+        const uint8_t *col =
+            age < r->spec_n ? r->spec[(r->spec_head + VW_SPEC_COLS - 1u - age) % VW_SPEC_COLS]
+                            : NULL;
+        for (uint32_t y = 0; y < sh; y++) {
+            const uint32_t bin = r->spec_bins - 1u - 2u * y; /* top: fastest toward */
+            uint8_t g = col ? (uint8_t)(col[bin] > col[bin - 1u] ? col[bin] : col[bin - 1u]) : 0u;
+            if (y == sh / 2u) {
+                g = 128u; /* the zero-velocity line */
+            }
+            uint8_t *px = r->rgb + 3u * ((size_t)(y0 + y) * r->w + x0 + c);
+            px[0] = px[1] = px[2] = g;
+        }
+    }
 }
 
 static void render_frame(vw_render *r, const sc_dlink_done *d, double fps, uint64_t lost_total)
@@ -339,6 +391,7 @@ static void render_frame(vw_render *r, const sc_dlink_done *d, double fps, uint6
     for (size_t i = 0; i < n; i++) {
         memcpy(r->rgb + 3u * i, r->palette + 3u * r->index[i], 3u);
     }
+    render_doppler(r, d);
 }
 
 /* ---- freeze, cine loop, calipers (window only) ------------------------------------------- */

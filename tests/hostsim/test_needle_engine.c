@@ -1,0 +1,182 @@
+/* test_needle_engine.c: the tracked needle through the whole engine on the host simulator: the
+ * tracker emulator's needle frames on the simulated bus, the engine's receiver, the needle in
+ * the image, and the puncture reports that leave on CAN (NeedleStatus, 0x220): a vein entered
+ * twice is reported twice, each entry once, and no artery. Deterministic (virtual clock). */
+#include "sc_test.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sc_canproto.h"
+#include "sc_err.h"
+#include "sc_hs_rig.h"
+#include "sc_hs_storage.h"
+#include "sc_test_case.h"
+#include "sc_trkemu.h"
+
+static sc_test_case block;
+static sc_hs_rig rig;
+static sc_emu emu;
+static sc_emu_needle needle;
+
+static int group_setup(void **state)
+{
+    (void)state;
+    return sc_test_case_make(&block, 12, 6, 8, SC_LABEL_VEIN, "block") == SC_OK ? 0 : -1;
+}
+
+static int group_teardown(void **state)
+{
+    (void)state;
+    free(block.bytes);
+    return 0;
+}
+
+typedef struct needle_seen {
+    uint32_t status_frames;
+    sc_needle_status_msg last;
+    uint32_t max_drawn;
+    uint32_t max_tip_contacts; /* tissue nodes the tip pushed */
+    float max_moved_mm;        /* largest node displacement seen (the probe only hovers) */
+} needle_seen;
+
+/* n frames; probe and needle samples due before each frame go on the bus, the engine's
+ * NeedleStatus frames are read back by the peer */
+static uint64_t t0, probe_next, needle_next; /* emulator time 0 on the rig's clock, next samples */
+
+static void run(uint32_t n, needle_seen *seen)
+{
+    sc_can_frame f[SC_EMU_MAX_FRAMES];
+    for (uint32_t i = 0; i < n; i++) {
+        const uint64_t release = sc_engine_next_release_ns(&rig.engine);
+        while (t0 + probe_next <= release) {
+            uint64_t t;
+            const int k = sc_emu_next(&emu, f, SC_EMU_MAX_FRAMES, &t);
+            assert_true(k >= 0);
+            for (int j = 0; j < k; j++) {
+                (void)sc_can_send(&rig.peer, &f[j]);
+            }
+            probe_next = t + (uint64_t)(1e9 / emu.def.rate_hz);
+        }
+        while (t0 + needle_next <= release) {
+            uint64_t t;
+            assert_int_equal(sc_emu_needle_next(&needle, f, 3u, &t), 3);
+            for (int j = 0; j < 3; j++) {
+                (void)sc_can_send(&rig.peer, &f[j]);
+            }
+            needle_next = t + (uint64_t)(1e9 / needle.def.rate_hz);
+        }
+        sc_engine_step(&rig.engine, NULL);
+        const sc_needle_status *ns = sc_engine_get_needle_status(&rig.engine);
+        if (getenv("NEEDLE_TRACE") && i % 10u == 0u) {
+            print_message("t %.2f present %u tip %u (deformed %u) depth %.1f rej %u\n",
+                          (double)(rig.clock.now_ns - t0) * 1e-9, ns->present, ns->tip_label,
+                          ns->tip_label_deformed, (double)rig.engine.needle.depth_mm,
+                          rig.engine.needle_rx.rejected);
+        }
+        seen->max_drawn = ns->drawn_pixels > seen->max_drawn ? ns->drawn_pixels : seen->max_drawn;
+        const uint32_t tc = rig.engine.tissue[rig.engine.active].tip_contacts;
+        seen->max_tip_contacts = tc > seen->max_tip_contacts ? tc : seen->max_tip_contacts;
+        if (tc > 0u) {
+            const sc_tissue *tt = &rig.engine.tissue[rig.engine.active];
+            for (uint32_t k = 0; k < tt->mesh.node_count; k++) {
+                const float ux = tt->nodes.x[k] - tt->mesh.rest_x[k];
+                const float uy = tt->nodes.y[k] - tt->mesh.rest_y[k];
+                const float uz = tt->nodes.z[k] - tt->mesh.rest_z[k];
+                seen->max_moved_mm = fmaxf(seen->max_moved_mm, sqrtf(ux * ux + uy * uy + uz * uz));
+            }
+        }
+        sc_can_frame r;
+        while (sc_can_recv(&rig.peer, &r) == SC_OK) {
+            if (r.id == SC_CANID_NEEDLE_STATUS) {
+                assert_int_equal(sc_canproto_decode_needle_status(&r, &seen->last), SC_OK);
+                assert_int_equal(sc_e2e_crc(SC_CANID_NEEDLE_STATUS, r.data, r.len), r.data[0]);
+                seen->status_frames++;
+            }
+        }
+    }
+}
+
+static void a_needle_into_the_vein_is_reported_once_per_entry_on_can(void **state)
+{
+    (void)state;
+    sc_engine_def def = sc_test_engine_def();
+    def.tissue.collider = sc_test_scene_collider(&block.scene);
+    def.case_names[0] = "block";
+    def.case_count = 1;
+    assert_int_equal(sc_hs_rig_init(&rig, &def, 7, 0), SC_OK);
+    assert_int_equal(sc_hs_storage_add(&rig.storage, "block", block.bytes, block.size), SC_OK);
+    assert_int_equal(sc_engine_load_case(&rig.engine, "block"), SC_OK);
+    /* the probe rests lightly over the block's middle (its plane holds both vessels) */
+    sc_emu_def pd = sc_emu_default_def();
+    pd.script = SC_EMU_PRESS;
+    memcpy(pd.point_mm, block.centre_tracker_mm, sizeof pd.point_mm);
+    pd.hover_mm = 2.0f;
+    pd.depth_mm = 1.0f;
+    pd.duration_s = 10.0;
+    assert_int_equal(sc_emu_init(&emu, &pd), SC_OK);
+    /* the needle in the image plane, from 8 mm beside the vein toward its axis (8 mm across,
+     * 10 mm down; tracker frame: (x, -y, -z) of the volume), 14 mm deep at most */
+    sc_emu_needle_def nd = sc_emu_needle_default_def();
+    nd.entry_mm[0] = block.vein_tracker_mm[0] - 8.0f;
+    nd.entry_mm[1] = block.vein_tracker_mm[1];
+    nd.entry_mm[2] = 0.0f;
+    nd.dir[0] = 8.0f;
+    nd.dir[1] = 0.0f;
+    nd.dir[2] = -10.0f;
+    nd.speed_mm_s = 10.0f;
+    nd.max_depth_mm = 14.0f;
+    nd.hold_s = 1.0;
+    assert_int_equal(sc_emu_needle_init(&needle, &nd), SC_OK);
+    t0 = rig.clock.now_ns;
+    probe_next = needle_next = 0u;
+    needle_seen seen = {0};
+    run(180, &seen); /* 3 s: in (the wall at about 1.5 s), held */
+    print_message("after 3 s: %u status frames, vein %u artery %u last %u tip %u, drawn %u px\n",
+                  seen.status_frames, seen.last.vein_punctures, seen.last.artery_punctures,
+                  seen.last.last_puncture, seen.last.tip_vessel, seen.max_drawn);
+    assert_true(seen.status_frames >= 25u);
+    assert_int_equal(seen.last.vein_punctures, 1u);
+    assert_int_equal(seen.last.artery_punctures, 0u);
+    assert_int_equal(seen.last.last_puncture, SC_LABEL_VEIN);
+    assert_int_equal(seen.last.tip_vessel, SC_LABEL_VEIN);
+    assert_int_equal(seen.last.needle_tracked, 1u);
+    assert_int_equal(seen.last.needle_rejected, 0u);
+    assert_true(seen.max_drawn > 20u); /* the shaft is in the image */
+    /* the tip pushed tissue: nodes near it held on its sphere, moved from rest */
+    {
+        const sc_tissue *t = &rig.engine.tissue[rig.engine.active];
+        const float *tip = rig.engine.needle.tip_mm;
+        float moved = 0.0f;
+        for (uint32_t i = 0; i < t->mesh.node_count; i++) {
+            const float dx = t->nodes.x[i] - tip[0], dy = t->nodes.y[i] - tip[1],
+                        dz = t->nodes.z[i] - tip[2];
+            if (dx * dx + dy * dy + dz * dz < 3.0f * 3.0f) { /* the 2.2 mm tip sphere and beyond */
+                const float ux = t->nodes.x[i] - t->mesh.rest_x[i];
+                const float uy = t->nodes.y[i] - t->mesh.rest_y[i];
+                const float uz = t->nodes.z[i] - t->mesh.rest_z[i];
+                moved = fmaxf(moved, sqrtf(ux * ux + uy * uy + uz * uz));
+            }
+        }
+        print_message("tip contacts up to %u, nodes moved up to %.2f mm while pushed (%.2f mm "
+                      "near the held tip now)\n",
+                      seen.max_tip_contacts, (double)seen.max_moved_mm, (double)moved);
+        assert_true(seen.max_tip_contacts > 0u);
+        assert_true(seen.max_moved_mm > 0.1f); /* the probe hovers: only the tip moves them */
+    }
+    run(180, &seen); /* out (3.3 .. 4.7 s) and in again */
+    print_message("after 6 s: vein %u artery %u\n", seen.last.vein_punctures,
+                  seen.last.artery_punctures);
+    assert_int_equal(seen.last.vein_punctures, 2u);
+    assert_int_equal(seen.last.artery_punctures, 0u);
+    assert_int_equal(sc_engine_get_needle_status(&rig.engine)->vein_punctures, 2u);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(a_needle_into_the_vein_is_reported_once_per_entry_on_can),
+    };
+    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+}
