@@ -178,10 +178,12 @@ static void abuse(const char *case_name, sc_tissue_method m)
     sc_engine_status st;
     sc_engine_get_status(&rig.engine, &st);
     print_message("%s %s: %u frames in contact, largest displacement %.1f mm, tracker rejects "
-                  "%llu; 1 s after the lift %.3f mm from rest; resets %llu, faults 0x%04x\n",
+                  "%llu; 1 s after the lift %.3f mm from rest; resets %llu (last guard %u), "
+                  "faults 0x%04x\n",
                   case_name, m == SC_TISSUE_MSDS ? "msds" : "fem", contact, (double)max_disp,
                   (unsigned long long)sc_tracker_rejected_implausible(&rig.engine.tracker),
                   (double)dev, (unsigned long long)rig.engine.counters.phys_resets,
+                  (unsigned)rig.engine.tissue[rig.engine.active].stats.last_fault,
                   (unsigned)st.faults);
     assert_true(contact > 200u);
     assert_true(rig.engine.counters.phys_resets == 0u);

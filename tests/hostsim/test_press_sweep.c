@@ -13,6 +13,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "sc_engine.h"
@@ -40,6 +41,15 @@ typedef struct sweep_point {
     float depth_mm, vein, artery, thrombus;
 } sweep_point;
 
+/* the compression exam without pulse and breathing (the lumen pressures at their means) */
+static void drive_off(void)
+{
+    sc_lumen_drive d = sc_lumen_drive_default();
+    d.heart_rate_bpm = 0.0f;
+    d.resp_rate_bpm = 0.0f;
+    assert_int_equal(sc_tissue_set_drive(&rig.engine.tissue[rig.engine.active], &d), SC_OK);
+}
+
 static void rig_up(const char *case_file, sc_tissue_method m)
 {
     sc_engine_def def = sc_engine_default_def();
@@ -57,6 +67,7 @@ static void rig_up(const char *case_file, sc_tissue_method m)
     }
     assert_int_equal(rc, SC_OK);
     assert_int_equal(rig.engine.tissue[rig.engine.active].method, m);
+    drive_off();
 }
 
 /* Feed the emulator's samples due before the next frame, run it. */
@@ -117,6 +128,7 @@ static void remesh(uint32_t nx, uint32_t ny, uint32_t nz)
                                     (uint8_t)SC_LABEL_FAT),
                      SC_OK);
     assert_int_equal(sc_bscan_attach_mesh(&rig.engine.bscan, &rig.engine.tissue[rig.engine.active].mesh), SC_OK);
+    drive_off();
 }
 
 static void sweep_mesh(const char *case_name, sc_tissue_method m, uint32_t fine)
@@ -174,6 +186,15 @@ static void sweep_mesh(const char *case_name, sc_tissue_method m, uint32_t fine)
             assert_true(state_finite());
         }
         const sc_bscan_status *b = sc_bscan_status_get(&rig.engine.bscan);
+        if (getenv("SC_LUMEN_DEBUG") != NULL) {
+            const sc_lumen *lu = &rig.engine.tissue[rig.engine.active].lumen;
+            for (uint32_t k = 0; k < lu->count; k++) {
+                print_message("    vessel %u label %u tets %u theta %.3f V0 %.0f V %.0f p %.0f\n",
+                              k, lu->v[k].label, lu->v[k].tets, (double)lu->v[k].theta,
+                              (double)lu->v[k].v0_mm3, (double)lu->v[k].v_mm3,
+                              (double)lu->v[k].p_pa);
+            }
+        }
         pts[np++] = (sweep_point){s == 0u ? 0.0f : STEP_MM * (float)s, ratio(b, SC_LABEL_VEIN),
                                   ratio(b, SC_LABEL_ARTERY), ratio(b, SC_LABEL_THROMBUS)};
     }
