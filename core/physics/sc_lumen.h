@@ -36,7 +36,7 @@
  * Explicit alone would still overshoot where B exceeds the stiffness of the tissue around the
  * lumen (the lagged pressure of a frame pushes further than the tissue's answer to it), so the
  * applied pressure is a per-vessel state relaxed toward the law once per frame,
- *   p <- p + theta (g(s) + d(t) - p) if that rises, else p <- g(s) + d(t),  theta = 1 / (1 + B c),
+ *   p <- p + theta (g(s) - p) if that rises, else p <- g(s),   theta = 1 / (1 + B c),
  * with c = 2 (1 + nu) / E the volume compliance of a cylindrical hole in an infinite medium of
  * the softest material around the lumen (plane strain): an upper bound on the lumen's real
  * compliance (the box's fixed bottom, the probe's held nodes and the filler only stiffen it),
@@ -46,8 +46,10 @@
  * jumped away between two frames) must not stay over-pressured for 1 / theta frames (it blew
  * the lumen up past the guard's bound in the robustness test); from below the relaxed rise is
  * monotone again. The law is bounded: s is clamped to [-1, 1], and faces of inverted (crushed)
- * tets are not loaded. The drive d(t) goes through the same relaxation (a pulse's upstroke
- * lags by a few frames where theta is small; its period is exact).
+ * tets are not loaded. The drive d(t) is fed forward (applied pressure p + d(t), unrelaxed):
+ * through the relaxation a pulse was smoothed to 0.7% of the artery's area (theta 0.02 in the
+ * neck phantom); fed forward the wall sees it in the frame it is due and the law answers the
+ * volume change with its lag (3% area, 1.5% diameter peak to peak, test_vessel_drive).
  *
  * Time: the drive's phases advance by frame_s (real seconds per frame, sc_lumen_set_frame_s;
  * the physics' own simulated time per frame is a solver setting, not the clock), so the pulse
