@@ -180,8 +180,9 @@ static void sweep_mesh(const char *case_name, sc_tissue_method m, uint32_t fine)
                       (double)pts[i].vein, (double)pts[i].artery, (double)pts[i].thrombus);
     }
     print_message("  1 s after the lift: largest node distance from rest %.3f mm (2 s: %.3f mm); "
-                  "resets %llu, faults 0x%04x\n",
+                  "resets %llu (last guard %u), faults 0x%04x\n",
                   (double)dev, (double)dev2, (unsigned long long)rig.engine.counters.phys_resets,
+                  (unsigned)rig.engine.tissue[rig.engine.active].stats.last_fault,
                   (unsigned)st.faults);
     /* the compression exam at a firm press (16 mm): a normal vein coapts, the artery keeps
      * its area, a thrombosed vein does not collapse; every ratio falls with the press (within
@@ -223,7 +224,11 @@ static void fine_mesh_press_sweeps_have_no_fault_and_show_the_vessels(void **sta
 {
     (void)state;
     static const char *const cases[3] = {"neck-ijv", "femoral", "femoral-dvt"};
+    const char *only = getenv("SC_PRESS_CASE"); /* one case alone (diagnosis) */
     for (int c = 0; c < 3; c++) {
+        if (only != NULL && strcmp(only, cases[c]) != 0) {
+            continue;
+        }
         sweep_mesh(cases[c], SC_TISSUE_MSDS, 1u);
         sweep_mesh(cases[c], SC_TISSUE_FEM, 1u);
     }
