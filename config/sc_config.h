@@ -55,6 +55,11 @@
 #define SC_MAX_TETS (5u * (SC_MAX_MESH_NX - 1u) * (SC_MAX_MESH_NY - 1u) * (SC_MAX_MESH_NZ - 1u))
 #endif
 /* Physics iterations per frame and time step (paper section VI: 20 and 0.01 s). */
+/* Vessel lumens as pressure-volume chambers with a cardiac/respiratory drive
+ * (core/physics/sc_lumen.h; one byte per tet). 0: vessels are solid filler only. */
+#ifndef SC_PHYS_LUMEN
+#define SC_PHYS_LUMEN 1
+#endif
 #ifndef SC_PHYS_ITERATIONS_DEFAULT
 #define SC_PHYS_ITERATIONS_DEFAULT 20u
 #endif

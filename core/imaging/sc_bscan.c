@@ -199,8 +199,7 @@ typedef struct frame_ctx {
     float inv_sp[3];   /* 1 / spacing */
     uint32_t n;        /* samples per line */
     uint32_t margin_n; /* samples of the rest reference above the face */
-    uint32_t line;     /* current line */
-    /* current line, image frame */
+    /* current line: its index and, in the image frame, its origin and direction */
     uint32_t line;
     float ox, oz, dx, dz;
     /* current line, voxel-index units: rigid position of sample k is f0 + k * fd */

@@ -214,6 +214,7 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
         (void)k;
     }
     memset(&g->stats, 0, sizeof g->stats);
+    g->forces_vanish_at_rest = 0u;
 
     /* every row is zero outside the mesh's nodes: the loops read and add there */
     const uint32_t used = SC_GRID_HEAD + g->node_end + SC_GRID_PAD;
@@ -346,8 +347,9 @@ void sc_grid_begin(sc_grid *g, const sc_mesh *m, const sc_nodes *n, float dt_s, 
      * the flags) */
     int loaded = 0;
     for (uint32_t i = 0; i < nn && !loaded; i++) {
-        loaded = (kinematic != NULL && kinematic[i] != 0u) || nonzero(n->fx[i]) ||
-                 nonzero(n->fy[i]) || nonzero(n->fz[i]);
+        loaded = (kinematic != NULL && kinematic[i] != 0u) ||
+                 (g->forces_vanish_at_rest == 0u &&
+                  (nonzero(n->fx[i]) || nonzero(n->fy[i]) || nonzero(n->fz[i])));
     }
     const float warm = beta_s / (beta_s + dt_s);
     const float pull = -1.0f / (beta_s + dt_s);

@@ -130,6 +130,10 @@ typedef struct sc_grid {
     uint8_t slot_tv[18][3][3];
     sc_grid_target target[SC_GRID_TARGETS];
     sc_grid_stats stats;
+    /* 1: the nodes' external forces of the next step are internal loads that vanish at rest
+     * (lumen pressures, sc_lumen.h): they do not keep the release warm start off (the owner
+     * sets it before sc_grid_begin; 0 after sc_grid_init) */
+    uint8_t forces_vanish_at_rest;
 
     /* ---- hot: matrix rows (node t at SC_GRID_HEAD + t) ---- */
     SC_ALIGN_HOT float d[6][SC_GRID_ROW];

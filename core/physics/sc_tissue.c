@@ -51,6 +51,9 @@ void sc_tissue_reset(sc_tissue *t)
         t->kinematic[i] = 0u;
     }
     t->stats.max_disp_mm = 0.0f;
+#if SC_PHYS_LUMEN
+    sc_lumen_reset(&t->lumen);
+#endif
 }
 
 int sc_tissue_build_begin(sc_tissue *t, const sc_tissue_def *def, const sc_volume *vol,
@@ -114,6 +117,11 @@ int sc_tissue_build_step(sc_tissue *t)
         break;
     case SC_TISSUE_BUILD_LABELS:
         rc = sc_material_assign(&t->mesh, t->build_vol, &t->mat, t->build_label);
+#if SC_PHYS_LUMEN
+        if (rc == SC_OK) {
+            rc = sc_lumen_init(&t->lumen, &t->mesh, &t->mat);
+        }
+#endif
         break;
     case SC_TISSUE_BUILD_SPRINGS:
         rc = sc_springs_from_tets(&t->springs, (const uint32_t(*)[4])t->mesh.tet,
@@ -229,6 +237,8 @@ static void step_kinematic(sc_tissue *t, int implicit_msds)
 {
     sc_nodes *n = &t->nodes;
     const float dt_frame = t->msds.def.dt_s * (float)t->msds.def.iterations;
+    /* the only external forces on this path are the lumen pressures (contacts are kinematic) */
+    t->fem.grid.forces_vanish_at_rest = 1u;
     /* nodes in the probe or on its surface (within the hold tolerance: a node left exactly on
      * the surface by the last frame, or by the MSDS before a switch, must stay held, or the
      * tissue under it would push it into the probe for one frame) */
@@ -324,12 +334,18 @@ int sc_tissue_step(sc_tissue *t, const sc_pose *probe)
             t->nodes.x, t->nodes.y, t->nodes.z, t->mesh.node_fixed, &t->contacts);
     }
     t->stats.contacts = t->contacts.count;
+#if SC_PHYS_LUMEN
+    sc_lumen_apply(&t->lumen, &t->mesh, &t->nodes);
+#endif
     if (t->method == SC_TISSUE_MSDS && t->msds.def.integrator == (uint8_t)SC_MSDS_EXPLICIT) {
         t->stats.kinematic = 0u;
         step_msds(t);
     } else {
         step_kinematic(t, t->method == SC_TISSUE_MSDS);
     }
+#if SC_PHYS_LUMEN
+    sc_lumen_clear(&t->lumen, &t->mesh, &t->nodes);
+#endif
     uint32_t mpr = t->contacts.mpr_calls;
     if (t->def.skin_enabled) {
         sc_skin_step(&t->skin, &t->collider);
@@ -367,6 +383,30 @@ void sc_tissue_set_tip(sc_tissue *t, int active, const float tip_mm[3], float ra
     t->tip_radius_mm = radius_mm;
     t->tip_active = 1u;
 }
+
+#if SC_PHYS_LUMEN
+int sc_tissue_set_drive(sc_tissue *t, const sc_lumen_drive *d)
+{
+    if (t == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    return sc_lumen_set_drive(&t->lumen, d);
+}
+
+void sc_tissue_set_valsalva(sc_tissue *t, int on)
+{
+    SC_ASSERT(t != NULL);
+    sc_lumen_set_valsalva(&t->lumen, on);
+}
+
+int sc_tissue_set_frame_s(sc_tissue *t, float frame_s)
+{
+    if (t == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    return sc_lumen_set_frame_s(&t->lumen, frame_s);
+}
+#endif
 
 static uint64_t fnv(uint64_t h, const float *v, uint32_t count)
 {

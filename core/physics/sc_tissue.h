@@ -21,6 +21,9 @@
  *      (depth > -SC_TISSUE_CONTACT_HOLD_MM) are moved onto the surface as kinematic
  *      (Dirichlet) nodes (sc_fem_step_kinematic), so a static probe does not make a surface
  *      node chatter, and a node is released as soon as the probe moves away from it;
+ *   2b. the lumen pass (SC_PHYS_LUMEN, sc_lumen.h): every vessel's volume, its pressure from
+ *      the pressure-volume law and the cardiac/respiratory drive, as forces on the lumen's
+ *      boundary nodes (external forces of the step below, cleared after it);
  *   4. the skin MSDS (sc_skin.h) with the same collider;
  *   5. stability guard: any non-finite position or velocity, a node displaced by more than
  *      the box diagonal, or (explicit MSDS) kinetic energy above the energy of every spring stretched
@@ -47,6 +50,7 @@
 
 #include "sc_collider.h"
 #include "sc_fem.h"
+#include "sc_lumen.h"
 #include "sc_material.h"
 #include "sc_mesh.h"
 #include "sc_msds.h"
@@ -135,6 +139,9 @@ typedef struct sc_tissue {
     sc_collider collider;
     sc_contact_set contacts;
     sc_skin skin;
+#if SC_PHYS_LUMEN
+    sc_lumen lumen; /* vessel lumens: pressure-volume law and drive (sc_lumen.h) */
+#endif
     uint8_t kinematic[SC_MAX_NODES];
     float box_diag_mm;
     sc_tissue_stats stats;
@@ -202,5 +209,15 @@ uint64_t sc_tissue_state_hash(const sc_tissue *t);
  * contact, -1 (not available) for the explicit MSDS (it has no assembled K) or an unbuilt
  * tissue. O(contacts x 27) block reads, bounded by SC_MAX_CONTACTS. Never allocates. */
 float sc_tissue_probe_force_n(const sc_tissue *t, float out[3]);
+
+#if SC_PHYS_LUMEN
+/* The lumens' drive (heart rate, pulse pressure, waveform, respiration, Valsalva), see
+ * sc_lumen.h. Errors: SC_ERR_INVALID_ARG (NULL), sc_lumen_drive_validate's. O(1). */
+int sc_tissue_set_drive(sc_tissue *t, const sc_lumen_drive *d);
+/* Start (on != 0) or end a Valsalva manoeuvre: the veins distend. O(1). */
+void sc_tissue_set_valsalva(sc_tissue *t, int on);
+/* Real seconds per frame for the drive's clock (the engine's frame period). SC_ERR_RANGE. */
+int sc_tissue_set_frame_s(sc_tissue *t, float frame_s);
+#endif
 
 #endif /* SC_TISSUE_H */

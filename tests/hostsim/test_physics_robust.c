@@ -18,6 +18,7 @@
 #include "sc_err.h"
 #include "sc_health.h"
 #include "sc_hs_rig.h"
+#include "sc_test_press.h"
 #include "sc_labels.h"
 #include "sc_storage_linux.h"
 #include "sc_trkemu.h"
@@ -30,60 +31,22 @@ static sc_emu_row rows[MAX_ROWS];
 
 static void rig_up(const char *case_file, sc_tissue_method m)
 {
-    sc_engine_def def = sc_engine_default_def();
-    def.watchdog_timeout_ms = 0;
-    def.case_names[0] = case_file;
-    def.case_count = 1u;
-    def.tissue.method = m;
-    assert_int_equal(sc_hs_rig_init(&rig, &def, 1u, 0), SC_OK);
-    sc_storage_linux_init(&storage, SC_BINARY_DIR "/cases");
-    rig.hal.storage = sc_storage_linux_dev(&storage);
-    const int rc = sc_engine_load_case(&rig.engine, case_file);
-    if (rc != SC_OK) {
-        print_message("case %s/cases/%s: %s (build the `cases` target)\n", SC_BINARY_DIR,
-                      case_file, sc_err_str(rc));
-    }
-    assert_int_equal(rc, SC_OK);
-    assert_int_equal(rig.engine.tissue[rig.engine.active].method, m);
-}
-
-static int send_peer(void *ctx, const sc_can_frame *f)
-{
-    return sc_can_send((const sc_can_dev *)ctx, f);
+    sc_test_press_rig_up(&rig, &storage, SC_BINARY_DIR "/cases", case_file, m);
 }
 
 static void frame(uint64_t t0, int *more)
 {
-    if (*more && sc_emu_feed(&emu, sc_engine_next_release_ns(&rig.engine) - t0, send_peer,
-                             &rig.peer) == SC_ERR_NOT_FOUND) {
-        *more = 0;
-    }
-    sc_engine_step(&rig.engine, NULL);
+    sc_test_press_frame(&rig, &emu, t0, more);
 }
 
 static int state_finite(void)
 {
-    const sc_nodes *n = &rig.engine.tissue[rig.engine.active].nodes;
-    for (uint32_t i = 0; i < rig.engine.tissue[rig.engine.active].mesh.node_count; i++) {
-        if (!isfinite(n->x[i]) || !isfinite(n->y[i]) || !isfinite(n->z[i]) ||
-            !isfinite(n->vx[i]) || !isfinite(n->vy[i]) || !isfinite(n->vz[i])) {
-            return 0;
-        }
-    }
-    return 1;
+    return sc_test_press_state_finite(&rig);
 }
 
 static float max_dev_from_rest_mm(void)
 {
-    const sc_tissue *t = &rig.engine.tissue[rig.engine.active];
-    float m = 0.0f;
-    for (uint32_t i = 0; i < t->mesh.node_count; i++) {
-        const float dx = t->nodes.x[i] - t->mesh.rest_x[i];
-        const float dy = t->nodes.y[i] - t->mesh.rest_y[i];
-        const float dz = t->nodes.z[i] - t->mesh.rest_z[i];
-        m = fmaxf(m, sqrtf(dx * dx + dy * dy + dz * dz));
-    }
-    return m;
+    return sc_test_press_max_dev_mm(&rig);
 }
 
 static void quat_mul(const float a[4], const float b[4], float out[4])
@@ -178,10 +141,12 @@ static void abuse(const char *case_name, sc_tissue_method m)
     sc_engine_status st;
     sc_engine_get_status(&rig.engine, &st);
     print_message("%s %s: %u frames in contact, largest displacement %.1f mm, tracker rejects "
-                  "%llu; 1 s after the lift %.3f mm from rest; resets %llu, faults 0x%04x\n",
+                  "%llu; 1 s after the lift %.3f mm from rest; resets %llu (last guard %u), "
+                  "faults 0x%04x\n",
                   case_name, m == SC_TISSUE_MSDS ? "msds" : "fem", contact, (double)max_disp,
                   (unsigned long long)sc_tracker_rejected_implausible(&rig.engine.tracker),
                   (double)dev, (unsigned long long)rig.engine.counters.phys_resets,
+                  (unsigned)rig.engine.tissue[rig.engine.active].stats.last_fault,
                   (unsigned)st.faults);
     assert_true(contact > 200u);
     assert_true(rig.engine.counters.phys_resets == 0u);

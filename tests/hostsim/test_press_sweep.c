@@ -13,12 +13,14 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "sc_engine.h"
 #include "sc_health.h"
 #include "sc_err.h"
 #include "sc_hs_rig.h"
+#include "sc_test_press.h"
 #include "sc_labels.h"
 #include "sc_storage_linux.h"
 #include "sc_tissue.h"
@@ -40,63 +42,34 @@ typedef struct sweep_point {
     float depth_mm, vein, artery, thrombus;
 } sweep_point;
 
-static void rig_up(const char *case_file, sc_tissue_method m)
+/* the compression exam without pulse and breathing (the lumen pressures at their means) */
+static void drive_off(void)
 {
-    sc_engine_def def = sc_engine_default_def();
-    def.watchdog_timeout_ms = 0;
-    def.case_names[0] = case_file;
-    def.case_count = 1u;
-    def.tissue.method = m;
-    assert_int_equal(sc_hs_rig_init(&rig, &def, 1u, 0), SC_OK);
-    sc_storage_linux_init(&storage, SC_BINARY_DIR "/cases");
-    rig.hal.storage = sc_storage_linux_dev(&storage);
-    const int rc = sc_engine_load_case(&rig.engine, case_file);
-    if (rc != SC_OK) {
-        print_message("case %s/cases/%s: %s (build the `cases` target)\n", SC_BINARY_DIR, case_file,
-                      sc_err_str(rc));
-    }
-    assert_int_equal(rc, SC_OK);
-    assert_int_equal(rig.engine.tissue[rig.engine.active].method, m);
+    sc_lumen_drive d = sc_lumen_drive_default();
+    d.heart_rate_bpm = 0.0f;
+    d.resp_rate_bpm = 0.0f;
+    assert_int_equal(sc_tissue_set_drive(&rig.engine.tissue[rig.engine.active], &d), SC_OK);
 }
 
-/* Feed the emulator's samples due before the next frame, run it. */
-static int send_peer(void *ctx, const sc_can_frame *f)
+static void rig_up(const char *case_file, sc_tissue_method m)
 {
-    return sc_can_send((const sc_can_dev *)ctx, f);
+    sc_test_press_rig_up(&rig, &storage, SC_BINARY_DIR "/cases", case_file, m);
+    drive_off();
 }
 
 static void frame(uint64_t t0, int *more)
 {
-    if (*more && sc_emu_feed(&emu, sc_engine_next_release_ns(&rig.engine) - t0, send_peer,
-                             &rig.peer) == SC_ERR_NOT_FOUND) {
-        *more = 0;
-    }
-    sc_engine_step(&rig.engine, NULL);
+    sc_test_press_frame(&rig, &emu, t0, more);
 }
 
 static int state_finite(void)
 {
-    const sc_nodes *n = &rig.engine.tissue[rig.engine.active].nodes;
-    for (uint32_t i = 0; i < rig.engine.tissue[rig.engine.active].mesh.node_count; i++) {
-        if (!isfinite(n->x[i]) || !isfinite(n->y[i]) || !isfinite(n->z[i]) || !isfinite(n->vx[i]) ||
-            !isfinite(n->vy[i]) || !isfinite(n->vz[i])) {
-            return 0;
-        }
-    }
-    return 1;
+    return sc_test_press_state_finite(&rig);
 }
 
 static float max_dev_from_rest_mm(void)
 {
-    const sc_tissue *t = &rig.engine.tissue[rig.engine.active];
-    float m = 0.0f;
-    for (uint32_t i = 0; i < t->mesh.node_count; i++) {
-        const float dx = t->nodes.x[i] - t->mesh.rest_x[i];
-        const float dy = t->nodes.y[i] - t->mesh.rest_y[i];
-        const float dz = t->nodes.z[i] - t->mesh.rest_z[i];
-        m = fmaxf(m, sqrtf(dx * dx + dy * dy + dz * dz));
-    }
-    return m;
+    return sc_test_press_max_dev_mm(&rig);
 }
 
 static float ratio(const sc_bscan_status *b, uint32_t label)
@@ -117,6 +90,7 @@ static void remesh(uint32_t nx, uint32_t ny, uint32_t nz)
                                     (uint8_t)SC_LABEL_FAT),
                      SC_OK);
     assert_int_equal(sc_bscan_attach_mesh(&rig.engine.bscan, &rig.engine.tissue[rig.engine.active].mesh), SC_OK);
+    drive_off();
 }
 
 static void sweep_mesh(const char *case_name, sc_tissue_method m, uint32_t fine)
@@ -174,6 +148,15 @@ static void sweep_mesh(const char *case_name, sc_tissue_method m, uint32_t fine)
             assert_true(state_finite());
         }
         const sc_bscan_status *b = sc_bscan_status_get(&rig.engine.bscan);
+        if (getenv("SC_LUMEN_DEBUG") != NULL) {
+            const sc_lumen *lu = &rig.engine.tissue[rig.engine.active].lumen;
+            for (uint32_t k = 0; k < lu->count; k++) {
+                print_message("    vessel %u label %u tets %u theta %.3f V0 %.0f V %.0f p %.0f\n",
+                              k, lu->v[k].label, lu->v[k].tets, (double)lu->v[k].theta,
+                              (double)lu->v[k].v0_mm3, (double)lu->v[k].v_mm3,
+                              (double)lu->v[k].p_pa);
+            }
+        }
         pts[np++] = (sweep_point){s == 0u ? 0.0f : STEP_MM * (float)s, ratio(b, SC_LABEL_VEIN),
                                   ratio(b, SC_LABEL_ARTERY), ratio(b, SC_LABEL_THROMBUS)};
     }
@@ -197,8 +180,9 @@ static void sweep_mesh(const char *case_name, sc_tissue_method m, uint32_t fine)
                       (double)pts[i].vein, (double)pts[i].artery, (double)pts[i].thrombus);
     }
     print_message("  1 s after the lift: largest node distance from rest %.3f mm (2 s: %.3f mm); "
-                  "resets %llu, faults 0x%04x\n",
+                  "resets %llu (last guard %u), faults 0x%04x\n",
                   (double)dev, (double)dev2, (unsigned long long)rig.engine.counters.phys_resets,
+                  (unsigned)rig.engine.tissue[rig.engine.active].stats.last_fault,
                   (unsigned)st.faults);
     /* the compression exam at a firm press (16 mm): a normal vein coapts, the artery keeps
      * its area, a thrombosed vein does not collapse; every ratio falls with the press (within
@@ -240,7 +224,11 @@ static void fine_mesh_press_sweeps_have_no_fault_and_show_the_vessels(void **sta
 {
     (void)state;
     static const char *const cases[3] = {"neck-ijv", "femoral", "femoral-dvt"};
+    const char *only = getenv("SC_PRESS_CASE"); /* one case alone (diagnosis) */
     for (int c = 0; c < 3; c++) {
+        if (only != NULL && strcmp(only, cases[c]) != 0) {
+            continue;
+        }
         sweep_mesh(cases[c], SC_TISSUE_MSDS, 1u);
         sweep_mesh(cases[c], SC_TISSUE_FEM, 1u);
     }

@@ -558,6 +558,27 @@ static void rest_reference_counts_vessels_pushed_into_view(void **state)
     assert_true(g_b.status.area_ratio[SC_LABEL_VEIN] > ratio_margin);
 }
 
+/* The compression measure at depth (issue 12): with the probe face 28 mm deep the vein (8-16 mm
+ * deep at rest) lies 12-20 mm above the face; the default rest reference (60 mm) still counts
+ * it whole, where the former 15 mm reference cut it (and read a collapsed vein as half open). */
+static void rest_reference_counts_vessels_far_above_a_deep_face(void **state)
+{
+    (void)state;
+    build_mesh(32, 16, 16);
+    deform(SCN_DEFORM_DENT, 10.0f, 0);
+    const sc_xform probe = scn_probe(20.0f, 10.0f, 28.0f, 0.0f);
+    sc_bscan_def d = sc_bscan_default_def();
+    render(&d, &probe, 1, g_a);
+    print_message("face 28 mm deep: vein rest %.2f mm^2 (margin %.0f mm)\n",
+                  (double)g_b.status.area_rest_mm2[SC_LABEL_VEIN], (double)d.rest_margin_mm);
+    assert_true(fabsf(g_b.status.area_rest_mm2[SC_LABEL_VEIN] - 50.27f) < 2.5f);
+    d.rest_margin_mm = 15.0f;
+    render(&d, &probe, 1, g_a);
+    print_message("  with a 15 mm reference: %.2f mm^2\n",
+                  (double)g_b.status.area_rest_mm2[SC_LABEL_VEIN]);
+    assert_true(g_b.status.area_rest_mm2[SC_LABEL_VEIN] < 45.0f);
+}
+
 /* ---- determinism ------------------------------------------------------------------------- */
 
 /* Golden image: fixed scene, deformation and pose. A change of this value is a numerics
@@ -625,6 +646,7 @@ int main(void)
         cmocka_unit_test(lines_stream_in_order_between_begin_and_end_with_frame_number),
         cmocka_unit_test(squashed_vein_area_drops_while_artery_stays),
         cmocka_unit_test(rest_reference_counts_vessels_pushed_into_view),
+        cmocka_unit_test(rest_reference_counts_vessels_far_above_a_deep_face),
         cmocka_unit_test(golden_image_hash_is_stable),
         cmocka_unit_test(bad_arguments_are_refused),
     };

@@ -539,7 +539,8 @@ static void colour_lines_and_the_doppler_record_arrive_with_their_frame(void **s
     assert_int_equal(sc_udp_display_open(&u, &def), 0);
     sc_display_dev dev = sc_udp_display_dev(&u);
     sc_dlink_asm_init(&g_rx);
-    const sc_display_frame_info info = {3u, 64u, 128u, 0u, 1u, 40.0f, 38.0f, 0.0f};
+    const sc_display_frame_info info = {.frame_no = 3u, .lines = 64u, .samples = 128u, .geometry_id = 0u,
+                                        .flags = 1u, .depth_mm = 40.0f, .width_mm = 38.0f};
     uint8_t s[128];
     int8_t c[100];
     uint8_t spec[128];

@@ -65,7 +65,7 @@ static int kd_end(void *ctx, const sc_display_end_info *end)
     (void)end;
     return SC_OK;
 }
-static const sc_display_ops g_kd_ops = {kd_begin, kd_line, kd_end, NULL};
+static const sc_display_ops g_kd_ops = {kd_begin, kd_line, kd_end, NULL, NULL, NULL};
 static const sc_display_dev g_kd = {&g_kd_ops, NULL};
 
 static int send_peer(void *ctx, const sc_can_frame *f)

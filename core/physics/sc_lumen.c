@@ -1,0 +1,420 @@
+/* sc_lumen.c: vessel lumens as pressure-volume chambers; see sc_lumen.h. */
+#include "sc_lumen.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <string.h>
+
+#include "sc_err.h"
+#include "sc_labels.h"
+#include "sc_materials.h"
+
+/* a region smaller than this (voxel noise at a vessel's edge) stays solid filler */
+#define SC_LUMEN_MIN_TETS 4u
+/* a lumen below this fraction of its rest volume has its walls in contact */
+#define SC_LUMEN_CONTACT_RATIO 0.02f
+#define SC_LUMEN_TWO_PI 6.28318530718f
+
+void sc_lumen_laws_default(sc_lumen_law law[SC_MAX_LABELS])
+{
+    for (uint32_t i = 0; i < SC_MAX_LABELS; i++) {
+        law[i].kind = (uint8_t)SC_LUMEN_NONE;
+        law[i].hold_pa = 0.0f;
+        law[i].bulk_pa = 0.0f;
+    }
+#define SC_LUMEN_ROW_(lab_, kind_, h_, b_)                                                     \
+    law[(lab_)].kind = (uint8_t)(kind_);                                                       \
+    law[(lab_)].hold_pa = (h_);                                                                \
+    law[(lab_)].bulk_pa = (b_);
+    SC_LUMEN_LIST(SC_LUMEN_ROW_)
+#undef SC_LUMEN_ROW_
+}
+
+sc_lumen_drive sc_lumen_drive_default(void)
+{
+    sc_lumen_drive d;
+    memset(&d, 0, sizeof d);
+    d.heart_rate_bpm = SC_LUMEN_HEART_RATE_BPM;
+    d.pulse_pa = SC_LUMEN_PULSE_PA;
+    d.wave = (uint8_t)SC_LUMEN_WAVE_ARTERIAL;
+    d.resp_rate_bpm = SC_LUMEN_RESP_RATE_BPM;
+    d.resp_pa = SC_LUMEN_RESP_PA;
+    d.valsalva_pa = SC_LUMEN_VALSALVA_PA;
+    d.valsalva = 0u;
+    return d;
+}
+
+int sc_lumen_drive_validate(const sc_lumen_drive *d)
+{
+    if (d == NULL || d->wave > (uint8_t)SC_LUMEN_WAVE_SINE || d->valsalva > 1u) {
+        return SC_ERR_INVALID_ARG;
+    }
+    if (!isfinite(d->heart_rate_bpm) || !isfinite(d->pulse_pa) || !isfinite(d->resp_rate_bpm) ||
+        !isfinite(d->resp_pa) || !isfinite(d->valsalva_pa)) {
+        return SC_ERR_NOT_FINITE;
+    }
+    const int hr_ok = !(d->heart_rate_bpm > 0.0f) ||
+                      (d->heart_rate_bpm >= 20.0f && d->heart_rate_bpm <= 250.0f);
+    const int rr_ok = !(d->resp_rate_bpm > 0.0f) ||
+                      (d->resp_rate_bpm >= 4.0f && d->resp_rate_bpm <= 60.0f);
+    if (!hr_ok || !rr_ok || d->heart_rate_bpm < 0.0f || d->resp_rate_bpm < 0.0f || !(d->pulse_pa >= 0.0f && d->pulse_pa <= 20.0e3f) ||
+        !(d->resp_pa >= 0.0f && d->resp_pa <= 5.0e3f) ||
+        !(d->valsalva_pa >= 0.0f && d->valsalva_pa <= 10.0e3f)) {
+        return SC_ERR_RANGE;
+    }
+    return SC_OK;
+}
+
+/* normalised arterial waveform at phase ph in [0, 1): 0 at diastole, 1 at the systolic peak */
+static float wave_at(uint8_t wave, float ph)
+{
+    if (wave == (uint8_t)SC_LUMEN_WAVE_SINE) {
+        return 0.5f - 0.5f * cosf(SC_LUMEN_TWO_PI * ph);
+    }
+    const float rise = 0.15f, tau = 0.3f;
+    if (ph < rise) {
+        return 0.5f - 0.5f * cosf(3.14159265359f * ph / rise);
+    }
+    const float tail = expf(-(1.0f - rise) / tau);
+    const float run = (expf(-(ph - rise) / tau) - tail) / (1.0f - tail);
+    const float u = (ph - 0.42f) / 0.04f; /* dicrotic notch and wave after it */
+    return run + 0.08f * expf(-u * u) * (1.0f - ph);
+}
+
+static float wave_mean(uint8_t wave)
+{
+    float s = 0.0f;
+    for (uint32_t i = 0; i < 256u; i++) {
+        s += wave_at(wave, ((float)i + 0.5f) / 256.0f);
+    }
+    return s / 256.0f;
+}
+
+void sc_lumen_reset(sc_lumen *l)
+{
+    for (uint32_t k = 0; k < l->count; k++) {
+        l->v[k].p_pa = 0.0f;
+        l->v[k].drive_pa = 0.0f;
+        l->v[k].v_mm3 = l->v[k].v0_mm3;
+    }
+    l->heart_phase = 0.0f;
+    l->resp_phase = 0.0f;
+    l->faces = 0u;
+}
+
+/* the tet's face opposite vertex f: its three nodes */
+static void face_nodes(const uint32_t tet[4], uint32_t f, uint32_t out[3])
+{
+    uint32_t c = 0;
+    for (uint32_t i = 0; i < 4u; i++) {
+        if (i != f) {
+            out[c++] = tet[i];
+        }
+    }
+}
+
+/* one sweep of the flood fill of region id over the tets of label lab (dir 0 up, 1 down);
+ * returns the tets added */
+static uint32_t fill_sweep(sc_lumen *l, const sc_mesh *m, uint8_t lab, uint8_t id, int down)
+{
+    uint32_t added = 0;
+    const uint32_t nt = m->tet_count;
+    for (uint32_t s = 0; s < nt; s++) {
+        const uint32_t t = down ? nt - 1u - s : s;
+        if (l->region[t] != 0u || m->tet_label[t] != lab) {
+            continue;
+        }
+        for (uint32_t f = 0; f < 4u; f++) {
+            const int32_t nb = m->tet_nbr[t][f];
+            if (nb >= 0 && l->region[nb] == id) {
+                l->region[t] = id;
+                added++;
+                break;
+            }
+        }
+    }
+    return added;
+}
+
+int sc_lumen_init(sc_lumen *l, const sc_mesh *m, const sc_material_table *mat)
+{
+    if (l == NULL || m == NULL || mat == NULL || m->tet_count > SC_MAX_TETS) {
+        return SC_ERR_INVALID_ARG;
+    }
+    memset(l->v, 0, sizeof l->v);
+    l->count = 0u;
+    l->dropped = 0u;
+    sc_lumen_laws_default(l->law);
+    l->drive = sc_lumen_drive_default();
+    l->frame_s = 1.0f / (float)SC_FRAME_RATE_DEFAULT_HZ;
+    l->wave_mean = wave_mean(l->drive.wave);
+    l->enabled = 1u;
+    const uint32_t nt = m->tet_count;
+    for (uint32_t t = 0; t < nt; t++) {
+        if (m->tet_label[t] >= mat->count) {
+            return SC_ERR_INVALID_ARG;
+        }
+    }
+    memset(l->region, 0, nt);
+    /* regions: a seed, then sweeps up and down until nothing is added (a tube along any axis
+     * fills in a few sweeps); 0xFF marks a region that is not a vessel (too small, or past
+     * SC_LUMEN_MAX) while the fill runs */
+    for (uint32_t t = 0; t < nt; t++) {
+        const uint8_t lab = m->tet_label[t];
+        if (l->region[t] != 0u || l->law[lab].kind == (uint8_t)SC_LUMEN_NONE) {
+            continue;
+        }
+        const uint8_t id = l->count < SC_LUMEN_MAX ? (uint8_t)(l->count + 1u) : 0xFEu;
+        l->region[t] = id;
+        uint32_t size = 1u;
+        for (;;) {
+            const uint32_t a = fill_sweep(l, m, lab, id, 0) + fill_sweep(l, m, lab, id, 1);
+            size += a;
+            if (a == 0u) {
+                break;
+            }
+        }
+        if (id == 0xFEu || size < SC_LUMEN_MIN_TETS) {
+            l->dropped += id == 0xFEu ? 1u : 0u;
+            for (uint32_t u = t; u < nt; u++) {
+                l->region[u] = l->region[u] == id ? 0xFFu : l->region[u];
+            }
+            continue;
+        }
+        sc_lumen_vessel *v = &l->v[l->count++];
+        v->label = lab;
+        v->kind = l->law[lab].kind;
+        v->tets = size;
+        v->hold_pa = l->law[lab].hold_pa;
+        v->bulk_pa = l->law[lab].bulk_pa;
+    }
+    for (uint32_t t = 0; t < nt; t++) {
+        l->region[t] = l->region[t] >= 0xFEu ? 0u : l->region[t];
+    }
+    /* rest volumes and the softest material across each lumen's boundary */
+    float emin[SC_LUMEN_MAX], numin[SC_LUMEN_MAX];
+    for (uint32_t k = 0; k < SC_LUMEN_MAX; k++) {
+        emin[k] = INFINITY;
+        numin[k] = 0.0f;
+    }
+    for (uint32_t t = 0; t < nt; t++) {
+        const uint8_t r = l->region[t];
+        if (r == 0u) {
+            continue;
+        }
+        l->v[r - 1u].v0_mm3 += sc_mesh_tet_volume_mm3(m->rest_x, m->rest_y, m->rest_z, m->tet[t]);
+        for (uint32_t f = 0; f < 4u; f++) {
+            const int32_t nb = m->tet_nbr[t][f];
+            if (nb >= 0 && l->region[nb] != r) {
+                const sc_material *q = &mat->row[m->tet_label[nb]];
+                if (q->e_pa < emin[r - 1u]) {
+                    emin[r - 1u] = q->e_pa;
+                    numin[r - 1u] = q->poisson;
+                }
+            }
+        }
+    }
+    for (uint32_t k = 0; k < l->count; k++) {
+        sc_lumen_vessel *v = &l->v[k];
+        /* a lumen with no solid around it (the whole box) is bounded by its own law only */
+        const float c = isfinite(emin[k]) ? 2.0f * (1.0f + numin[k]) / emin[k] : 0.0f;
+        v->theta = 1.0f / (1.0f + v->bulk_pa * c);
+    }
+    sc_lumen_reset(l);
+    return SC_OK;
+}
+
+int sc_lumen_set_drive(sc_lumen *l, const sc_lumen_drive *d)
+{
+    if (l == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    const int rc = sc_lumen_drive_validate(d);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    l->drive = *d;
+    l->wave_mean = wave_mean(d->wave);
+    return SC_OK;
+}
+
+void sc_lumen_set_valsalva(sc_lumen *l, int on)
+{
+    l->drive.valsalva = on != 0 ? 1u : 0u;
+}
+
+int sc_lumen_set_frame_s(sc_lumen *l, float frame_s)
+{
+    if (l == NULL || !isfinite(frame_s) || frame_s < 1e-4f || frame_s > 1.0f) {
+        return SC_ERR_RANGE;
+    }
+    l->frame_s = frame_s;
+    return SC_OK;
+}
+
+float sc_lumen_drive_pa(const sc_lumen *l, uint8_t kind)
+{
+    const sc_lumen_drive *d = &l->drive;
+    if (kind == (uint8_t)SC_LUMEN_ARTERY) {
+        if (d->heart_rate_bpm <= 0.0f) {
+            return 0.0f;
+        }
+        return d->pulse_pa * (wave_at(d->wave, l->heart_phase) - l->wave_mean);
+    }
+    if (kind == (uint8_t)SC_LUMEN_VEIN) {
+        float p = d->valsalva != 0u ? d->valsalva_pa : 0.0f;
+        if (d->resp_rate_bpm > 0.0f) {
+            /* inspiration (first half of the breath) lowers the venous pressure */
+            p -= d->resp_pa * sinf(SC_LUMEN_TWO_PI * l->resp_phase);
+        }
+        return p;
+    }
+    return 0.0f;
+}
+
+static float advance(float phase, float rate_bpm, float dt_s)
+{
+    phase += rate_bpm * (1.0f / 60.0f) * dt_s;
+    phase -= floorf(phase);
+    return phase >= 0.0f && phase < 1.0f ? phase : 0.0f;
+}
+
+float sc_lumen_volume_mm3(const sc_lumen *l, const sc_mesh *m, const float *x, const float *y,
+                          const float *z, uint32_t k)
+{
+    float vol = 0.0f;
+    for (uint32_t t = 0; t < m->tet_count; t++) {
+        if (l->region[t] == k) {
+            vol += sc_mesh_tet_volume_mm3(x, y, z, m->tet[t]);
+        }
+    }
+    return vol;
+}
+
+/* the law g(s) of sc_lumen.h */
+static float law(const sc_lumen_vessel *v, float s)
+{
+    if (s >= 0.0f) {
+        /* walls in contact: below SC_LUMEN_CONTACT_RATIO of the rest volume the lumen pushes
+         * back again, with the law's own slope B (so theta bounds it too) */
+        const float c = s - (1.0f - SC_LUMEN_CONTACT_RATIO);
+        return v->hold_pa * tanhf(v->bulk_pa * s / v->hold_pa) + (c > 0.0f ? v->bulk_pa * c : 0.0f);
+    }
+    return v->bulk_pa * s;
+}
+
+void sc_lumen_apply(sc_lumen *l, const sc_mesh *m, sc_nodes *n)
+{
+    l->faces = 0u;
+    if (!l->enabled || l->count == 0u) {
+        return;
+    }
+    l->heart_phase = advance(l->heart_phase, l->drive.heart_rate_bpm, l->frame_s);
+    l->resp_phase = advance(l->resp_phase, l->drive.resp_rate_bpm, l->frame_s);
+    float vol[SC_LUMEN_MAX];
+    for (uint32_t k = 0; k < SC_LUMEN_MAX; k++) {
+        vol[k] = 0.0f;
+    }
+    const uint32_t nt = m->tet_count;
+    for (uint32_t t = 0; t < nt; t++) {
+        const uint8_t r = l->region[t];
+        if (r != 0u) {
+            vol[r - 1u] += sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[t]);
+        }
+    }
+    float press_nmm2[SC_LUMEN_MAX];
+    for (uint32_t k = 0; k < l->count; k++) {
+        sc_lumen_vessel *v = &l->v[k];
+        v->v_mm3 = vol[k];
+        const float s = (v->v0_mm3 - vol[k]) / v->v0_mm3;
+        v->drive_pa = sc_lumen_drive_pa(l, v->kind);
+        /* bounded: a lumen squeezed past empty (inverted tets) pushes back no harder than an
+         * empty one, a distension past double its volume pulls no harder than that */
+        const float sc = isfinite(s) ? fminf(fmaxf(s, -1.0f), 1.0f) : 0.0f;
+        const float g = law(v, sc);
+        /* up: relaxed (theta, stable against the tissue's answer); down: at once, so that a
+         * lumen let go (the probe lifted or jumped away) is never over-pressured (the relaxed
+         * fall took 1 / theta frames and blew the lumen up) */
+        v->p_pa = g < v->p_pa ? g : v->p_pa + v->theta * (g - v->p_pa);
+        /* Pa -> N/mm^2; a third of the face's area vector per node */
+        /* a lumen squeezed below half its volume carries less of the drive, none when empty
+         * (no flow through a crushed vessel; fed forward onto a crushed artery the pulse flung
+         * its filler's nodes past the guard's bound at the deepest press) */
+        const float open = sc <= 0.5f ? 1.0f : 2.0f * (1.0f - sc);
+        press_nmm2[k] = (v->p_pa + open * v->drive_pa) * (1.0e-6f / 3.0f);
+    }
+    uint32_t faces = 0;
+    for (uint32_t t = 0; t < nt; t++) {
+        const uint8_t r = l->region[t];
+        if (r == 0u) {
+            continue;
+        }
+        const float pk = press_nmm2[r - 1u];
+        const uint32_t *tv = m->tet[t];
+        if (!(sc_mesh_tet_volume_mm3(n->x, n->y, n->z, tv) > 0.0f)) {
+            continue; /* an inverted (crushed) lumen tet: its faces have no outward side */
+        }
+        for (uint32_t f = 0; f < 4u; f++) {
+            const int32_t nb = m->tet_nbr[t][f];
+            if (nb < 0 || l->region[nb] != 0u) {
+                /* hull (the vessel goes on), inside the lumen, or a wall shared with another
+                 * vessel (loaded by both lumens: an artery's pressure drove the filler of a
+                 * crushed vein beside it far off in the robustness test) */
+                continue;
+            }
+            if (!(sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[nb]) > 0.0f)) {
+                continue; /* the wall tet across is crushed: no face to push on */
+            }
+            uint32_t q[3];
+            face_nodes(tv, f, q);
+            const float ax = n->x[q[1]] - n->x[q[0]], ay = n->y[q[1]] - n->y[q[0]],
+                        az = n->z[q[1]] - n->z[q[0]];
+            const float bx = n->x[q[2]] - n->x[q[0]], by = n->y[q[2]] - n->y[q[0]],
+                        bz = n->z[q[2]] - n->z[q[0]];
+            float cx = 0.5f * (ay * bz - az * by), cy = 0.5f * (az * bx - ax * bz),
+                  cz = 0.5f * (ax * by - ay * bx);
+            /* outward: away from the tet's fourth vertex */
+            const uint32_t o = tv[f];
+            const float ox = n->x[q[0]] - n->x[o], oy = n->y[q[0]] - n->y[o],
+                        oz = n->z[q[0]] - n->z[o];
+            if (cx * ox + cy * oy + cz * oz < 0.0f) {
+                cx = -cx;
+                cy = -cy;
+                cz = -cz;
+            }
+            for (uint32_t i = 0; i < 3u; i++) {
+                n->fx[q[i]] += pk * cx;
+                n->fy[q[i]] += pk * cy;
+                n->fz[q[i]] += pk * cz;
+            }
+            faces++;
+        }
+    }
+    l->faces = faces;
+}
+
+void sc_lumen_clear(const sc_lumen *l, const sc_mesh *m, sc_nodes *n)
+{
+    if (l->faces == 0u) {
+        return;
+    }
+    for (uint32_t t = 0; t < m->tet_count; t++) {
+        const uint8_t r = l->region[t];
+        if (r == 0u) {
+            continue;
+        }
+        for (uint32_t f = 0; f < 4u; f++) {
+            const int32_t nb = m->tet_nbr[t][f];
+            if (nb < 0 || l->region[nb] != 0u) {
+                continue;
+            }
+            uint32_t q[3];
+            face_nodes(m->tet[t], f, q);
+            for (uint32_t i = 0; i < 3u; i++) {
+                n->fx[q[i]] = 0.0f;
+                n->fy[q[i]] = 0.0f;
+                n->fz[q[i]] = 0.0f;
+            }
+        }
+    }
+}
