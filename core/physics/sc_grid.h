@@ -70,14 +70,20 @@
 /* node loops run over multiples of this many nodes (the widest vector of any variant) */
 #define SC_GRID_CHUNK 16u
 /* leading and trailing padding of every row: the farthest neighbour offset, nx ny + nx + 1,
- * plus a chunk, rounded to a chunk */
+ * rounded up to a chunk. That is enough: a node loop's vector at t (t + GW - 1 < node_end)
+ * reads t - (nx ny + nx) .. t + GW - 1 + nx ny + nx + 1, a cell block's at n0
+ * (n0 + GCB - 1 < cell_end <= node_count - (nx ny + nx + 1) + GCB - 1) reads up to
+ * n0 + GCB - 1 + nx ny + nx + 1 < node_end + GCB (asserted by sc_grid_init). */
 #define SC_GRID_PAD                                                                                \
-    (((SC_MAX_MESH_NX * SC_MAX_MESH_NY + SC_MAX_MESH_NX + 1u + 2u * SC_GRID_CHUNK) /               \
+    (((SC_MAX_MESH_NX * SC_MAX_MESH_NY + SC_MAX_MESH_NX + 1u + SC_GRID_CHUNK - 1u) /               \
       SC_GRID_CHUNK) *                                                                             \
      SC_GRID_CHUNK)
 #define SC_GRID_HEAD SC_GRID_PAD
-/* row stride: an odd multiple of 16 floats (see above) */
-#define SC_GRID_ROW ((((SC_GRID_HEAD + SC_MAX_NODES + SC_GRID_PAD) / 32u) + 1u) * 32u + 16u)
+/* row stride: the smallest odd multiple of 16 floats that holds head, nodes and tail (see
+ * above; the node offsets and the lanes of every sum are counted from SC_GRID_HEAD, so neither
+ * the padding nor the stride changes a result) */
+#define SC_GRID_ROW                                                                                \
+    ((((SC_GRID_HEAD + SC_MAX_NODES + SC_GRID_PAD + 15u) / 16u) | 1u) * 16u)
 _Static_assert(SC_MAX_NODES % SC_GRID_CHUNK == 0u, "node capacity a multiple of the chunk");
 _Static_assert((SC_GRID_ROW / 16u) % 2u == 1u, "row stride an odd multiple of 16 floats");
 
