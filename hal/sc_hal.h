@@ -9,6 +9,7 @@
 #include "sc_hal_clock.h"
 #include "sc_hal_display.h"
 #include "sc_hal_log.h"
+#include "sc_hal_pool.h"
 #include "sc_hal_storage.h"
 #include "sc_hal_watchdog.h"
 
@@ -19,6 +20,7 @@ typedef struct sc_hal {
     sc_storage_dev storage;   /* mandatory */
     sc_log_dev log;           /* ops may be NULL: no log */
     sc_watchdog_dev watchdog; /* ops may be NULL: unguarded */
+    sc_pool_dev pool;         /* ops may be NULL: one worker, the loops run serially */
 } sc_hal;
 
 #endif /* SC_HAL_H */

@@ -214,6 +214,7 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
         (void)k;
     }
     memset(&g->stats, 0, sizeof g->stats);
+    g->pool = NULL;
 
     /* every row is zero outside the mesh's nodes: the loops read and add there */
     const uint32_t used = SC_GRID_HEAD + g->node_end + SC_GRID_PAD;

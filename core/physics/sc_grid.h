@@ -65,6 +65,7 @@
 #include <stdint.h>
 
 #include "sc_config.h"
+#include "sc_hal_pool.h"
 #include "sc_mesh.h"
 
 /* node loops run over multiples of this many nodes (the widest vector of any variant) */
@@ -86,6 +87,17 @@
     ((((SC_GRID_HEAD + SC_MAX_NODES + SC_GRID_PAD + 15u) / 16u) | 1u) * 16u)
 _Static_assert(SC_MAX_NODES % SC_GRID_CHUNK == 0u, "node capacity a multiple of the chunk");
 _Static_assert((SC_GRID_ROW / 16u) % 2u == 1u, "row stride an odd multiple of 16 floats");
+
+/* The CG on the worker pool (hal/sc_hal_pool.h): element-wise loops and the mat-vec run over
+ * ranges of SC_GRID_POOL_RANGE nodes, the dot products over blocks of SC_GRID_SUM_BLOCK nodes
+ * whose partial sums are added in block order: both sizes are part of what makes a state hash
+ * (a mesh of one sum block, up to 8192 nodes, sums exactly as one serial loop), the number of
+ * workers is not. */
+#define SC_GRID_POOL_RANGE 1024u
+#define SC_GRID_SUM_BLOCK 8192u
+#define SC_GRID_SUM_BLOCKS ((SC_MAX_NODES + SC_GRID_SUM_BLOCK - 1u) / SC_GRID_SUM_BLOCK)
+_Static_assert(SC_GRID_POOL_RANGE % SC_GRID_CHUNK == 0u && SC_GRID_SUM_BLOCK % 16u == 0u,
+               "pool ranges and sum blocks are whole chunks and whole partial-sum groups");
 
 /* cells per assembly block (a multiple of every variant's vector width); part of what makes
  * a state hash, so it is the same on every target (the MCU's SRAM sets it: the buffer is
@@ -136,6 +148,7 @@ typedef struct sc_grid {
     uint8_t slot_tv[18][3][3];
     sc_grid_target target[SC_GRID_TARGETS];
     sc_grid_stats stats;
+    const sc_pool_dev *pool; /* workers of the CG (NULL: serial); sc_grid_init sets NULL */
 
     /* ---- hot: matrix rows (node t at SC_GRID_HEAD + t) ---- */
     SC_ALIGN_HOT float d[6][SC_GRID_ROW];

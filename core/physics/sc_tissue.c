@@ -72,6 +72,7 @@ int sc_tissue_build_begin(sc_tissue *t, const sc_tissue_def *def, const sc_volum
     t->mat = *mat;
     t->build_vol = vol;
     t->build_label = default_label;
+    t->pool = NULL;
     memset(&t->stats, 0, sizeof t->stats);
     t->build_phase = SC_TISSUE_BUILD_MESH;
     return SC_OK;
@@ -129,6 +130,7 @@ int sc_tissue_build_step(sc_tissue *t)
         break;
     case SC_TISSUE_BUILD_FEM:
         rc = sc_fem_init(&t->fem, &t->mesh, &t->mat, &t->def.fem);
+        t->fem.grid.pool = t->pool;
         break;
     case SC_TISSUE_BUILD_CONTACT:
         rc = build_contact(t);
@@ -368,4 +370,14 @@ uint64_t sc_tissue_state_hash(const sc_tissue *t)
     h = fnv(h, t->skin.y, t->skin.count);
     h = fnv(h, t->skin.z, t->skin.count);
     return h;
+}
+
+void sc_tissue_set_pool(sc_tissue *t, const sc_pool_dev *pool)
+{
+    SC_ASSERT(t != NULL);
+    t->pool = pool;
+    if (t->build_phase > (uint8_t)SC_TISSUE_BUILD_FEM) {
+        t->fem.grid.pool = pool; /* before: the FEM phase copies t->pool (and until then the
+                                    FEM's storage holds the springs) */
+    }
 }

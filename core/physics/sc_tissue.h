@@ -142,6 +142,7 @@ typedef struct sc_tissue {
     sc_contact_set contacts;
     sc_skin skin;
     uint8_t kinematic[SC_MAX_NODES];
+    const sc_pool_dev *pool; /* workers of the solvers (NULL: serial); sc_tissue_set_pool */
     float box_diag_mm;
     sc_tissue_stats stats;
 } sc_tissue;
@@ -185,6 +186,11 @@ int sc_tissue_set_msds_def(sc_tissue *t, const sc_msds_def *def);
 
 /* Back to rest (nodes, skin, contacts, kinematic flags). O(N). */
 void sc_tissue_reset(sc_tissue *t);
+
+/* The worker pool the solvers split their loops over (hal/sc_hal_pool.h; NULL: serial), kept
+ * until changed (sc_tissue_build_begin sets NULL: call it after). Results are bit-identical
+ * for every worker count. O(1). */
+void sc_tissue_set_pool(sc_tissue *t, const sc_pool_dev *pool);
 
 /* FNV-1a 64 over positions and velocities of the nodes and the skin. O(N). */
 uint64_t sc_tissue_state_hash(const sc_tissue *t);
