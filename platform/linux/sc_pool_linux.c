@@ -130,7 +130,7 @@ static void pin(pthread_t th, int cpu)
 {
     cpu_set_t set;
     CPU_ZERO(&set);
-    CPU_SET(cpu, &set);
+    CPU_SET((unsigned)cpu, &set);
     (void)pthread_setaffinity_np(th, sizeof set, &set);
 }
 
