@@ -37,15 +37,16 @@
 #define SC_HEALTH_MISS_DEGRADED 4u
 #endif
 
-/* ---- soft-tissue mesh (paper Table I: up to 32x16x16 nodes) ------------------------------ */
+/* ---- soft-tissue mesh (paper Table I: up to 32x16x16 nodes; the appliance up to 64x32x32:
+ * 63 MB per tissue slot and 137 MB of engine object, mostly untouched below that size) ----- */
 #ifndef SC_MAX_MESH_NX
-#define SC_MAX_MESH_NX 32u
+#define SC_MAX_MESH_NX 64u
 #endif
 #ifndef SC_MAX_MESH_NY
-#define SC_MAX_MESH_NY 16u
+#define SC_MAX_MESH_NY 32u
 #endif
 #ifndef SC_MAX_MESH_NZ
-#define SC_MAX_MESH_NZ 16u
+#define SC_MAX_MESH_NZ 32u
 #endif
 #ifndef SC_MAX_NODES
 #define SC_MAX_NODES (SC_MAX_MESH_NX * SC_MAX_MESH_NY * SC_MAX_MESH_NZ)

@@ -532,7 +532,12 @@ static int build_begin(sc_engine *e, uint32_t slot)
         td.skin.size_mm[a] = c->mesh.size_mm[a] + 2.0f * SC_ENGINE_SKIN_MARGIN_MM;
     }
     td.skin.z_mm = c->mesh.origin_mm[2];
-    return sc_tissue_build_begin(&e->tissue[slot], &td, &c->volume, &mat, (uint8_t)SC_LABEL_FAT);
+    const int rc =
+        sc_tissue_build_begin(&e->tissue[slot], &td, &c->volume, &mat, (uint8_t)SC_LABEL_FAT);
+    if (rc == SC_OK) {
+        sc_tissue_set_pool(&e->tissue[slot], &e->hal->pool);
+    }
+    return rc;
 }
 
 /* The case's truth for the assessment: DVT when a tet of its mesh is thrombus. O(tets). */

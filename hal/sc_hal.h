@@ -10,6 +10,7 @@
 #include "sc_hal_display.h"
 #include "sc_hal_log.h"
 #include "sc_hal_state.h"
+#include "sc_hal_pool.h"
 #include "sc_hal_storage.h"
 #include "sc_hal_watchdog.h"
 
@@ -21,6 +22,7 @@ typedef struct sc_hal {
     sc_log_dev log;           /* ops may be NULL: no log */
     sc_watchdog_dev watchdog; /* ops may be NULL: unguarded */
     sc_state_dev state;       /* ops may be NULL: no state stream (console) */
+    sc_pool_dev pool;         /* ops may be NULL: one worker, the loops run serially */
 } sc_hal;
 
 #endif /* SC_HAL_H */

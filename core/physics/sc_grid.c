@@ -215,6 +215,7 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
     }
     memset(&g->stats, 0, sizeof g->stats);
     g->forces_vanish_at_rest = 0u;
+    g->pool = NULL;
 
     /* every row is zero outside the mesh's nodes: the loops read and add there */
     const uint32_t used = SC_GRID_HEAD + g->node_end + SC_GRID_PAD;

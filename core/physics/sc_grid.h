@@ -65,21 +65,39 @@
 #include <stdint.h>
 
 #include "sc_config.h"
+#include "sc_hal_pool.h"
 #include "sc_mesh.h"
 
 /* node loops run over multiples of this many nodes (the widest vector of any variant) */
 #define SC_GRID_CHUNK 16u
 /* leading and trailing padding of every row: the farthest neighbour offset, nx ny + nx + 1,
- * plus a chunk, rounded to a chunk */
+ * rounded up to a chunk. That is enough: a node loop's vector at t (t + GW - 1 < node_end)
+ * reads t - (nx ny + nx) .. t + GW - 1 + nx ny + nx + 1, a cell block's at n0
+ * (n0 + GCB - 1 < cell_end <= node_count - (nx ny + nx + 1) + GCB - 1) reads up to
+ * n0 + GCB - 1 + nx ny + nx + 1 < node_end + GCB (asserted by sc_grid_init). */
 #define SC_GRID_PAD                                                                                \
-    (((SC_MAX_MESH_NX * SC_MAX_MESH_NY + SC_MAX_MESH_NX + 1u + 2u * SC_GRID_CHUNK) /               \
+    (((SC_MAX_MESH_NX * SC_MAX_MESH_NY + SC_MAX_MESH_NX + 1u + SC_GRID_CHUNK - 1u) /               \
       SC_GRID_CHUNK) *                                                                             \
      SC_GRID_CHUNK)
 #define SC_GRID_HEAD SC_GRID_PAD
-/* row stride: an odd multiple of 16 floats (see above) */
-#define SC_GRID_ROW ((((SC_GRID_HEAD + SC_MAX_NODES + SC_GRID_PAD) / 32u) + 1u) * 32u + 16u)
+/* row stride: the smallest odd multiple of 16 floats that holds head, nodes and tail (see
+ * above; the node offsets and the lanes of every sum are counted from SC_GRID_HEAD, so neither
+ * the padding nor the stride changes a result) */
+#define SC_GRID_ROW                                                                                \
+    ((((SC_GRID_HEAD + SC_MAX_NODES + SC_GRID_PAD + 15u) / 16u) | 1u) * 16u)
 _Static_assert(SC_MAX_NODES % SC_GRID_CHUNK == 0u, "node capacity a multiple of the chunk");
 _Static_assert((SC_GRID_ROW / 16u) % 2u == 1u, "row stride an odd multiple of 16 floats");
+
+/* The CG on the worker pool (hal/sc_hal_pool.h): element-wise loops and the mat-vec run over
+ * ranges of SC_GRID_POOL_RANGE nodes, the dot products over blocks of SC_GRID_SUM_BLOCK nodes
+ * whose partial sums are added in block order: both sizes are part of what makes a state hash
+ * (a mesh of one sum block, up to 8192 nodes, sums exactly as one serial loop), the number of
+ * workers is not. */
+#define SC_GRID_POOL_RANGE 1024u
+#define SC_GRID_SUM_BLOCK 8192u
+#define SC_GRID_SUM_BLOCKS ((SC_MAX_NODES + SC_GRID_SUM_BLOCK - 1u) / SC_GRID_SUM_BLOCK)
+_Static_assert(SC_GRID_POOL_RANGE % SC_GRID_CHUNK == 0u && SC_GRID_SUM_BLOCK % 16u == 0u,
+               "pool ranges and sum blocks are whole chunks and whole partial-sum groups");
 
 /* cells per assembly block (a multiple of every variant's vector width); part of what makes
  * a state hash, so it is the same on every target (the MCU's SRAM sets it: the buffer is
@@ -134,6 +152,7 @@ typedef struct sc_grid {
      * (lumen pressures, sc_lumen.h): they do not keep the release warm start off (the owner
      * sets it before sc_grid_begin; 0 after sc_grid_init) */
     uint8_t forces_vanish_at_rest;
+    const sc_pool_dev *pool; /* workers of the CG (NULL: serial); sc_grid_init sets NULL */
 
     /* ---- hot: matrix rows (node t at SC_GRID_HEAD + t) ---- */
     SC_ALIGN_HOT float d[6][SC_GRID_ROW];

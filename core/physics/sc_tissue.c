@@ -75,6 +75,7 @@ int sc_tissue_build_begin(sc_tissue *t, const sc_tissue_def *def, const sc_volum
     t->mat = *mat;
     t->build_vol = vol;
     t->build_label = default_label;
+    t->pool = NULL;
     memset(&t->stats, 0, sizeof t->stats);
     t->tip_active = 0u;
     t->tip_contacts = 0u;
@@ -139,6 +140,7 @@ int sc_tissue_build_step(sc_tissue *t)
         break;
     case SC_TISSUE_BUILD_FEM:
         rc = sc_fem_init(&t->fem, &t->mesh, &t->mat, &t->def.fem);
+        t->fem.grid.pool = t->pool;
         break;
     case SC_TISSUE_BUILD_CONTACT:
         rc = build_contact(t);
@@ -479,4 +481,14 @@ float sc_tissue_probe_force_n(const sc_tissue *t, float out[3])
         out[2] = f[2];
     }
     return sqrtf(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+}
+
+void sc_tissue_set_pool(sc_tissue *t, const sc_pool_dev *pool)
+{
+    SC_ASSERT(t != NULL);
+    t->pool = pool;
+    if (t->build_phase > (uint8_t)SC_TISSUE_BUILD_FEM) {
+        t->fem.grid.pool = pool; /* before: the FEM phase copies t->pool (and until then the
+                                    FEM's storage holds the springs) */
+    }
 }

@@ -133,9 +133,15 @@ typedef struct sc_tissue {
     sc_material_table mat;
     sc_mesh mesh;
     sc_nodes nodes;
-    sc_springs springs;
     sc_msds msds;
-    sc_fem fem;
+    /* Algorithm 1's springs are read by the MSDS build phase alone (sc_msds_init_begin turns
+     * them into its families) and the FEM is built after it: the two share their storage
+     * (0.04 MB of the MCU's 0.5 MB, 1.3 MB per slot at 32x16x16). springs is meaningless once
+     * SC_TISSUE_BUILD_FEM has run. */
+    union {
+        sc_springs springs;
+        sc_fem fem;
+    };
     sc_collider collider;
     sc_contact_set contacts;
     sc_skin skin;
@@ -143,6 +149,7 @@ typedef struct sc_tissue {
     sc_lumen lumen; /* vessel lumens: pressure-volume law and drive (sc_lumen.h) */
 #endif
     uint8_t kinematic[SC_MAX_NODES];
+    const sc_pool_dev *pool; /* workers of the solvers (NULL: serial); sc_tissue_set_pool */
     float box_diag_mm;
     sc_tissue_stats stats;
     /* a second tool's tip pushing tissue (the tracked needle), sc_tissue_set_tip */
@@ -196,6 +203,11 @@ int sc_tissue_set_msds_def(sc_tissue *t, const sc_msds_def *def);
 
 /* Back to rest (nodes, skin, contacts, kinematic flags). O(N). */
 void sc_tissue_reset(sc_tissue *t);
+
+/* The worker pool the solvers split their loops over (hal/sc_hal_pool.h; NULL: serial), kept
+ * until changed (sc_tissue_build_begin sets NULL: call it after). Results are bit-identical
+ * for every worker count. O(1). */
+void sc_tissue_set_pool(sc_tissue *t, const sc_pool_dev *pool);
 
 /* FNV-1a 64 over positions and velocities of the nodes and the skin. O(N). */
 uint64_t sc_tissue_state_hash(const sc_tissue *t);

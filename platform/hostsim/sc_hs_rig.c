@@ -32,5 +32,6 @@ int sc_hs_rig_init(sc_hs_rig *rig, const sc_engine_def *def, uint64_t seed, int 
         .log = sc_hs_log_dev(&rig->log),
         .watchdog = {0},
     };
+    sc_hs_pool_init(&rig->pool, 1u, &rig->hal.pool);
     return sc_engine_init(&rig->engine, def, &rig->hal);
 }

@@ -17,6 +17,7 @@
 #include "sc_hs_clock.h"
 #include "sc_hs_display.h"
 #include "sc_hs_log.h"
+#include "sc_hs_pool.h"
 #include "sc_hs_storage.h"
 
 typedef struct sc_hs_rig {
@@ -31,6 +32,8 @@ typedef struct sc_hs_rig {
     sc_hs_display display;
     sc_hs_storage storage;
     sc_hs_log log;
+    sc_hs_pool pool; /* 1 worker; sc_hs_pool_init(&rig->pool, w, &rig->hal.pool) before a case
+                        load runs its solvers' ranges as w workers would take them */
     sc_hal hal;
     sc_engine engine;
 } sc_hs_rig;

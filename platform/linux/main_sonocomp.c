@@ -30,6 +30,7 @@
 #include "sc_log_linux.h"
 #include "sc_png_sink.h"
 #include "sc_rt.h"
+#include "sc_pool_linux.h"
 #include "sc_rtcfg.h"
 #include "sc_socketcan.h"
 #include "sc_storage_linux.h"
@@ -107,6 +108,8 @@ typedef struct cli {
     const char *can_replay_path;   /* --can-replay: a candump -l log instead of SocketCAN */
     const char *state_target;      /* --state-udp: the console state stream's UDP target */
     uint16_t can_udp_port;         /* --can-udp: CAN over UDP instead of SocketCAN */
+    uint32_t workers;              /* --workers: solver workers, 0: one per CPU (default 1) */
+    const char *hist_path;         /* --hist: frame and wake-up histograms as CSV at the end */
 } cli;
 
 static void usage(FILE *f)
@@ -131,6 +134,11 @@ static void usage(FILE *f)
            "                        hosts without SocketCAN; can.interface is then ignored\n"
            "      --state-udp H:P   the console state stream (docs/state-stream.md) to UDP H:P\n"
            "                        (sc-gateway --state-port P)\n"
+           "      --hist FILE       at the end, write the frame-time and wake-up lateness\n"
+           "                        histograms (CSV: bin upper bound us, counts)\n"
+           "      --workers N       solver worker threads, one per core from rt.cpu\n"
+           "                        (0: one per online CPU; default 1: no thread);\n"
+           "                        results are bit-identical for every N\n"
            "  -h, --help            this help\n"
            "  -V, --version         version\n\n"
            "Stops cleanly on SIGINT or SIGTERM and prints its final statistics on stdout.\n"
@@ -411,6 +419,25 @@ static void print_stats_row(const char *name, const sc_stats *s)
            ms(sc_stats_percentile_ns(s, 990u)), ms(s->worst_ns));
 }
 
+/* The frame-time and wake-up lateness histograms (sc_stats.h bins) as CSV: bins with a count. */
+static int write_hist(const char *path, const sc_engine *e)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) {
+        return -1;
+    }
+    const sc_sched *s = sc_engine_get_sched(e);
+    fprintf(f, "bin_upper_us,frame_count,wakeup_late_count\n");
+    for (uint32_t b = 0; b < SC_STATS_BINS; b++) {
+        const uint32_t fc = s->frame_stats.hist[b], lc = s->lateness_stats.hist[b];
+        if (fc || lc) {
+            fprintf(f, "%llu,%u,%u\n", (unsigned long long)sc_stats_bin_upper_us(b),
+                    (unsigned)fc, (unsigned)lc);
+        }
+    }
+    return fclose(f);
+}
+
 static void final_report(const sc_engine *e, double wall_s, const char *stop_reason,
                          const sc_display_dev *disp, const sc_rt_report *rt,
                          const sc_udp_display *udp)
@@ -431,6 +458,9 @@ static void final_report(const sc_engine *e, double wall_s, const char *stop_rea
     printf("  %-16s %9s %9s %9s %9s %9s   (ms)\n", "", "count", "mean", "p50", "p99", "worst");
     print_stats_row("frame", &s->frame_stats);
     print_stats_row("wake-up latency", &s->lateness_stats);
+    printf("  p99.9: frame %.3f ms, wake-up latency %.3f ms\n",
+           ms(sc_stats_percentile_ns(&s->frame_stats, 999u)),
+           ms(sc_stats_percentile_ns(&s->lateness_stats, 999u)));
     for (uint32_t i = 0; i < s->stage_count; i++) {
         char name[40];
         snprintf(name, sizeof name, "stage %s", s->stages[i].name ? s->stages[i].name : "?");
@@ -487,9 +517,10 @@ static void final_report(const sc_engine *e, double wall_s, const char *stop_rea
 static int parse_cli(int argc, char **argv, cli *a)
 {
     memset(a, 0, sizeof *a);
+    a->workers = 1u;
     optind = 0; /* glibc: a full re-initialisation, so that it can be called again */
     enum { OPT_CHECK = 1000, OPT_HELP_CONFIG, OPT_CASE_DIR, OPT_INJECT, OPT_CAN_REPLAY,
-           OPT_STATE_UDP, OPT_CAN_UDP };
+           OPT_STATE_UDP, OPT_CAN_UDP, OPT_WORKERS, OPT_HIST };
     static const struct option lo[] = {{"config", required_argument, NULL, 'c'},
                                        {"set", required_argument, NULL, 's'},
                                        {"check-config", no_argument, NULL, OPT_CHECK},
@@ -499,6 +530,8 @@ static int parse_cli(int argc, char **argv, cli *a)
                                        {"can-replay", required_argument, NULL, OPT_CAN_REPLAY},
                                        {"state-udp", required_argument, NULL, OPT_STATE_UDP},
                                        {"can-udp", required_argument, NULL, OPT_CAN_UDP},
+                                       {"workers", required_argument, NULL, OPT_WORKERS},
+                                       {"hist", required_argument, NULL, OPT_HIST},
                                        {"frames", required_argument, NULL, 'n'},
                                        {"seconds", required_argument, NULL, 't'},
                                        {"help", no_argument, NULL, 'h'},
@@ -558,6 +591,20 @@ static int parse_cli(int argc, char **argv, cli *a)
                 return EXIT_USAGE;
             }
             a->can_udp_port = (uint16_t)v;
+            break;
+        }
+        case OPT_HIST:
+            a->hist_path = optarg;
+            break;
+        case OPT_WORKERS: {
+            errno = 0;
+            unsigned long v = strtoul(optarg, &end, 10);
+            if (errno || !end || *end || optarg[0] == '-' || v > SC_POOL_LINUX_MAX_WORKERS) {
+                fprintf(stderr, "sonocomp: --workers %s: expected 0..%u\n", optarg,
+                        (unsigned)SC_POOL_LINUX_MAX_WORKERS);
+                return EXIT_USAGE;
+            }
+            a->workers = (uint32_t)v;
             break;
         }
         case 'n':
@@ -669,6 +716,20 @@ int main(int argc, char **argv)
     memset(&hal, 0, sizeof hal);
     hal.clock = sc_rt_clock_dev();
     hal.log = sc_log_linux_dev(&g_log);
+    static sc_pool_linux pool;
+    int pool_started = 0;
+    if (a.workers != 1u) {
+        const int prc = sc_pool_linux_start(&pool, a.workers, cfg.rt_cpu, 200u, &hal.pool);
+        if (prc != 0) {
+            sc_log_linux_msg(&g_log, SC_LOG_WARN, "pool_refused",
+                             "workers=%u errno=\"%s\" action=\"serial solvers\"",
+                             (unsigned)a.workers, strerror(-prc));
+        } else {
+            pool_started = 1;
+            sc_log_linux_msg(&g_log, SC_LOG_INFO, "pool_started", "workers=%u first_cpu=%d",
+                             (unsigned)pool.workers, (int)cfg.rt_cpu);
+        }
+    }
 
     static sc_socketcan can;
     static sc_can_replay replay;
@@ -896,9 +957,15 @@ int main(int argc, char **argv)
         wall_s = (double)(sc_rt_now_ns() - t0) / 1e9;
         sc_log_linux_status_done(&g_log);
         final_report(e, wall_s, stop_reason, &hal.display, &rtr, udp_open ? &udp : NULL);
+        if (a.hist_path && write_hist(a.hist_path, e) != 0) {
+            fprintf(stderr, "sonocomp: --hist %s: %s\n", a.hist_path, strerror(errno));
+        }
     }
 
     /* clean shutdown: a stopped engine must not be reset by its watchdog */
+    if (pool_started) {
+        sc_pool_linux_stop(&pool);
+    }
     if (soft_wdg_used) {
         sc_soft_watchdog_stop(&soft_wdg);
     }

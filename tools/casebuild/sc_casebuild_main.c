@@ -1,6 +1,7 @@
 /* sc-casebuild: build, inspect and verify sonocomp case files.
  *
  *   sc-casebuild phantom <neck-ijv|femoral|femoral-dvt> -o OUT.scase [--seed N] [--spacing MM]
+ *                        [--mesh-nodes NX,NY,NZ] (the same mesh box at another resolution)
  *                        [--acoustics engine|baked]
  *   sc-casebuild import --volume V.{mha,mhd,nrrd,nhdr,dcm}|DICOMDIR/ [--labels L.{...}] -o
  * OUT.scase
@@ -50,6 +51,7 @@ static int usage(void)
             "usage:\n"
             "  sc-casebuild phantom <neck-ijv|femoral|femoral-dvt> -o OUT.scase [--seed N] "
             "[--spacing MM]\n"
+            "               [--mesh-nodes NX,NY,NZ]  (the phantom's mesh box at this resolution)\n"
             "               [--acoustics engine|baked]  (engine: the engine computes shadows and\n"
             "               enhancement along the beam; baked, the default: in the voxels)\n"
             "  sc-casebuild import --volume FILE [--labels FILE] -o OUT.scase [--name NAME]\n"
@@ -344,6 +346,7 @@ static int cmd_phantom(int argc, char **argv)
         return usage();
     }
     pd.kind = (sc_phantom_kind)kind;
+    uint32_t mesh_nodes[3] = {0u, 0u, 0u}; /* 0: the phantom's own mesh */
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "-o") == 0 && i + 1 < argc) {
             out = argv[++i];
@@ -362,6 +365,25 @@ static int cmd_phantom(int argc, char **argv)
                 return 2;
             }
             pd.engine_acoustics = strcmp(a, "engine") == 0;
+        } else if (strcmp(argv[i], "--mesh-nodes") == 0 && i + 1 < argc) {
+            const char *val = argv[++i];
+            char buf[64];
+            const uint32_t maxn[3] = {SC_MAX_MESH_NX, SC_MAX_MESH_NY, SC_MAX_MESH_NZ};
+            snprintf(buf, sizeof buf, "%s", val);
+            char *save = NULL, *tok = strtok_r(buf, ",", &save);
+            for (int k = 0; k < 3; k++) {
+                if (tok == NULL || num_u32("--mesh-nodes", tok, 2u, maxn[k], &mesh_nodes[k])) {
+                    fprintf(stderr,
+                            "sc-casebuild: --mesh-nodes '%s': NX,NY,NZ, each 2..%u,%u,%u\n", val,
+                            maxn[0], maxn[1], maxn[2]);
+                    return 2;
+                }
+                tok = strtok_r(NULL, ",", &save);
+            }
+            if (tok != NULL) {
+                fprintf(stderr, "sc-casebuild: --mesh-nodes '%s': three counts\n", val);
+                return 2;
+            }
         } else {
             return usage();
         }
@@ -374,6 +396,11 @@ static int cmd_phantom(int argc, char **argv)
     if (rc != SC_OK) {
         fprintf(stderr, "sc-casebuild: phantom: %s\n", sc_err_name(rc));
         return 1;
+    }
+    if (mesh_nodes[0] != 0u) { /* the same mesh box at another resolution */
+        p.def.mesh.nx = mesh_nodes[0];
+        p.def.mesh.ny = mesh_nodes[1];
+        p.def.mesh.nz = mesh_nodes[2];
     }
     rc = write_case_file(&p.def, out);
     sc_phantom_free(&p);

@@ -1,0 +1,59 @@
+/*
+ * sc_pool_linux.h: the appliance's worker pool (hal/sc_hal_pool.h): W - 1 threads created once
+ * at start-up, each pinned to its own core (the caller, worker 0, pinned to the first), that
+ * wait for a job and claim its ranges one at a time from a shared counter, as the caller does:
+ * a worker that the kernel has descheduled (a shared machine) holds up no range it has not
+ * claimed. The claim counter carries the job's sequence number, so a late worker can never
+ * claim a range of the next job with the previous job's view. Between the jobs of a frame the
+ * workers spin (pause) for up to spin_us, then sleep on a futex until the next job, so an idle
+ * engine costs no CPU and a hand-over within a frame costs about a microsecond.
+ * Which worker runs which range varies from run to run; the core's jobs do not depend on it
+ * (hal/sc_hal_pool.h), so the results do not either.
+ * Threads: run is called by one thread at a time (the frame loop). Allocation: none after
+ * sc_pool_linux_start (the threads' stacks are created there).
+ */
+#ifndef SC_POOL_LINUX_H
+#define SC_POOL_LINUX_H
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdint.h>
+
+#include "sc_hal_pool.h"
+
+#define SC_POOL_LINUX_MAX_WORKERS 16u
+
+typedef struct sc_pool_linux_arg {
+    struct sc_pool_linux *p;
+    uint32_t w;
+} sc_pool_linux_arg;
+
+typedef struct sc_pool_linux {
+    uint32_t workers;
+    sc_pool_linux_arg args[SC_POOL_LINUX_MAX_WORKERS];
+    uint32_t spin_us;
+    pthread_t th[SC_POOL_LINUX_MAX_WORKERS];
+    uint32_t started; /* threads started */
+    /* the current job: written by the caller before seq is bumped, stable until all report */
+    _Atomic(sc_pool_job_fn) fn;
+    _Atomic(void *) arg;
+    _Atomic uint32_t ranges;
+    _Atomic uint32_t seq;   /* job sequence number (also the futex word) */
+    _Atomic uint64_t claim; /* job sequence << 32 | next range to claim */
+    _Atomic uint32_t done;  /* ranges of the current job finished */
+    _Atomic uint32_t stop;
+    _Atomic uint32_t sleeping; /* workers blocked on the futex */
+    int first_cpu;             /* worker w pinned to CPU first_cpu + w (-1: not pinned) */
+} sc_pool_linux;
+
+/* Start a pool of `workers` (1..SC_POOL_LINUX_MAX_WORKERS; 0: one per online CPU) and fill
+ * dev. first_cpu >= 0 pins worker w (w >= 1) to CPU (first_cpu + w) mod online CPUs, and the
+ * caller to first_cpu; -1 leaves placement to the kernel. Returns 0, or a negative errno
+ * (then no thread runs and dev is the serial pool: NULL ops). */
+int sc_pool_linux_start(sc_pool_linux *p, uint32_t workers, int first_cpu, uint32_t spin_us,
+                        sc_pool_dev *dev);
+
+/* Stop and join the threads. The pool must not be running a job. */
+void sc_pool_linux_stop(sc_pool_linux *p);
+
+#endif /* SC_POOL_LINUX_H */

@@ -1,0 +1,61 @@
+#!/bin/sh
+# rt_press.sh: deadline evidence with the probe pressing. The real frame loop (sonocomp, FEM
+# and MSDS) is fed a replayed press-and-sweep tracker log (sc-tracker-emu --script sweep
+# --log: the probe held DEPTH mm into the skin and swept 20 mm back and forth every 4 s) for
+# SECONDS at 60 Hz and at 120 Hz, SCHED_FIFO, memory locked, the loop on CPU 0, while
+# stress-ng (or a busy loop when stress-ng is missing) loads CPU 1. Per run: sonocomp's final
+# table (frame time and wake-up lateness: mean, p50, p99, p99.9, worst; deadline misses) and
+# the two histograms (OUT/hist-METHOD-RATEhz.csv, bins of 1/16 octave of microseconds).
+# Without SocketCAN the log is replayed in real time through --can-replay (tools/demo-live.sh).
+# It takes 4 x (SECONDS + ~5) s plus the case build (about 4.5 min at the default 60 s).
+#
+# usage: tools/rt_bench/rt_press.sh BUILD_DIR [SECONDS] [MESH NX,NY,NZ] [WORKERS] [OUT_DIR]
+#   defaults: 60 s, the phantom neck-ijv at its own mesh, 1 worker, out/rt_press
+set -eu
+BUILD=$1
+SECS=${2:-60}
+MESH=${3:-}
+WORKERS=${4:-1}
+OUT=${5:-out/rt_press}
+ENGINE=$BUILD/platform/linux/sonocomp
+EMU=$BUILD/tools/tracker_emu/sc-tracker-emu
+CB=$BUILD/tools/casebuild/sc-casebuild
+for b in "$ENGINE" "$EMU" "$CB"; do
+    [ -x "$b" ] || { echo "rt_press: missing $b (build sonocomp sc-tracker-emu sc-casebuild)"; exit 2; }
+done
+mkdir -p "$OUT"
+CASE=$OUT/neck-ijv.scase
+if [ -n "$MESH" ]; then
+    "$CB" phantom neck-ijv --mesh-nodes "$MESH" -o "$CASE" > "$OUT/casebuild.log" 2>&1
+else
+    "$CB" phantom neck-ijv -o "$CASE" > "$OUT/casebuild.log" 2>&1
+fi
+LOG=$OUT/tracker.log
+# the neck-ijv box top centre is volume (-2, 0, 0), tracker (x, -y, -z) (tools/demo-live.sh)
+"$EMU" --script sweep --point -2,0,0 --depth-mm 8 --hover-mm 5 --length-mm 20 --period-s 4 \
+    --duration-s $((SECS + 5)) --log "$LOG" 2> "$OUT/tracker.err"
+hog=""
+if command -v stress-ng > /dev/null 2>&1; then
+    stress-ng --cpu 1 --taskset 1 --timeout $((4 * (SECS + 10)))s > /dev/null 2>&1 &
+    hog=$!
+    load="stress-ng --cpu 1 --taskset 1"
+else
+    taskset -c 1 sh -c 'while :; do :; done' &
+    hog=$!
+    load="busy loop on CPU 1 (no stress-ng)"
+fi
+trap '[ -n "$hog" ] && kill "$hog" 2> /dev/null; true' EXIT
+echo "machine: $(nproc) CPUs, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')," \
+    "load average $(cut -d' ' -f1-3 /proc/loadavg), kernel $(uname -r)"
+echo "second core: $load; mesh: ${MESH:-the phantom's own}; workers: $WORKERS; $SECS s per run"
+for method in fem msds; do
+    for rate in 60 120; do
+        echo "=== $method at $rate Hz ==="
+        "$ENGINE" -s "case=$CASE" -s physics.method=$method -s frame_rate_hz=$rate \
+            -s display.target=none -s rt.cpu=0 -s rt.sched_fifo=true -s rt.mlock=true \
+            -s watchdog.device=soft -s status.line=off -s log.level=error \
+            --workers "$WORKERS" --can-replay "$LOG" --seconds "$SECS" \
+            --hist "$OUT/hist-$method-${rate}hz.csv" 2> "$OUT/sonocomp-$method-${rate}hz.err" |
+            sed -n '/final statistics/,$p'
+    done
+done
