@@ -230,6 +230,14 @@ static void stage_imaging(sc_engine *e, const sc_probe_in *probe, const sc_tissu
                           .artery_area_ratio = SC_AREA_RATIO_NOT_AVAILABLE};
 #if SC_ENABLE_DOPPLER
     /* colour and spectrum come from the B-scan's own pass (a line hook) */
+#if SC_PHYS_LUMEN
+    if (e->case_loaded) {
+        /* one heart for both: the flow follows the cardiac and respiratory phases of the
+         * pulsation that drives the lumens (sc_lumen.h) */
+        const sc_lumen *lu = &e->tissue[e->active].lumen;
+        (void)sc_doppler_set_phase(&e->doppler, lu->heart_phase, lu->resp_phase);
+    }
+#endif
     sc_doppler_advance(&e->doppler, 1.0f / (float)e->def.sched.rate_hz);
     (void)sc_doppler_frame_begin(&e->doppler, &e->bscan, &e->hal->display, e->frame_no);
     e->doppler_on = (uint8_t)(e->bscan.line_hook == sc_doppler_line_hook);
@@ -575,6 +583,12 @@ static int swap_case(sc_engine *e, uint32_t slot)
     bd.scan.depth_mm = case_imaging_depth_mm(e, &e->sw.c, &bd.scan);
     /* a method command during the build applies to the new tissue too */
     int rc = sc_tissue_set_method(&e->tissue[slot], e->def.tissue.method);
+#if SC_PHYS_LUMEN
+    if (rc == SC_OK) {
+        /* the pulsation's clock runs at the frame rate */
+        rc = sc_tissue_set_frame_s(&e->tissue[slot], 1.0f / (float)e->def.sched.rate_hz);
+    }
+#endif
     if (rc == SC_OK) {
         rc = sc_bscan_set_def(&e->bscan, &bd);
     }
@@ -954,6 +968,7 @@ static void state_stream(sc_engine *e, uint64_t now)
         .case_loads = e->counters.case_loads,
         .case_load_failures = e->counters.case_load_failures,
         .last_case_error = e->counters.last_case_error,
+        .assess = sc_assess_get(&e->assess),
         .catalogue = e->def.case_names,
         .catalogue_count = e->def.case_count,
     };

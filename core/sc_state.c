@@ -253,6 +253,44 @@ static uint32_t emit_catalogue(sc_state_tx *t, const sc_state_dev *dev, const sc
     return finish(t, dev, &w, in->frame_no);
 }
 
+/* The assessment record, field by field in the little-endian layout of docs/assessment.md
+ * (104 bytes, the same as sc_assess_report's). */
+static uint32_t emit_assessment(sc_state_tx *t, const sc_state_dev *dev, const sc_state_in *in)
+{
+    const sc_assess_report *r = in->assess;
+    wr w = begin(t, SC_STATE_ASSESSMENT);
+    put_u32(&w, r->version);
+    put_u32(&w, r->frames);
+    put_u32(&w, r->contact_frames);
+    put_u32(&w, r->resets);
+    put_u32(&w, r->calls);
+    for (uint32_t v = 0; v < SC_ASSESS_VESSELS; v++) {
+        const sc_assess_vessel_rec *x = &r->vessel[v];
+        put_f32(&w, x->min_ratio);
+        put_f32(&w, x->force_at_min_n);
+        put_u32(&w, x->frames_in_view);
+        put_u32(&w, x->min_frame);
+        put_u8(&w, x->coapted);
+        put_u8(&w, 0u);
+        put_u16(&w, 0u);
+    }
+    put_f32(&w, r->peak_force_n);
+    put_f32(&w, r->venous_force_max_n);
+    put_u8(&w, r->artery_over);
+    put_u8(&w, r->call);
+    put_u8(&w, r->finding);
+    put_u8(&w, r->criteria_met);
+    for (uint32_t c = 0; c < SC_ASSESS_CRITERIA; c++) {
+        put_u8(&w, r->points[c]);
+    }
+    put_u8(&w, r->score);
+    put_u8(&w, r->score_max);
+    for (uint32_t k = 0; k < 5u; k++) {
+        put_u8(&w, 0u);
+    }
+    return finish(t, dev, &w, in->frame_no);
+}
+
 uint32_t sc_state_emit(sc_state_tx *t, const sc_state_dev *dev, const sc_state_in *in)
 {
     if (t->period_ms == 0u || dev == NULL || dev->ops == NULL || in->now_ns < t->next_ns) {
@@ -278,6 +316,9 @@ uint32_t sc_state_emit(sc_state_tx *t, const sc_state_dev *dev, const sc_state_i
     }
     if (in->catalogue_count > 0u && in->catalogue != NULL) {
         sent += emit_catalogue(t, dev, in);
+    }
+    if (in->assess != NULL) {
+        sent += emit_assessment(t, dev, in);
     }
     t->periods++;
     return sent;

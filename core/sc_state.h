@@ -9,15 +9,15 @@
  * u32 sequence number (+1 per record, wraps), u32 engine frame number), then the payload of its
  * type. Types: FRAME (status, pose, statistics, imaging settings, compression measures),
  * SURF_INFO (the case's surfaces), VERTS (a run of deformed surface vertices), TRIS (a run of
- * triangles), CATALOGUE (one catalogue entry), ASSESSMENT (reserved: the exam assessment,
- * filled by the assessment module when present). A receiver ignores types and versions it does
+ * triangles), CATALOGUE (one catalogue entry), ASSESSMENT (the exam's assessment record,
+ * sc_assess_report in the layout of docs/assessment.md, one per period when the engine has one). A receiver ignores types and versions it does
  * not know, and never needs every record: FRAME is complete in itself, surfaces are sent
  * round-robin (vertices every period, triangles and catalogue slowly), so a lost record is
  * replaced by the next round.
  *
  * Rate and cost: at most once per state_period_ms (engine def): one FRAME, one SURF_INFO, up
  * to vert_records VERTS (SC_STATE_VERTS_PER_RECORD vertices each: 4 node reads and a weighted
- * sum per vertex), one TRIS, one CATALOGUE. O(vert_records x SC_STATE_VERTS_PER_RECORD), never
+ * sum per vertex), one TRIS, one CATALOGUE, one ASSESSMENT. O(vert_records x SC_STATE_VERTS_PER_RECORD), never
  * allocates, never blocks (a record the device refuses is dropped and counted).
  * Memory: one record buffer of SC_STATE_RECORD_MAX bytes in the sc_state_tx.
  */
@@ -26,6 +26,7 @@
 
 #include <stdint.h>
 
+#include "sc_assess.h"
 #include "sc_case.h"
 #include "sc_hal_state.h"
 #include "sc_mesh.h"
@@ -48,7 +49,7 @@ typedef enum sc_state_type {
     SC_STATE_VERTS = 3,
     SC_STATE_TRIS = 4,
     SC_STATE_CATALOGUE = 5,
-    SC_STATE_ASSESSMENT = 6, /* reserved for the assessment module */
+    SC_STATE_ASSESSMENT = 6, /* the exam's assessment record (sc_assess.h) */
 } sc_state_type;
 
 #define SC_STATE_FRAME_SIZE 208u /* FRAME payload bytes (docs/state-stream.md) */
@@ -70,6 +71,7 @@ typedef struct sc_state_in {
     const sc_case *c;       /* NULL without a case */
     const sc_mesh *mesh;    /* NULL without a case */
     const float *x, *y, *z; /* deformed node positions (mm), NULL without a case */
+    const sc_assess_report *assess; /* the exam's assessment; NULL: none */
     const char *const *catalogue; /* case_count names */
     uint32_t catalogue_count;
 } sc_state_in;

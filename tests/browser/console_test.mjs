@@ -150,6 +150,15 @@ if (scenario === 'press') {
   if (!(pressed.height < 0.7 * rest.height)) await fail(`the vein is not visibly narrower: ${pressed.height} px vs ${rest.height} px at rest`);
   ok(`the vein in the 3D view is ${(100 * (1 - pressed.height / rest.height)).toFixed(0)} % narrower (screenshots in ${outDir})`);
   await stopped(emu);
+  // the exam's assessment: the trainee's call from the page reaches the engine (CmdAssessment)
+  // and comes back scored in the stream's ASSESSMENT record
+  await page.click('[data-call=normal]');
+  await waitFor(page, () => window.sc.assessment && window.sc.assessment.call === 'normal', null,
+    'the assessment shows the call');
+  const a = await page.evaluate(() => window.sc.assessment);
+  if (!((a.met >> 4) & 1)) await fail(`the correct call "normal" on a normal case did not score (criteria 0x${a.met.toString(16)})`);
+  if (!(a.vessels[0].inView > 0 && a.vessels[0].min < 0.3)) await fail(`the assessment missed the press: vein ${JSON.stringify(a.vessels[0])}`);
+  ok(`assessment: score ${a.score}/${a.scoreMax}, vein min ratio ${a.vessels[0].min.toFixed(3)}, call ${a.call} scored`);
   await page.evaluate(() => window.scNormalView());
 } else {
   // switch the case

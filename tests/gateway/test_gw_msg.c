@@ -35,6 +35,13 @@ static void each_protocol_command_parses(void **state)
     assert_string_equal(m.pass, "a\"b");
     assert_int_equal(parse("{\"op\":\"ping\"}", &m, &why), 0);
     assert_int_equal(m.op, GW_OP_PING);
+    assert_int_equal(parse("{\"op\":\"assess\",\"action\":\"call\",\"call\":\"dvt\"}", &m, &why), 0);
+    assert_int_equal(m.cmd.kind, SC_CMD_ASSESS);
+    assert_int_equal(m.cmd.assess_action, SC_ASSESS_ACTION_CALL);
+    assert_int_equal(m.cmd.assess_call, SC_ASSESS_CALL_DVT);
+    assert_int_equal(parse("{\"op\":\"assess\",\"action\":\"reset\"}", &m, &why), 0);
+    assert_int_equal(m.cmd.assess_action, SC_ASSESS_ACTION_RESET);
+    assert_int_equal(m.cmd.assess_call, SC_ASSESS_CALL_NONE);
 }
 
 static void bad_messages_are_refused_with_a_reason(void **state)
@@ -56,6 +63,9 @@ static void bad_messages_are_refused_with_a_reason(void **state)
         "{\"op\":\"imaging\",\"depth_mm\":40}",             /* fields missing */
         "{\"op\":\"reset\",\"target\":\"engine\"}",
         "{\"op\":\"shutdown\"}",                           /* not a protocol command */
+        "{\"op\":\"assess\",\"action\":\"call\"}",           /* a call without its value */
+        "{\"op\":\"assess\",\"action\":\"call\",\"call\":\"maybe\"}",
+        "{\"op\":\"assess\",\"action\":\"reset\",\"call\":\"dvt\"}", /* reset takes no call */
         "{\"op\":\"case\",\"id\":1e999}",
         "{\"op\":\"auth\",\"pass\":\"\\u0041\"}",          /* unsupported escape */
         "{\"op\":{\"nested\":1}}",

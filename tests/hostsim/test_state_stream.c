@@ -23,7 +23,8 @@ static size_t g_size;
 
 /* ---- what the stream delivered ----------------------------------------------------------- */
 static struct {
-    uint32_t frames, surf_infos, verts, tris, catalogue, other;
+    uint32_t frames, surf_infos, verts, tris, catalogue, assessments, other;
+    uint32_t assess_frames, assess_score_max; /* of the last ASSESSMENT record */
     uint32_t last_seq;
     int have_seq;
     uint32_t gaps;
@@ -69,6 +70,11 @@ static int sink(void *ctx, const uint8_t *rec, uint16_t len)
     }
     case SC_STATE_TRIS: got.tris++; break;
     case SC_STATE_CATALOGUE: got.catalogue++; break;
+    case SC_STATE_ASSESSMENT: /* docs/assessment.md: frames at 4, score_max at 98 */
+        got.assessments++;
+        got.assess_frames = rd32(p + 4);
+        got.assess_score_max = p[98];
+        break;
     default: got.other++; break;
     }
     return SC_OK;
@@ -193,6 +199,9 @@ static void stream_carries_the_engine_and_the_skin_sinks_under_the_press(void **
     assert_int_equal(got.surf_infos, got.frames);
     assert_int_equal(got.verts, got.frames); /* 72 vertices: one record a period */
     assert_int_equal(got.gaps, 0u);
+    assert_int_equal(got.assessments, got.frames); /* the exam's record every period */
+    assert_true(got.assess_frames >= 55u && got.assess_frames <= 60u);
+    assert_int_equal(got.assess_score_max, sc_engine_assessment(&rig.engine)->score_max);
     assert_int_equal(got.other, 0u);
     assert_string_equal(got.name, "block");
     float rest_max = -1e9f;

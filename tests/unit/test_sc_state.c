@@ -96,6 +96,48 @@ static void frame_record_has_header_size_and_fields(void **state)
     assert_true(rdf(p + 56) > 0.249f && rdf(p + 56) < 0.251f); /* vein ratio */
 }
 
+/* The ASSESSMENT record carries the report in the layout of docs/assessment.md. */
+static void assessment_record_has_the_documented_layout(void **state)
+{
+    (void)state;
+    memset(&g_sink, 0, sizeof g_sink);
+    sc_state_tx_init(&g_tx, 33u, 4u);
+    const sc_state_dev dev = {&k_ops, &g_sink};
+    sc_assess_report r;
+    memset(&r, 0, sizeof r);
+    r.version = SC_ASSESS_REPORT_VERSION;
+    r.frames = 321u;
+    r.vessel[SC_ASSESS_ARTERY].min_ratio = 0.875f;
+    r.vessel[SC_ASSESS_ARTERY].frames_in_view = 40u;
+    r.vessel[SC_ASSESS_VEIN].coapted = 1u;
+    r.peak_force_n = 21.5f;
+    r.call = SC_ASSESS_CALL_DVT;
+    r.finding = SC_ASSESS_CALL_NORMAL;
+    r.criteria_met = 0x0Fu;
+    r.points[4] = 3u;
+    r.score = 5u;
+    r.score_max = 8u;
+    sc_state_in in = base_in(1000000000u);
+    in.assess = &r;
+    assert_int_equal(sc_state_emit(&g_tx, &dev, &in), 2u); /* FRAME, ASSESSMENT */
+    const uint8_t *rec = g_sink.rec[1];
+    assert_int_equal(g_sink.len[1], SC_STATE_HEADER_SIZE + sizeof(sc_assess_report));
+    assert_int_equal(sc_state_check(rec, g_sink.len[1], NULL, NULL), SC_STATE_ASSESSMENT);
+    const uint8_t *p = rec + SC_STATE_HEADER_SIZE;
+    assert_int_equal(rd32(p + 0), SC_ASSESS_REPORT_VERSION);
+    assert_int_equal(rd32(p + 4), 321u);
+    assert_true(rdf(p + 20 + 20) > 0.874f && rdf(p + 20 + 20) < 0.876f); /* artery min */
+    assert_int_equal(rd32(p + 20 + 20 + 8), 40u);
+    assert_int_equal(p[20 + 16], 1u);                                   /* vein coapted */
+    assert_true(rdf(p + 80) > 21.49f && rdf(p + 80) < 21.51f);
+    assert_int_equal(p[89], SC_ASSESS_CALL_DVT);
+    assert_int_equal(p[90], SC_ASSESS_CALL_NORMAL);
+    assert_int_equal(p[91], 0x0Fu);
+    assert_int_equal(p[96], 3u);
+    assert_int_equal(p[97], 5u);
+    assert_int_equal(p[98], 8u);
+}
+
 static void period_limits_the_rate_and_sequence_counts_up(void **state)
 {
     (void)state;
@@ -235,6 +277,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(frame_record_has_header_size_and_fields),
+        cmocka_unit_test(assessment_record_has_the_documented_layout),
         cmocka_unit_test(period_limits_the_rate_and_sequence_counts_up),
         cmocka_unit_test(refused_records_are_counted_and_leave_a_sequence_gap),
         cmocka_unit_test(period_zero_or_no_device_sends_nothing),

@@ -287,8 +287,26 @@ int gw_msg_parse(const char *text, size_t len, gw_msg *out, const char **why)
         r.cmd.imaging.tgc_db_per_cm = (float)t->num;
         r.cmd.imaging.geometry =
             strcmp(geo->str, "curvilinear") == 0 ? SC_SCAN_CURVILINEAR : SC_SCAN_LINEAR;
+    } else if (strcmp(op->str, "assess") == 0) {
+        /* the exam's assessment: reset it, or enter the trainee's call (CmdAssessment) */
+        static const char *const k[] = {"op", "action", "call", NULL};
+        const member *a = find(m, n, "action", 1), *c = find(m, n, "call", 1);
+        const int reset = a != NULL && strcmp(a->str, "reset") == 0 && c == NULL;
+        const int call = a != NULL && strcmp(a->str, "call") == 0 && c != NULL &&
+                         (strcmp(c->str, "normal") == 0 || strcmp(c->str, "dvt") == 0);
+        if (!only(m, n, k) || (!reset && !call)) {
+            return fail(why, "assess wants {\"op\":\"assess\",\"action\":\"reset\"} or "
+                             "{\"op\":\"assess\",\"action\":\"call\",\"call\":\"normal\"|\"dvt\"}");
+        }
+        r.op = GW_OP_COMMAND;
+        r.name = "assess";
+        r.cmd.kind = SC_CMD_ASSESS;
+        r.cmd.assess_action = reset ? SC_ASSESS_ACTION_RESET : SC_ASSESS_ACTION_CALL;
+        r.cmd.assess_call = reset                           ? SC_ASSESS_CALL_NONE
+                            : strcmp(c->str, "dvt") == 0 ? SC_ASSESS_CALL_DVT
+                                                          : SC_ASSESS_CALL_NORMAL;
     } else {
-        return fail(why, "unknown op (auth, ping, case, method, imaging, reset)");
+        return fail(why, "unknown op (auth, ping, case, method, imaging, reset, assess)");
     }
     if (r.op == GW_OP_COMMAND) {
         sc_can_frame f;

@@ -309,6 +309,36 @@ function onTris(dv, p) {
   }
 }
 
+// ASSESSMENT: the engine's exam record (docs/assessment.md, 104 bytes little-endian)
+const CRITERIA = ['vein imaged', 'compressed', 'artery spared', 'force safe', 'call correct'];
+const CALLS = ['none', 'normal', 'DVT'];
+function onAssessment(dv, p) {
+  if (dv.byteLength < p + 104 || dv.getUint32(p, true) !== 1) return;
+  const ves = ['vein', 'artery', 'thrombus'].map((name, v) => {
+    const q = p + 20 + 20 * v;
+    return { name, min: dv.getFloat32(q, true), force: dv.getFloat32(q + 4, true),
+             inView: dv.getUint32(q + 8, true), coapted: dv.getUint8(q + 16) === 1 };
+  });
+  const a = {
+    frames: dv.getUint32(p + 4, true), vessels: ves, peakForce: dv.getFloat32(p + 80, true),
+    arteryOver: dv.getUint8(p + 88) === 1, call: CALLS[dv.getUint8(p + 89)] ?? '?',
+    finding: CALLS[dv.getUint8(p + 90)] ?? '?', met: dv.getUint8(p + 91),
+    points: [0, 1, 2, 3, 4].map((i) => dv.getUint8(p + 92 + i)),
+    score: dv.getUint8(p + 97), scoreMax: dv.getUint8(p + 98),
+  };
+  sc.assessment = a;
+  $('assessment').hidden = false;
+  const lines = [`score ${a.score}/${a.scoreMax}`];
+  CRITERIA.forEach((c, i) => lines.push(`${(a.met >> i) & 1 ? '\u2713' : '\u2717'} ${c} (${a.points[i]})`));
+  for (const v of ves) {
+    if (v.inView > 0) lines.push(`${v.name}: min ratio ${v.min.toFixed(3)}${v.coapted ? ' (coapted)' : ''}` +
+                                 (v.force >= 0 ? ` at ${v.force.toFixed(1)} N` : ''));
+  }
+  if (a.peakForce >= 0) lines.push(`peak force ${a.peakForce.toFixed(1)} N`);
+  lines.push(`call ${a.call}; case finding ${a.call === 'none' ? 'hidden until the call' : a.finding}`);
+  $('assessment-body').textContent = lines.join('\n');
+}
+
 function onRecord(buf) {
   const dv = new DataView(buf, 1), u8 = new Uint8Array(buf, 1);
   if (dv.byteLength < 16 || dv.getUint32(0, true) !== 0x54534353 || dv.getUint8(4) !== 1) return;
@@ -320,7 +350,7 @@ function onRecord(buf) {
   else if (type === 2) onSurfInfo(dv, p, u8);
   else if (type === 3) onVerts(dv, p);
   else if (type === 4) onTris(dv, p);
-  else if (type === 6) { sc.assessment = u8.slice(p); $('assessment').hidden = false; $('assessment-body').textContent = `assessment record (${dv.getUint16(6, true)} bytes)`; }
+  else if (type === 6) onAssessment(dv, p);
   // CATALOGUE records reach the page as the gateway's JSON catalogue (with the case texts)
 }
 
@@ -392,6 +422,8 @@ for (const r of document.querySelectorAll('input[name=method]')) {
   };
 }
 for (const b of document.querySelectorAll('[data-reset]')) b.onclick = () => send({ op: 'reset', target: b.dataset.reset });
+for (const b of document.querySelectorAll('[data-call]')) b.onclick = () => send({ op: 'assess', action: 'call', call: b.dataset.call });
+$('assess-reset').onclick = () => send({ op: 'assess', action: 'reset' });
 $('unlock').onclick = () => send({ op: 'auth', pass: $('pass').value });
 
 // material sliders: shown, disabled (no material command in the CAN protocol)
