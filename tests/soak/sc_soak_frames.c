@@ -226,7 +226,15 @@ int main(int argc, char **argv)
         }
         sc_engine_status st;
         sc_engine_get_status(&rig.engine, &st);
-        CHECK(k->frames == c->can_rx_frames);
+        /* every received frame went to the tracker or, on the needle's ids, to its receiver */
+        uint64_t needle_frames = 0;
+#if SC_ENABLE_NEEDLE
+        const sc_needle_rx *nrx = sc_engine_get_needle_rx(&rig.engine);
+        for (int o = 0; o < (int)SC_NEEDLE_OUTCOME_COUNT; o++) {
+            needle_frames += nrx->outcome[o];
+        }
+#endif
+        CHECK(k->frames + needle_frames == c->can_rx_frames);
         CHECK(outcomes == k->frames);
         CHECK(rig.tap.frames == c->can_rx_frames);
         CHECK(st.misses == 0u);
