@@ -3,6 +3,7 @@
  * over-long messages are refused with a reason. */
 #include "sc_test.h"
 
+#include <stdio.h>
 #include <string.h>
 
 #include "gw_msg.h"
