@@ -25,6 +25,7 @@ const outDir = path.join(process.env.SC_OUT_DIR ?? path.join(build ?? '.', 'brow
 const consoleDir = process.env.SC_CONSOLE_SRC; // tools/console (node_modules)
 mkdirSync(outDir, { recursive: true });
 
+const procs = []; // the programs started (declared first: fail() stops them)
 function skip(why) { console.log(`SKIPPED: ${why}`); process.exit(77); }
 async function fail(why) {
   console.log(`FAIL: ${why}`);
@@ -52,7 +53,6 @@ const freeTcp = () => new Promise((res) => { const s = createServer(); s.listen(
 const freeUdp = () => new Promise((res) => { const s = createSocket('udp4'); s.bind(0, '127.0.0.1', () => { const p = s.address().port; s.close(() => res(p)); }); });
 function sleep(ms) { return new Promise((r) => setTimeout(r, ms)); }
 
-const procs = [];
 function start(name, args) {
   const p = spawn(args[0], args.slice(1), { stdio: ['ignore', 'pipe', 'pipe'] });
   p.out = '';
@@ -178,7 +178,8 @@ if (scenario === 'sessions') {
   await waitFor(page, () => window.sc.replay.state === 'ended', null, 'the replay ended', 60000);
   const end = await page.evaluate(() => window.sc.replay);
   if (!end.ok) await fail(`the replay failed (exit ${end.exit}): every image hash must match`);
-  const maxFrame = await page.evaluate(() => window.sc.frame.frames);
+  const maxFrame = end.frame; // the replay's newest frame the page saw
+  if (!(maxFrame >= 0.9 * bundle.frames)) await fail(`the page saw the replay only up to frame ${maxFrame} of ${bundle.frames}`);
   await waitFor(page, (c) => window.sc.frame.caseCrc === c && window.sc.frame.frames > 0, live.crc, 'back on the live engine');
   ok(`replay ended (every image hash matched, last replay frame seen ${maxFrame}/${bundle.frames}); back on the live engine at frame ${await page.evaluate(() => window.sc.frame.frames)}`);
 } else if (scenario === 'press') {

@@ -403,13 +403,14 @@ function renderSessions(m) {
 }
 
 function onReplay(m) {
-  sc.replay = { ...m, frame: 0 };
+  // frame: the replay's newest frame seen (kept when it ends)
+  sc.replay = { ...m, frame: m.state === 'running' ? 0 : (sc.replay?.frame ?? 0) };
   sc.replays.push(m);
   if (m.state === 'running') {
     $('replay-status').textContent = `replaying ${m.name} (frame 0/${m.frames})`;
     log(`replay of ${m.name} (${m.case}, ${m.frames} frames) started`);
   } else {
-    $('replay-status').textContent = `live (replay of ${m.name} ${m.ok ? 'ended, every image hash matched' : `failed, exit ${m.exit}`})`;
+    $('replay-status').textContent = `live (replay of ${m.name} ${m.ok ? 'ended, every image hash matched' : `failed, exit ${m.exit}`}, frame ${sc.replay.frame} seen)`;
     log(`replay of ${m.name} ended`);
     send({ op: 'sessions' });
   }
