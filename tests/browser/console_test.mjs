@@ -162,9 +162,13 @@ if (scenario === 'sessions') {
   await waitFor(page, (e0) => window.sc.errors.length >= e0 + 4, e0, 'four refused replays answered');
   ok(`refused: ${await page.evaluate((e0) => window.sc.errors.slice(e0).map((e) => `${e.reason} (refused ${e.refused})`).join('; '), e0)}`);
   // the replay: frames from the bundle's engine (its frame counter restarts, its case), then live
+  await waitFor(page, () => window.sc.frame.frames >= 30, null, 'the live engine past frame 30');
   const live = await page.evaluate(() => ({ frames: window.sc.frame.frames, crc: window.sc.frame.caseCrc }));
   if (live.crc === parseInt(bundle.case_id, 16)) await fail('the live engine runs the bundle\'s case: the test cannot tell them apart');
   await page.click('[data-testid="replay-press.scb"]');
+  // a command right behind it (the same WebSocket, so the gateway sees it after the replay op) is
+  // refused: it would go to the live engine, not the one shown
+  await page.evaluate(() => window.scSend({ op: 'method', value: 'fem' }));
   await waitFor(page, () => window.sc.replay?.state === 'running', null, 'the replay started');
   await waitFor(page, (crc) => window.sc.frame.caseCrc === crc && window.sc.frame.frames > 0, parseInt(bundle.case_id, 16),
     'frames of the replay (the bundle\'s case) arrive', 30000);
@@ -172,8 +176,6 @@ if (scenario === 'sessions') {
   if (!(during.frames < live.frames)) await fail(`the frame counter did not restart: ${during.frames} after ${live.frames}`);
   if (!new RegExp(`^replaying press\\.scb \\(frame \\d+/${bundle.frames}\\)$`).test(during.status)) await fail(`status line "${during.status}"`);
   ok(`replaying: frame counter ${live.frames} (live) -> ${during.frames}, case 0x${(parseInt(bundle.case_id, 16) >>> 0).toString(16)}; "${during.status}"`);
-  // a command during the replay is refused (it would go to the live engine, not the one shown)
-  await page.click('[data-testid=method-fem]');
   await waitFor(page, () => window.sc.errors.some((e) => /replay is running/.test(e.reason)), null, 'a command during the replay refused');
   await waitFor(page, () => window.sc.replay.state === 'ended', null, 'the replay ended', 60000);
   const end = await page.evaluate(() => window.sc.replay);

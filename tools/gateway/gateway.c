@@ -468,6 +468,11 @@ static int bundle_check(const char *name, sc_bundle_info *info, char *why, size_
 {
     char path[4096];
     snprintf(path, sizeof path, "%s/%s", opt.sessions_dir, name);
+    struct stat sb;
+    if (stat(path, &sb) != 0 || !S_ISREG(sb.st_mode)) {
+        snprintf(why, wcap, "no such bundle in the sessions folder");
+        return -1;
+    }
     uint8_t *buf = NULL;
     size_t len = 0;
     sc_bundle_reject r = SC_BDL_OK;
@@ -584,7 +589,7 @@ static int replay_start(const char *name, char *why, size_t wcap)
     sc_bundle_info info;
     char bwhy[160];
     if (bundle_check(name, &info, bwhy, sizeof bwhy) != 0) {
-        snprintf(why, wcap, "%s is not a valid bundle: %s", name, bwhy);
+        snprintf(why, wcap, "%s: %s", name, bwhy);
         return -1;
     }
     char path[4096], out[4096], st[64], dl[64];

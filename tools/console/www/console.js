@@ -406,6 +406,7 @@ function onReplay(m) {
   // frame: the replay's newest frame seen (kept when it ends)
   sc.replay = { ...m, frame: m.state === 'running' ? 0 : (sc.replay?.frame ?? 0) };
   sc.replays.push(m);
+  sc.lastSeq = -1; // another engine's sequence numbers follow (the gateway resets its own count too)
   if (m.state === 'running') {
     $('replay-status').textContent = `replaying ${m.name} (frame 0/${m.frames})`;
     log(`replay of ${m.name} (${m.case}, ${m.frames} frames) started`);
