@@ -7,6 +7,10 @@
 //             but not control without the pass phrase; zero deadline misses with clients connected
 //   press     the tracker emulator presses the probe; a screenshot of the 3D view shows the vein
 //             narrower than at rest
+//   sessions  a short session recorded as a bundle (sc-hostsim --record-bundle) is listed on the
+//             page with its score (sc-gateway --sessions); refused names and a broken bundle are
+//             answered; the replay button replays it into the console (its frames, its case), and
+//             the console is back on the live engine after it
 // Exit 0 pass, 1 fail, 77 skipped (chromium genuinely unavailable).
 import { spawn, spawnSync } from 'node:child_process';
 import { existsSync, mkdirSync, readFileSync, writeFileSync } from 'node:fs';
@@ -21,6 +25,7 @@ const outDir = path.join(process.env.SC_OUT_DIR ?? path.join(build ?? '.', 'brow
 const consoleDir = process.env.SC_CONSOLE_SRC; // tools/console (node_modules)
 mkdirSync(outDir, { recursive: true });
 
+const procs = []; // the programs started (declared first: fail() stops them)
 function skip(why) { console.log(`SKIPPED: ${why}`); process.exit(77); }
 async function fail(why) {
   console.log(`FAIL: ${why}`);
@@ -48,7 +53,6 @@ const freeTcp = () => new Promise((res) => { const s = createServer(); s.listen(
 const freeUdp = () => new Promise((res) => { const s = createSocket('udp4'); s.bind(0, '127.0.0.1', () => { const p = s.address().port; s.close(() => res(p)); }); });
 function sleep(ms) { return new Promise((r) => setTimeout(r, ms)); }
 
-const procs = [];
 function start(name, args) {
   const p = spawn(args[0], args.slice(1), { stdio: ['ignore', 'pipe', 'pipe'] });
   p.out = '';
@@ -72,12 +76,30 @@ async function waitFor(page, fn, arg, what, ms = 20000) {
 
 const [canPort, statePort, dlinkPort, httpPort] = [await freeUdp(), await freeUdp(), await freeUdp(), await freeTcp()];
 const pass = 'instructor';
+// sessions: a recorded bundle (another case than the live engine's, 3 s of the press script, the
+// trainee's call) and a broken one in the gateway's sessions folder
+const sessDir = path.join(outDir, 'sessions');
+const hostsim = path.join(build, 'platform/hostsim/sc-hostsim');
+let bundle = null;
+if (scenario === 'sessions') {
+  mkdirSync(sessDir, { recursive: true });
+  const rec = spawnSync(hostsim, ['--case', 'femoral', '--cases-dir', path.join(build, 'cases'), '--script', 'press',
+    '--seconds', '3', '--every', '0', '--quiet', '--call', 'normal', '--out', path.join(outDir, 'record'),
+    '--record-bundle', path.join(sessDir, 'press.scb')], { encoding: 'utf8' });
+  if (rec.status !== 0) await fail(`sc-hostsim --record-bundle failed (${rec.status}): ${rec.stdout}${rec.stderr}`);
+  writeFileSync(path.join(sessDir, 'broken.scb'), 'SCBUNDLE 1\nnot a bundle\n');
+  const list = spawnSync(hostsim, ['--list-bundles', sessDir], { encoding: 'utf8' });
+  bundle = JSON.parse(list.stdout).bundles.find((b) => b.file === 'press.scb');
+  if (!bundle || bundle.error) await fail(`the recorded bundle is not listed by --list-bundles: ${list.stdout}`);
+  ok(`recorded press.scb: ${bundle.case} ${bundle.method}, ${bundle.frames} frames, score ${bundle.score}/${bundle.score_max}`);
+}
 const engine = start('sc-hostsim', [path.join(build, 'platform/hostsim/sc-hostsim'), '--live', '--case', 'neck-ijv',
   '--cases-dir', path.join(build, 'cases'), '--can-udp', String(canPort), '--state-udp', `127.0.0.1:${statePort}`,
   '--dlink-udp', `127.0.0.1:${dlinkPort}`, '--seconds', '300', '--every', '0', '--quiet', '--out', path.join(outDir, 'engine')]);
 const gateway = start('sc-gateway', [path.join(build, 'tools/gateway/sc-gateway'), '--port', String(httpPort),
   '--www', path.join(build, 'console'), '--state-port', String(statePort), '--dlink-port', String(dlinkPort),
-  '--can-udp', `127.0.0.1:${canPort}`, '--cases-dir', path.join(build, 'cases'), '--pass', pass]);
+  '--can-udp', `127.0.0.1:${canPort}`, '--cases-dir', path.join(build, 'cases'), '--pass', pass,
+  ...(scenario === 'sessions' ? ['--sessions', sessDir, '--hostsim', hostsim] : [])]);
 process.on('exit', cleanup);
 // a playwright error (a timeout, a lost page) fails the test with the programs' reports
 process.on('uncaughtException', (e) => { fail(`unexpected error: ${e.message.split('\n')[0]}`); });
@@ -125,7 +147,44 @@ async function veinHeight(label) {
   }, png.toString('base64'));
 }
 
-if (scenario === 'press') {
+if (scenario === 'sessions') {
+  // the list: the recorded session with its score, the broken one with its reason
+  await waitFor(page, () => window.sc.sessions.length === 2, null, 'the Sessions panel lists the two bundles');
+  const row = await page.locator('#sessions tr[data-file="press.scb"]').innerText();
+  const want = [bundle.case, bundle.method, String(bundle.frames), `${bundle.score}/${bundle.score_max}`];
+  if (!want.every((w) => row.includes(w))) await fail(`the session's row "${row}" lacks one of ${JSON.stringify(want)}`);
+  const bad = await page.locator('#sessions tr[data-file="broken.scb"]').innerText();
+  if (!/refused/.test(bad)) await fail(`the broken bundle is not shown as refused: "${bad}"`);
+  ok(`listed: "${row.replace(/\s+/g, ' ').trim()}"; "${bad.trim()}"`);
+  // refused replays: names that leave the folder, an empty one, a broken bundle
+  const e0 = await page.evaluate(() => window.sc.errors.length);
+  for (const n of ['../x.scb', 'a/b.scb', '', 'broken.scb']) await page.evaluate((n) => window.scSend(JSON.stringify({ op: 'replay', name: n })), n);
+  await waitFor(page, (e0) => window.sc.errors.length >= e0 + 4, e0, 'four refused replays answered');
+  ok(`refused: ${await page.evaluate((e0) => window.sc.errors.slice(e0).map((e) => `${e.reason} (refused ${e.refused})`).join('; '), e0)}`);
+  // the replay: frames from the bundle's engine (its frame counter restarts, its case), then live
+  await waitFor(page, () => window.sc.frame.frames >= 30, null, 'the live engine past frame 30');
+  const live = await page.evaluate(() => ({ frames: window.sc.frame.frames, crc: window.sc.frame.caseCrc }));
+  if (live.crc === parseInt(bundle.case_id, 16)) await fail('the live engine runs the bundle\'s case: the test cannot tell them apart');
+  await page.click('[data-testid="replay-press.scb"]');
+  // a command right behind it (the same WebSocket, so the gateway sees it after the replay op) is
+  // refused: it would go to the live engine, not the one shown
+  await page.evaluate(() => window.scSend({ op: 'method', value: 'fem' }));
+  await waitFor(page, () => window.sc.replay?.state === 'running', null, 'the replay started');
+  await waitFor(page, (crc) => window.sc.frame.caseCrc === crc && window.sc.frame.frames > 0, parseInt(bundle.case_id, 16),
+    'frames of the replay (the bundle\'s case) arrive', 30000);
+  const during = await page.evaluate(() => ({ frames: window.sc.frame.frames, status: document.querySelector('#replay-status').textContent }));
+  if (!(during.frames < live.frames)) await fail(`the frame counter did not restart: ${during.frames} after ${live.frames}`);
+  if (!new RegExp(`^replaying press\\.scb \\(frame \\d+/${bundle.frames}\\)$`).test(during.status)) await fail(`status line "${during.status}"`);
+  ok(`replaying: frame counter ${live.frames} (live) -> ${during.frames}, case 0x${(parseInt(bundle.case_id, 16) >>> 0).toString(16)}; "${during.status}"`);
+  await waitFor(page, () => window.sc.errors.some((e) => /replay is running/.test(e.reason)), null, 'a command during the replay refused');
+  await waitFor(page, () => window.sc.replay.state === 'ended', null, 'the replay ended', 60000);
+  const end = await page.evaluate(() => window.sc.replay);
+  if (!end.ok) await fail(`the replay failed (exit ${end.exit}): every image hash must match`);
+  const maxFrame = end.frame; // the replay's newest frame the page saw
+  if (!(maxFrame >= 0.9 * bundle.frames)) await fail(`the page saw the replay only up to frame ${maxFrame} of ${bundle.frames}`);
+  await waitFor(page, (c) => window.sc.frame.caseCrc === c && window.sc.frame.frames > 0, live.crc, 'back on the live engine');
+  ok(`replay ended (every image hash matched, last replay frame seen ${maxFrame}/${bundle.frames}); back on the live engine at frame ${await page.evaluate(() => window.sc.frame.frames)}`);
+} else if (scenario === 'press') {
   await waitFor(page, () => window.sc.surf && window.sc.surf.count >= 2, null, 'surfaces of the case');
   await sleep(2500); // every triangle and vertex round has arrived
   const rest = await veinHeight('rest');

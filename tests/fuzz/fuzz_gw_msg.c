@@ -25,8 +25,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         SC_FUZZ_CHECK(sc_canproto_decode_cmd(&f, &back) == 0 && back.kind == m.cmd.kind);
     } else if (m.op == GW_OP_AUTH) {
         SC_FUZZ_CHECK(strlen(m.pass) < GW_MSG_PASS_MAX);
+    } else if (m.op == GW_OP_REPLAY) {
+        /* a plain file name in the sessions folder: never a path */
+        SC_FUZZ_CHECK(gw_msg_bundle_name_ok(m.file) && strchr(m.file, '/') == NULL &&
+                      strstr(m.file, "..") != m.file && m.file[0] != '.');
     } else {
-        SC_FUZZ_CHECK(m.op == GW_OP_PING);
+        SC_FUZZ_CHECK(m.op == GW_OP_PING || m.op == GW_OP_SESSIONS);
     }
     return 0;
 }
@@ -35,6 +39,8 @@ size_t sc_fuzz_seed(uint32_t i, uint8_t *buf, size_t cap)
 {
     static const char *const seeds[] = {
         "{\"op\":\"case\",\"id\":1}",
+        "{\"op\":\"sessions\"}",
+        "{\"op\":\"replay\",\"name\":\"press.scb\"}",
         "{\"op\":\"method\",\"value\":\"fem\"}",
         "{\"op\":\"imaging\",\"depth_mm\":40,\"gain_db\":12.5,\"dyn_range_db\":60,\"tgc_db_per_cm\":1,\"geometry\":\"linear\"}",
         "{\"op\":\"reset\",\"target\":\"tissue\"}",

@@ -3,6 +3,7 @@
  * over-long messages are refused with a reason. */
 #include "sc_test.h"
 
+#include <stdio.h>
 #include <string.h>
 
 #include "gw_msg.h"
@@ -86,11 +87,63 @@ static void bad_messages_are_refused_with_a_reason(void **state)
     assert_string_equal(why, "message too long");
 }
 
+static void session_ops_parse_and_bad_names_are_refused(void **state)
+{
+    (void)state;
+    gw_msg m;
+    const char *why = NULL;
+    assert_int_equal(parse("{\"op\":\"sessions\"}", &m, &why), 0);
+    assert_int_equal(m.op, GW_OP_SESSIONS);
+    assert_int_equal(parse("{\"op\":\"sessions\",\"dir\":\"/etc\"}", &m, &why), -1);
+    assert_int_equal(parse("{\"op\":\"replay\",\"name\":\"press-2026_11.24.scb\"}", &m, &why), 0);
+    assert_int_equal(m.op, GW_OP_REPLAY);
+    assert_string_equal(m.name, "replay");
+    assert_string_equal(m.file, "press-2026_11.24.scb");
+    /* names that leave the folder, are empty, too long, hidden or not bundles */
+    static const char *const bad[] = {
+        "{\"op\":\"replay\",\"name\":\"../x.scb\"}",
+        "{\"op\":\"replay\",\"name\":\"a/b.scb\"}",
+        "{\"op\":\"replay\",\"name\":\"/abs.scb\"}",
+        "{\"op\":\"replay\",\"name\":\"a\\\\b.scb\"}",
+        "{\"op\":\"replay\",\"name\":\"\"}",
+        "{\"op\":\"replay\",\"name\":\".scb\"}",
+        "{\"op\":\"replay\",\"name\":\".hidden.scb\"}",
+        "{\"op\":\"replay\",\"name\":\"session.txt\"}",
+        "{\"op\":\"replay\",\"name\":\"a b.scb\"}",
+        "{\"op\":\"replay\",\"name\":7}",
+        "{\"op\":\"replay\"}",
+        "{\"op\":\"replay\",\"name\":\"a.scb\",\"x\":1}",
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        why = NULL;
+        assert_int_equal(parse(bad[i], &m, &why), -1);
+        assert_non_null(why);
+    }
+    /* too long: one byte over the limit (the parser's own string limit is larger) */
+    char name[GW_MSG_FILE_MAX + 1];
+    memset(name, 'a', sizeof name);
+    memcpy(name + GW_MSG_FILE_MAX - 4, ".scb", 5);
+    assert_int_equal(strlen(name), GW_MSG_FILE_MAX);
+    char msg[256];
+    snprintf(msg, sizeof msg, "{\"op\":\"replay\",\"name\":\"%s\"}", name);
+    assert_int_equal(parse(msg, &m, &why), -1);
+    assert_non_null(strstr(why, "plain file name"));
+    /* the longest accepted */
+    memcpy(name + GW_MSG_FILE_MAX - 5, ".scb", 5);
+    snprintf(msg, sizeof msg, "{\"op\":\"replay\",\"name\":\"%s\"}", name);
+    assert_int_equal(parse(msg, &m, &why), 0);
+    assert_int_equal(strlen(m.file), GW_MSG_FILE_MAX - 1);
+    assert_true(gw_msg_bundle_name_ok("x.scb"));
+    assert_false(gw_msg_bundle_name_ok("../x.scb"));
+    assert_false(gw_msg_bundle_name_ok(NULL));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(each_protocol_command_parses),
         cmocka_unit_test(bad_messages_are_refused_with_a_reason),
+        cmocka_unit_test(session_ops_parse_and_bad_names_are_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -12,6 +12,14 @@
  * (--pass / --pass-file). The gateway is a separate process: nothing it or its clients do
  * reaches the engine's frame but CAN frames, so the engine's deadline does not depend on it.
  *
+ * Recorded sessions (--sessions DIR, a folder of session bundles, docs/session-bundle.md): the
+ * "sessions" op lists them (validated by sc_bundle_parse, refused ones with their reason); the
+ * "replay" op starts `sc-hostsim --replay DIR/FILE --live` as a second engine whose state stream
+ * and display link come to two more UDP ports of the gateway; while it runs the gateway forwards
+ * the replay's stream instead of the live engine's (whose packets are drained and counted; the
+ * live engine runs on untouched) and refuses commands; when it exits the console is back on the
+ * live engine. One replay at a time; controls locked like the commands.
+ *
  * Threads: a receive thread (UDP state + display link) fills a ring and the newest frame under
  * a mutex and wakes libwebsockets' service thread (lws_cancel_service), which alone writes to
  * clients and sends CAN frames.
@@ -29,11 +37,16 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <spawn.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <dirent.h>
 #include <time.h>
 #include <unistd.h>
 
 #include "gw_msg.h"
+#include "sc_bundle.h"
 #include "sc_case.h"
 #include "sc_cmdsign.h"
 #include "sc_dlink.h"
@@ -48,6 +61,10 @@
 #define BSCAN_HDR 32u
 #define BSCAN_MAX (BSCAN_HDR + SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES)
 #define TEXT_MAX 16384u
+#define SESS_MAX 64u                  /* bundles listed */
+#define SESS_JSON_MAX 49152u          /* the list's JSON */
+#define BUNDLE_READ_MAX ((size_t)1 << 30)
+_Static_assert(SESS_JSON_MAX <= BSCAN_MAX + TEXT_MAX, "the sessions list fits a client's buffer");
 
 typedef struct gw_opts {
     int port;
@@ -61,6 +78,8 @@ typedef struct gw_opts {
     const char *cases_dir;
     double bscan_hz;
     double seconds;
+    const char *sessions_dir; /* --sessions */
+    const char *hostsim;      /* --hostsim */
 } gw_opts;
 
 /* ---- shared between the receive thread and the service thread (under g.lock) -------------- */
@@ -80,6 +99,8 @@ static struct {
     uint64_t state_records, state_rejected, state_gaps, dlink_frames, dlink_rejected;
     uint32_t last_seq;
     int have_seq;
+    int replay_on;          /* forward the replay engine's stream, drain the live one's */
+    uint64_t other_dropped; /* packets of the engine not shown (counted) */
 } g = {.lock = PTHREAD_MUTEX_INITIALIZER};
 
 /* ---- service-thread state ----------------------------------------------------------------- */
@@ -92,12 +113,23 @@ static sc_socketcan can_sock;
 static sc_udpcan can_udp;
 static uint64_t cmds_sent, cmds_refused, can_tx_failed, clients_now, clients_total;
 static int udp_state_fd = -1, udp_dlink_fd = -1;
+static const struct lws_protocols *console_protocol;
+static int udp_rstate_fd = -1, udp_rdlink_fd = -1; /* the replay engine's (--sessions) */
+static uint16_t rstate_port, rdlink_port;
+/* the replay (service thread only) */
+static pid_t replay_pid = -1;
+static char replay_name[GW_MSG_FILE_MAX];
+static char replay_json[1024];
+static uint64_t replay_gen, replays_started, replays_failed;
+static char sess_json[SESS_JSON_MAX];
 
 typedef struct client {
     uint64_t next_rec;   /* ring index of the next record to send */
     uint64_t bscan_gen;  /* last frame sent */
     double bscan_t;      /* when */
     uint64_t cat_gen;
+    uint64_t replay_gen; /* last replay status sent */
+    int want_sessions;   /* the sessions list is due */
     int unlocked;
     uint64_t refused, skipped;
     char rx[GW_MSG_MAX + 1u];
@@ -225,6 +257,14 @@ static int bind_udp(uint16_t port)
     return fd;
 }
 
+/* a packet of the engine not shown (the live one during a replay, the replay's stragglers) */
+static void drop_other(void)
+{
+    pthread_mutex_lock(&g.lock);
+    g.other_dropped++;
+    pthread_mutex_unlock(&g.lock);
+}
+
 static void on_state(const uint8_t *b, size_t n)
 {
     uint32_t seq = 0, fno = 0;
@@ -294,36 +334,53 @@ static void on_frame(const sc_dlink_done *d)
 static void *rx_thread(void *arg)
 {
     (void)arg;
-    static sc_dlink_asm as;
+    static sc_dlink_asm as[2]; /* live, replay */
     static uint8_t buf[65536];
-    sc_dlink_asm_init(&as);
+    sc_dlink_asm_init(&as[0]);
+    sc_dlink_asm_init(&as[1]);
+    const int sources = udp_rstate_fd >= 0 ? 2 : 1;
     while (!stop) {
-        struct pollfd pf[2] = {{udp_state_fd, POLLIN, 0}, {udp_dlink_fd, POLLIN, 0}};
-        if (poll(pf, 2, 100) <= 0) {
+        struct pollfd pf[4] = {{udp_state_fd, POLLIN, 0}, {udp_dlink_fd, POLLIN, 0},
+                               {udp_rstate_fd, POLLIN, 0}, {udp_rdlink_fd, POLLIN, 0}};
+        if (poll(pf, (nfds_t)(2 * sources), 100) <= 0) {
             continue;
         }
+        pthread_mutex_lock(&g.lock);
+        const int shown = g.replay_on ? 1 : 0;
+        pthread_mutex_unlock(&g.lock);
         int woke = 0;
-        for (int k = 0; k < 256; k++) {
-            const ssize_t n = recv(udp_state_fd, buf, sizeof buf, MSG_DONTWAIT);
-            if (n < 0) {
-                break;
-            }
-            on_state(buf, (size_t)n);
-            woke = 1;
-        }
-        for (int k = 0; k < 4096; k++) {
-            const ssize_t n = recv(udp_dlink_fd, buf, sizeof buf, MSG_DONTWAIT);
-            if (n < 0) {
-                break;
-            }
-            const int r = sc_dlink_asm_push(&as, buf, (size_t)n);
-            if (r == 1) {
-                on_frame(&as.done);
+        for (int src = 0; src < sources; src++) {
+            const int sfd = src ? udp_rstate_fd : udp_state_fd, dfd = src ? udp_rdlink_fd : udp_dlink_fd;
+            for (int k = 0; k < 256; k++) {
+                const ssize_t n = recv(sfd, buf, sizeof buf, MSG_DONTWAIT);
+                if (n < 0) {
+                    break;
+                }
+                if (src != shown) {
+                    drop_other();
+                    continue;
+                }
+                on_state(buf, (size_t)n);
                 woke = 1;
-            } else if (r < 0) {
-                pthread_mutex_lock(&g.lock);
-                g.dlink_rejected++;
-                pthread_mutex_unlock(&g.lock);
+            }
+            for (int k = 0; k < 4096; k++) {
+                const ssize_t n = recv(dfd, buf, sizeof buf, MSG_DONTWAIT);
+                if (n < 0) {
+                    break;
+                }
+                if (src != shown) {
+                    drop_other();
+                    continue;
+                }
+                const int r = sc_dlink_asm_push(&as[src], buf, (size_t)n);
+                if (r == 1) {
+                    on_frame(&as[src].done);
+                    woke = 1;
+                } else if (r < 0) {
+                    pthread_mutex_lock(&g.lock);
+                    g.dlink_rejected++;
+                    pthread_mutex_unlock(&g.lock);
+                }
             }
         }
         if (woke && ctx) {
@@ -399,6 +456,216 @@ static int pass_ok(const char *p)
     return d == 0u;
 }
 
+/* ---- recorded sessions -------------------------------------------------------------------- */
+
+static int name_cmp(const void *a, const void *b)
+{
+    return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+/* Read and validate DIR/name: 0 with *info, or -1 with *why. */
+static int bundle_check(const char *name, sc_bundle_info *info, char *why, size_t wcap)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s", opt.sessions_dir, name);
+    struct stat sb;
+    if (stat(path, &sb) != 0 || !S_ISREG(sb.st_mode)) {
+        snprintf(why, wcap, "no such bundle in the sessions folder");
+        return -1;
+    }
+    uint8_t *buf = NULL;
+    size_t len = 0;
+    sc_bundle_reject r = SC_BDL_OK;
+    uint64_t line = 0;
+    int rc = sc_bundle_read_file(path, BUNDLE_READ_MAX, &buf, &len);
+    if (rc == SC_OK) {
+        rc = sc_bundle_parse(buf, len, info, &r, &line);
+        free(buf);
+    }
+    if (rc != SC_OK) {
+        if (r != SC_BDL_OK) {
+            snprintf(why, wcap, "%s (line %" PRIu64 ")", sc_bundle_reject_name(r), line);
+        } else {
+            snprintf(why, wcap, "%s", sc_err_str(rc));
+        }
+        return -1;
+    }
+    return 0;
+}
+
+/* The sessions list as JSON into sess_json (the same fields as sc-hostsim --list-bundles). */
+static void sessions_build(void)
+{
+    size_t n = (size_t)snprintf(sess_json, sizeof sess_json, "{\"type\":\"sessions\",\"entries\":[");
+    uint32_t count = 0, refused = 0, more = 0;
+    DIR *d = opt.sessions_dir ? opendir(opt.sessions_dir) : NULL;
+    if (d != NULL) {
+        static char names[SESS_MAX][GW_MSG_FILE_MAX];
+        const char *sorted[SESS_MAX];
+        uint32_t k = 0;
+        const struct dirent *de;
+        while ((de = readdir(d)) != NULL) {
+            const size_t l = strlen(de->d_name);
+            if (l > 4u && strcmp(de->d_name + l - 4u, ".scb") == 0) {
+                if (k < SESS_MAX && l < GW_MSG_FILE_MAX) {
+                    memcpy(names[k], de->d_name, l + 1u); /* l < GW_MSG_FILE_MAX */
+                    sorted[k] = names[k];
+                    k++;
+                } else {
+                    more++; /* not listed: too many, or a name too long to ask for */
+                }
+            }
+        }
+        closedir(d);
+        qsort(sorted, k, sizeof sorted[0], name_cmp);
+        for (uint32_t i = 0; i < k && n + 1200u < sizeof sess_json; i++) {
+            char jf[2 * GW_MSG_FILE_MAX + 8], why[160], jw[400], jc[300], jd[300];
+            sc_bundle_info info;
+            json_str(jf, sizeof jf, sorted[i]);
+            n += (size_t)snprintf(sess_json + n, sizeof sess_json - n, "%s{\"file\":%s",
+                                  count ? "," : "", jf);
+            count++;
+            if (!gw_msg_bundle_name_ok(sorted[i])) {
+                refused++;
+                n += (size_t)snprintf(sess_json + n, sizeof sess_json - n,
+                                      ",\"error\":\"not a plain file name (cannot be replayed)\"}");
+            } else if (bundle_check(sorted[i], &info, why, sizeof why) != 0) {
+                refused++;
+                json_str(jw, sizeof jw, why);
+                n += (size_t)snprintf(sess_json + n, sizeof sess_json - n, ",\"error\":%s}", jw);
+            } else {
+                const sc_bundle_meta *m = &info.meta;
+                json_str(jc, sizeof jc, m->case_name);
+                json_str(jd, sizeof jd, m->date);
+                n += (size_t)snprintf(
+                    sess_json + n, sizeof sess_json - n,
+                    ",\"case\":%s,\"case_id\":\"0x%08x\",\"method\":\"%s\",\"date\":%s,"
+                    "\"frames\":%" PRIu64 ",\"rate_hz\":%u,\"seconds\":%.3f,\"score\":%u,"
+                    "\"score_max\":%u,\"criteria_met\":%u,\"call\":\"%s\",\"finding\":\"%s\"}",
+                    jc, m->case_id, m->method ? "fem" : "msds", jd, m->frames, m->rate_hz,
+                    m->rate_hz ? (double)m->frames / (double)m->rate_hz : 0.0, m->score,
+                    m->score_max, m->criteria, sc_bundle_call_name(m->call),
+                    sc_bundle_call_name(m->finding));
+            }
+        }
+    }
+    snprintf(sess_json + n, sizeof sess_json - n,
+             "],\"count\":%u,\"refused\":%u,\"not_listed\":%u,\"folder\":%s}", count, refused,
+             more, d != NULL || opt.sessions_dir == NULL ? "true" : "false");
+}
+
+static void replay_status(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static void replay_status(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(replay_json, sizeof replay_json, fmt, ap);
+    va_end(ap);
+    replay_gen++;
+    if (ctx) {
+        lws_callback_on_writable_all_protocol(ctx, console_protocol);
+    }
+}
+
+static void replay_switch(int on)
+{
+    pthread_mutex_lock(&g.lock);
+    g.replay_on = on;
+    g.have_seq = 0; /* another engine's sequence numbers */
+    pthread_mutex_unlock(&g.lock);
+}
+
+/* Start the replay of DIR/name: 0, or -1 with *why. */
+static int replay_start(const char *name, char *why, size_t wcap)
+{
+    if (opt.sessions_dir == NULL) {
+        snprintf(why, wcap, "no sessions folder (sc-gateway --sessions DIR)");
+        return -1;
+    }
+    if (replay_pid > 0) {
+        snprintf(why, wcap, "a replay is running (%s)", replay_name);
+        return -1;
+    }
+    sc_bundle_info info;
+    char bwhy[160];
+    if (bundle_check(name, &info, bwhy, sizeof bwhy) != 0) {
+        snprintf(why, wcap, "%s: %s", name, bwhy);
+        return -1;
+    }
+    char path[4096], out[4096], st[64], dl[64];
+    snprintf(path, sizeof path, "%s/%s", opt.sessions_dir, name);
+    snprintf(out, sizeof out, "%s/replay-out", opt.sessions_dir);
+    (void)mkdir(out, 0755);
+    snprintf(st, sizeof st, "127.0.0.1:%u", (unsigned)rstate_port);
+    snprintf(dl, sizeof dl, "127.0.0.1:%u", (unsigned)rdlink_port);
+    char *argv[16];
+    int a = 0;
+    argv[a++] = (char *)opt.hostsim;
+    argv[a++] = (char *)"--replay";
+    argv[a++] = path;
+    argv[a++] = (char *)"--live";
+    argv[a++] = (char *)"--state-udp";
+    argv[a++] = st;
+    argv[a++] = (char *)"--dlink-udp";
+    argv[a++] = dl;
+    argv[a++] = (char *)"--every";
+    argv[a++] = (char *)"0";
+    argv[a++] = (char *)"--quiet";
+    argv[a++] = (char *)"--out";
+    argv[a++] = out;
+    if (opt.cases_dir) {
+        argv[a++] = (char *)"--cases-dir";
+        argv[a++] = (char *)opt.cases_dir;
+    }
+    argv[a] = NULL;
+    extern char **environ;
+    pid_t pid;
+    const int rc = posix_spawn(&pid, opt.hostsim, NULL, NULL, argv, environ);
+    if (rc != 0) {
+        snprintf(why, wcap, "cannot start %s: %s", opt.hostsim, strerror(rc));
+        return -1;
+    }
+    replay_pid = pid;
+    replays_started++;
+    snprintf(replay_name, sizeof replay_name, "%s", name);
+    replay_switch(1);
+    char jn[2 * GW_MSG_FILE_MAX + 8], jc[300];
+    json_str(jn, sizeof jn, name);
+    json_str(jc, sizeof jc, info.meta.case_name);
+    replay_status("{\"type\":\"replay\",\"state\":\"running\",\"name\":%s,\"case\":%s,"
+                  "\"frames\":%" PRIu64 ",\"rate_hz\":%u,\"score\":%u,\"score_max\":%u}",
+                  jn, jc, info.meta.frames, info.meta.rate_hz, info.meta.score, info.meta.score_max);
+    printf("sc-gateway: replay of %s started (pid %d, %" PRIu64 " frames)\n", path, (int)pid,
+           info.meta.frames);
+    fflush(stdout);
+    return 0;
+}
+
+/* The replay engine's exit (service loop): back to the live engine. */
+static void replay_reap(int wait_it)
+{
+    if (replay_pid <= 0) {
+        return;
+    }
+    int status = 0;
+    const pid_t r = waitpid(replay_pid, &status, wait_it ? 0 : WNOHANG);
+    if (r != replay_pid) {
+        return;
+    }
+    replay_pid = -1;
+    replay_switch(0);
+    const int ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+    replays_failed += !ok;
+    char jn[2 * GW_MSG_FILE_MAX + 8];
+    json_str(jn, sizeof jn, replay_name);
+    replay_status("{\"type\":\"replay\",\"state\":\"ended\",\"name\":%s,\"ok\":%s,\"exit\":%d}",
+                  jn, ok ? "true" : "false",
+                  WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status));
+    printf("sc-gateway: replay of %s ended (%s, status %d); back to the live engine\n",
+           replay_name, ok ? "every image hash matched" : "FAILED", status);
+    fflush(stdout);
+}
+
 static void on_message(client *cl, const char *text, size_t len)
 {
     gw_msg m;
@@ -419,9 +686,33 @@ static void on_message(client *cl, const char *text, size_t len)
             refuse(cl, "auth", "wrong pass phrase");
         }
         return;
+    case GW_OP_SESSIONS:
+        if (opt.sessions_dir == NULL) {
+            refuse(cl, m.name, "no sessions folder (sc-gateway --sessions DIR)");
+            return;
+        }
+        cl->want_sessions = 1;
+        return;
+    case GW_OP_REPLAY: {
+        if (opt.have_pass && !cl->unlocked) {
+            refuse(cl, m.name, "controls locked: send the pass phrase first");
+            return;
+        }
+        char why2[400];
+        if (replay_start(m.file, why2, sizeof why2) != 0) {
+            refuse(cl, m.name, why2);
+            return;
+        }
+        reply(cl, "{\"type\":\"ack\",\"op\":\"replay\",\"replays\":%" PRIu64 "}", replays_started);
+        return;
+    }
     case GW_OP_COMMAND:
         if (opt.have_pass && !cl->unlocked) {
             refuse(cl, m.name, "controls locked: send the pass phrase first");
+            return;
+        }
+        if (replay_pid > 0) {
+            refuse(cl, m.name, "a replay is running: commands go to the live engine after it");
             return;
         }
         if (send_command(&m.cmd) != SC_OK) {
@@ -456,6 +747,17 @@ static int on_writeable(struct lws *wsi, client *cl)
         cl->out_n--;
         lws_callback_on_writable(wsi);
         return 0;
+    }
+    if (cl->replay_gen != replay_gen) {
+        cl->replay_gen = replay_gen;
+        lws_callback_on_writable(wsi);
+        return write_msg(wsi, cl, replay_json, strlen(replay_json), LWS_WRITE_TEXT);
+    }
+    if (cl->want_sessions) {
+        cl->want_sessions = 0;
+        sessions_build(); /* read now: the folder may have changed */
+        lws_callback_on_writable(wsi);
+        return write_msg(wsi, cl, sess_json, strlen(sess_json), LWS_WRITE_TEXT);
     }
     pthread_mutex_lock(&g.lock);
     int rc = 0, more = 0;
@@ -509,8 +811,9 @@ static int cb_console(struct lws *wsi, enum lws_callback_reasons reason, void *u
         cl->unlocked = !opt.have_pass;
         clients_now++;
         clients_total++;
-        reply(cl, "{\"type\":\"hello\",\"version\":1,\"locked\":%s,\"client\":%" PRIu64 "}",
-              opt.have_pass ? "true" : "false", clients_total);
+        reply(cl, "{\"type\":\"hello\",\"version\":1,\"locked\":%s,\"client\":%" PRIu64
+                  ",\"sessions\":%s}",
+              opt.have_pass ? "true" : "false", clients_total, opt.sessions_dir ? "true" : "false");
         lws_callback_on_writable(wsi);
         break;
     case LWS_CALLBACK_CLOSED:
@@ -563,9 +866,11 @@ static void print_stats(FILE *f)
     fprintf(f, "sc-gateway: clients %" PRIu64 " now, %" PRIu64 " total; state records %" PRIu64
                " (%" PRIu64 " gaps, %" PRIu64 " rejected); B-scan frames %" PRIu64 " (%" PRIu64
                " bad packets); commands sent %" PRIu64 ", refused %" PRIu64 ", CAN tx failed %" PRIu64
+               "; replays %" PRIu64 " (%" PRIu64 " failed, %s), other engine's packets drained %" PRIu64
                "\n",
             clients_now, clients_total, g.state_records, g.state_gaps, g.state_rejected,
-            g.dlink_frames, g.dlink_rejected, cmds_sent, cmds_refused, can_tx_failed);
+            g.dlink_frames, g.dlink_rejected, cmds_sent, cmds_refused, can_tx_failed,
+            replays_started, replays_failed, replay_pid > 0 ? "running" : "none", g.other_dropped);
     pthread_mutex_unlock(&g.lock);
     fflush(f);
 }
@@ -591,6 +896,8 @@ static void usage(FILE *f)
             "  --cases-dir DIR     where the case files are (catalogue names, descriptions)\n"
             "  --bscan-hz HZ       B-scan frames per second per client, 1..60 (default 20)\n"
             "  --seconds S         stop after S seconds (default: run until SIGINT/SIGTERM)\n"
+            "  --sessions DIR      recorded sessions (*.scb bundles) the console lists and replays\n"
+            "  --hostsim PATH      the sc-hostsim that replays them (default " SC_GATEWAY_HOSTSIM ")\n"
             "  --help\n");
 }
 
@@ -610,10 +917,11 @@ static int parse_port(const char *s, int lo, long *out)
 static int parse_args(int argc, char **argv, gw_opts *o)
 {
     *o = (gw_opts){.port = 8080, .www = SC_GATEWAY_WWW, .state_port = 47001, .dlink_port = 47002,
-                   .sender = 1u, .bscan_hz = 20.0};
+                   .sender = 1u, .bscan_hz = 20.0,
+                   .hostsim = SC_GATEWAY_HOSTSIM};
     memcpy(o->key, sc_secoc_bench_key, sizeof o->key);
     enum { O_PORT = 256, O_WWW, O_SP, O_DP, O_CAN, O_CANUDP, O_KEY, O_SENDER, O_PASS, O_PASSF,
-           O_CASES, O_BHZ, O_SEC, O_HELP };
+           O_CASES, O_BHZ, O_SEC, O_HELP, O_SESS, O_HOSTSIM };
     static const struct option lo[] = {
         {"port", required_argument, 0, O_PORT},      {"www", required_argument, 0, O_WWW},
         {"state-port", required_argument, 0, O_SP},  {"dlink-port", required_argument, 0, O_DP},
@@ -622,6 +930,7 @@ static int parse_args(int argc, char **argv, gw_opts *o)
         {"pass", required_argument, 0, O_PASS},      {"pass-file", required_argument, 0, O_PASSF},
         {"cases-dir", required_argument, 0, O_CASES}, {"bscan-hz", required_argument, 0, O_BHZ},
         {"seconds", required_argument, 0, O_SEC},    {"help", no_argument, 0, O_HELP},
+        {"sessions", required_argument, 0, O_SESS},   {"hostsim", required_argument, 0, O_HOSTSIM},
         {0, 0, 0, 0}};
     int c;
     opterr = 0;
@@ -703,6 +1012,8 @@ static int parse_args(int argc, char **argv, gw_opts *o)
             break;
         }
         case O_CASES: o->cases_dir = optarg; break;
+        case O_SESS: o->sessions_dir = optarg; break;
+        case O_HOSTSIM: o->hostsim = optarg; break;
         case O_BHZ:
         case O_SEC: {
             errno = 0;
@@ -736,6 +1047,14 @@ static int parse_args(int argc, char **argv, gw_opts *o)
         return 2;
     }
     return 0;
+}
+
+static void on_sigchld(int s)
+{
+    (void)s;
+    if (ctx) {
+        lws_cancel_service(ctx);
+    }
 }
 
 static void on_signal(int s)
@@ -774,6 +1093,31 @@ int main(int argc, char **argv)
     (void)sc_cmdsign_init(&signer, opt.key, (uint8_t)opt.sender, sc_cmdsign_fv_now(), 1);
     udp_state_fd = bind_udp(opt.state_port);
     udp_dlink_fd = bind_udp(opt.dlink_port);
+    if (opt.sessions_dir != NULL) {
+        /* the replay engine's ports: any free ones on localhost */
+        udp_rstate_fd = bind_udp(0);
+        udp_rdlink_fd = bind_udp(0);
+        struct sockaddr_in a;
+        socklen_t al = sizeof a;
+        if (udp_rstate_fd < 0 || udp_rdlink_fd < 0 ||
+            getsockname(udp_rstate_fd, (struct sockaddr *)&a, &al) != 0) {
+            fprintf(stderr, "sc-gateway: cannot bind the replay's UDP ports: %s\n", strerror(errno));
+            return 1;
+        }
+        rstate_port = ntohs(a.sin_port);
+        al = sizeof a;
+        if (getsockname(udp_rdlink_fd, (struct sockaddr *)&a, &al) != 0) {
+            fprintf(stderr, "sc-gateway: cannot bind the replay's UDP ports: %s\n", strerror(errno));
+            return 1;
+        }
+        rdlink_port = ntohs(a.sin_port);
+        DIR *d = opendir(opt.sessions_dir);
+        if (d == NULL) {
+            fprintf(stderr, "sc-gateway: --sessions %s: %s\n", opt.sessions_dir, strerror(errno));
+            return 1;
+        }
+        closedir(d);
+    }
     if (udp_state_fd < 0 || udp_dlink_fd < 0) {
         fprintf(stderr, "sc-gateway: cannot bind UDP ports %u/%u on 127.0.0.1: %s\n",
                 (unsigned)opt.state_port, (unsigned)opt.dlink_port, strerror(errno));
@@ -792,6 +1136,7 @@ int main(int argc, char **argv)
         {"http", lws_callback_http_dummy, 0, 0, 0, NULL, 0},
         {"sonocomp-console", cb_console, sizeof(client), GW_MSG_MAX, 0, NULL, 0},
         {NULL, NULL, 0, 0, 0, NULL, 0}};
+    console_protocol = &protocols[1];
     struct lws_context_creation_info info;
     memset(&info, 0, sizeof info);
     info.port = opt.port;
@@ -809,6 +1154,9 @@ int main(int argc, char **argv)
     sa.sa_handler = on_signal;
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
+    sa.sa_handler = on_sigchld; /* a replay's end wakes the service loop */
+    sa.sa_flags = SA_NOCLDSTOP;
+    sigaction(SIGCHLD, &sa, NULL);
     pthread_t th;
     if (pthread_create(&th, NULL, rx_thread, NULL) != 0) {
         fprintf(stderr, "sc-gateway: cannot start the receive thread\n");
@@ -827,12 +1175,17 @@ int main(int argc, char **argv)
         if (opt.seconds > 0.0 && t - t0 >= opt.seconds) {
             break;
         }
+        replay_reap(0);
         if (t - last_stats >= 5.0) {
             last_stats = t;
             print_stats(stdout);
         }
     }
     stop = 1;
+    if (replay_pid > 0) {
+        kill(replay_pid, SIGTERM);
+        replay_reap(1);
+    }
     pthread_join(th, NULL);
     print_stats(stdout);
     lws_context_destroy(ctx);

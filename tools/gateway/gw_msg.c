@@ -184,6 +184,25 @@ static int fail(const char **why, const char *reason)
     return -1;
 }
 
+int gw_msg_bundle_name_ok(const char *name)
+{
+    if (name == NULL) {
+        return 0;
+    }
+    const size_t n = strlen(name);
+    if (n <= 4u || n >= GW_MSG_FILE_MAX || name[0] == '.' || strcmp(name + n - 4u, ".scb") != 0) {
+        return 0;
+    }
+    for (size_t i = 0; i < n; i++) {
+        const char c = name[i];
+        if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+              c == '.' || c == '_' || c == '-')) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
 int gw_msg_parse(const char *text, size_t len, gw_msg *out, const char **why)
 {
     static const char *dummy;
@@ -305,8 +324,29 @@ int gw_msg_parse(const char *text, size_t len, gw_msg *out, const char **why)
         r.cmd.assess_call = reset                           ? SC_ASSESS_CALL_NONE
                             : strcmp(c->str, "dvt") == 0 ? SC_ASSESS_CALL_DVT
                                                           : SC_ASSESS_CALL_NORMAL;
+    } else if (strcmp(op->str, "sessions") == 0) {
+        static const char *const k[] = {"op", NULL};
+        if (!only(m, n, k)) {
+            return fail(why, "sessions takes no arguments");
+        }
+        r.op = GW_OP_SESSIONS;
+        r.name = "sessions";
+    } else if (strcmp(op->str, "replay") == 0) {
+        static const char *const k[] = {"op", "name", NULL};
+        const member *f = find(m, n, "name", 1);
+        if (!only(m, n, k) || f == NULL) {
+            return fail(why, "replay wants {\"op\":\"replay\",\"name\":\"FILE.scb\"}");
+        }
+        if (!gw_msg_bundle_name_ok(f->str)) {
+            return fail(why, "replay: the name must be a plain file name of [A-Za-z0-9._-] ending "
+                             "in .scb, not starting with '.' (no path)");
+        }
+        r.op = GW_OP_REPLAY;
+        r.name = "replay";
+        strcpy(r.file, f->str);
     } else {
-        return fail(why, "unknown op (auth, ping, case, method, imaging, reset, assess)");
+        return fail(why, "unknown op (auth, ping, case, method, imaging, reset, assess, sessions, "
+                         "replay)");
     }
     if (r.op == GW_OP_COMMAND) {
         sc_can_frame f;

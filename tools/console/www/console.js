@@ -11,7 +11,7 @@ const $ = (id) => document.getElementById(id);
 
 // ---- state shared with the tests (window.sc) ------------------------------------------------
 const sc = {
-  frame: null, surf: null, catalogue: [], replies: [], errors: [], bscanFrames: 0,
+  frame: null, surf: null, catalogue: [], replies: [], errors: [], bscanFrames: 0, sessions: [], replay: null, replays: [],
   records: 0, gaps: 0, lastSeq: -1, frozen: false, assessment: null,
 };
 window.sc = sc;
@@ -231,6 +231,10 @@ function onFrame(dv, p) {
     caseCrc: dv.getUint32(p + 180, true), streamDropped: dv.getUint32(p + 192, true),
   };
   sc.frame = f;
+  if (sc.replay && sc.replay.state === 'running') {
+    sc.replay.frame = f.frames;
+    $('replay-status').textContent = `replaying ${sc.replay.name} (frame ${f.frames}/${sc.replay.frames})`;
+  }
   if (sc.frozen) return;
   probe.position.set(f.pos[0], f.pos[1], f.pos[2]);
   probe.quaternion.set(f.q[1], f.q[2], f.q[3], f.q[0]);
@@ -370,7 +374,49 @@ function onJson(m) {
   if (m.type === 'hello') $('lock').textContent = m.locked ? 'locked (viewing only)' : 'open';
   if (m.type === 'ack' && m.op === 'auth') $('lock').textContent = 'unlocked';
   if (m.type === 'catalogue') renderCatalogue(m.entries);
+  if (m.type === 'hello' && m.sessions) { $('sessions-panel').hidden = false; send({ op: 'sessions' }); }
+  if (m.type === 'sessions') renderSessions(m);
+  if (m.type === 'replay') onReplay(m);
 }
+
+// ---- recorded sessions (sc-gateway --sessions DIR) ------------------------------------------
+function renderSessions(m) {
+  sc.sessions = m.entries;
+  $('sessions').tBodies[0].replaceChildren(...m.entries.map((e) => {
+    const tr = document.createElement('tr');
+    tr.dataset.file = e.file;
+    const cell = (t) => { const td = document.createElement('td'); td.textContent = t; return td; };
+    const b = document.createElement('button');
+    b.textContent = 'replay'; b.dataset.testid = 'replay-' + e.file; b.title = e.file;
+    b.onclick = () => send({ op: 'replay', name: e.file });
+    const first = document.createElement('td'); first.append(b);
+    if (e.error) {
+      b.disabled = true;
+      const bad = cell(`${e.file}: refused (${e.error})`); bad.colSpan = 5; bad.className = 'desc';
+      tr.append(first, bad);
+    } else {
+      tr.append(first, cell(e.case), cell(e.method), cell(e.date), cell(`${e.frames} (${e.seconds.toFixed(1)} s)`),
+        cell(`${e.score}/${e.score_max}`));
+    }
+    return tr;
+  }));
+}
+
+function onReplay(m) {
+  // frame: the replay's newest frame seen (kept when it ends)
+  sc.replay = { ...m, frame: m.state === 'running' ? 0 : (sc.replay?.frame ?? 0) };
+  sc.replays.push(m);
+  sc.lastSeq = -1; // another engine's sequence numbers follow (the gateway resets its own count too)
+  if (m.state === 'running') {
+    $('replay-status').textContent = `replaying ${m.name} (frame 0/${m.frames})`;
+    log(`replay of ${m.name} (${m.case}, ${m.frames} frames) started`);
+  } else {
+    $('replay-status').textContent = `live (replay of ${m.name} ${m.ok ? 'ended, every image hash matched' : `failed, exit ${m.exit}`}, frame ${sc.replay.frame} seen)`;
+    log(`replay of ${m.name} ended`);
+    send({ op: 'sessions' });
+  }
+}
+$('sessions-refresh').onclick = () => send({ op: 'sessions' });
 
 function renderCatalogue(entries) {
   sc.catalogue = entries;
