@@ -10,7 +10,9 @@
  * (rounded: trilinear blending at label borders is the same for every mapper where they map to
  * the same rest point).
  *
- * In these frames 700-850 tets of the vein's lumen are turned inside out by the physics (printed):
+ * In these frames hundreds of tets of the vein's lumen are turned inside out by the physics
+ * (printed; 657 MSDS / 651 FEM with the phantoms' former 20 mm wide mesh box, 347 / 310 with
+ * the 30 mm box, whose cells are coarser across the vessel):
  * before, every line crossing one went to the region path (about 100 of 256 lines per frame at
  * the deepest press, 4.4 ms of imaging); the walker now locates across them. What this test
  * found about the bars: the walker, the region path and the oracle give the same labels on

@@ -77,6 +77,76 @@ static float ratio(const sc_bscan_status *b, uint32_t label)
     return b->areas_valid ? b->area_ratio[label] : -1.0f;
 }
 
+/* diagnosis (SC_PRESS_DEBUG): the largest displacement, its node, inverted tets by label */
+static void debug_frame(uint32_t step, uint32_t f)
+{
+    const sc_tissue *t = &rig.engine.tissue[rig.engine.active];
+    const sc_mesh *m = &t->mesh;
+    const sc_nodes *n = &t->nodes;
+    float best = 0.0f;
+    uint32_t bi = 0;
+    for (uint32_t i = 0; i < m->node_count; i++) {
+        const float dx = n->x[i] - m->rest_x[i], dy = n->y[i] - m->rest_y[i],
+                    dz = n->z[i] - m->rest_z[i];
+        const float d = sqrtf(dx * dx + dy * dy + dz * dz);
+        if (d > best) {
+            best = d;
+            bi = i;
+        }
+    }
+    uint32_t inv[16] = {0};
+    uint32_t near_inv = 0;
+    uint32_t lab_of_best = 0xFF;
+    for (uint32_t k = 0; k < m->tet_count; k++) {
+        const float v = sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[k]);
+        const int has = m->tet[k][0] == bi || m->tet[k][1] == bi || m->tet[k][2] == bi ||
+                        m->tet[k][3] == bi;
+        if (has) {
+            lab_of_best = m->tet_label[k];
+        }
+        if (!(v > 0.0f)) {
+            inv[m->tet_label[k] & 15u]++;
+            near_inv += has ? 1u : 0u;
+        }
+    }
+    if (f == 40u && getenv("SC_PRESS_HIST") != NULL) {
+        /* where the inverted tets are: rest centroid histogram in z (2 mm bins) and |y| */
+        uint32_t hz_[20] = {0}, hy_[12] = {0};
+        for (uint32_t k = 0; k < m->tet_count; k++) {
+            if (sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[k]) > 0.0f) {
+                continue;
+            }
+            float cy = 0.0f, cz = 0.0f;
+            for (uint32_t a = 0; a < 4u; a++) {
+                cy += 0.25f * m->rest_y[m->tet[k][a]];
+                cz += 0.25f * m->rest_z[m->tet[k][a]];
+            }
+            hz_[(uint32_t)fminf(19.0f, fmaxf(0.0f, cz / 2.0f))]++;
+            hy_[(uint32_t)fminf(11.0f, fabsf(cy))]++;
+        }
+        print_message("hist step %u z:", step);
+        for (uint32_t b = 0; b < 20u; b++) {
+            print_message(" %u", hz_[b]);
+        }
+        print_message(" | |y|:");
+        for (uint32_t b = 0; b < 12u; b++) {
+            print_message(" %u", hy_[b]);
+        }
+        print_message("\n");
+    }
+    if (f % 8u == 0u || best > 0.8f * t->box_diag_mm || step == 999u) {
+        print_message("dbg step %u f %u maxd %.2f (diag %.1f) node %u rest %.1f %.1f %.1f -> "
+                      "%.1f %.1f %.1f lab %u inv-adj %u fixed %u | inv vein %u art %u fat %u "
+                      "mus %u thr %u other %u | faults %u\n",
+                      step, f, (double)best, (double)t->box_diag_mm, bi, (double)m->rest_x[bi],
+                      (double)m->rest_y[bi], (double)m->rest_z[bi], (double)n->x[bi],
+                      (double)n->y[bi], (double)n->z[bi], lab_of_best, near_inv,
+                      m->node_fixed[bi], inv[SC_LABEL_VEIN], inv[SC_LABEL_ARTERY],
+                      inv[SC_LABEL_FAT], inv[SC_LABEL_MUSCLE], inv[SC_LABEL_THROMBUS],
+                      inv[SC_LABEL_SKIN] + inv[SC_LABEL_NERVE], t->stats.faults);
+    }
+}
+
 /* The loaded case's tissue again on a finer mesh (the same box, nx x ny x nz nodes), as the
  * engine builds it at case load. */
 static void remesh(uint32_t nx, uint32_t ny, uint32_t nz)
@@ -85,6 +155,12 @@ static void remesh(uint32_t nx, uint32_t ny, uint32_t nz)
     td.mesh.nx = nx;
     td.mesh.ny = ny;
     td.mesh.nz = nz;
+    if (getenv("SC_PRESS_WIDE_Y") != NULL) {
+        /* diagnosis: the box widened in y (the probe's elevation axis) */
+        const float w = (float)atof(getenv("SC_PRESS_WIDE_Y"));
+        td.mesh.origin_mm[1] -= 0.5f * (w - td.mesh.size_mm[1]);
+        td.mesh.size_mm[1] = w;
+    }
     const sc_material_table mat = rig.engine.tissue[rig.engine.active].mat;
     assert_int_equal(sc_tissue_init(&rig.engine.tissue[rig.engine.active], &td, &rig.engine.slot.c.volume, &mat,
                                     (uint8_t)SC_LABEL_FAT),
@@ -146,6 +222,9 @@ static void sweep_mesh(const char *case_name, sc_tissue_method m, uint32_t fine)
         for (uint32_t f = 0; f < frames; f++) {
             frame(t0, &more);
             assert_true(state_finite());
+            if (getenv("SC_PRESS_DEBUG") != NULL) {
+                debug_frame(s, f);
+            }
         }
         const sc_bscan_status *b = sc_bscan_status_get(&rig.engine.bscan);
         if (getenv("SC_LUMEN_DEBUG") != NULL) {
@@ -163,6 +242,9 @@ static void sweep_mesh(const char *case_name, sc_tissue_method m, uint32_t fine)
     /* the lift (ramp) and 1 s without contact */
     for (uint32_t f = 0; f < (uint32_t)(RAMP_S * hz) + hz; f++) {
         frame(t0, &more);
+        if (getenv("SC_PRESS_DEBUG") != NULL) {
+            debug_frame(999u, f);
+        }
     }
     const float dev = max_dev_from_rest_mm();
     for (uint32_t f = 0; f < hz; f++) {
@@ -229,8 +311,13 @@ static void fine_mesh_press_sweeps_have_no_fault_and_show_the_vessels(void **sta
         if (only != NULL && strcmp(only, cases[c]) != 0) {
             continue;
         }
-        sweep_mesh(cases[c], SC_TISSUE_MSDS, 1u);
-        sweep_mesh(cases[c], SC_TISSUE_FEM, 1u);
+        const char *meth = getenv("SC_PRESS_METHOD"); /* msds or fem alone (diagnosis) */
+        if (meth == NULL || strcmp(meth, "fem") != 0) {
+            sweep_mesh(cases[c], SC_TISSUE_MSDS, 1u);
+        }
+        if (meth == NULL || strcmp(meth, "msds") != 0) {
+            sweep_mesh(cases[c], SC_TISSUE_FEM, 1u);
+        }
     }
 }
 

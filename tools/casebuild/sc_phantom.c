@@ -555,8 +555,13 @@ int sc_phantom_generate(const sc_phantom_def *pd, sc_phantom *out)
         d->mesh.size_mm[0] = 30.0f;
         d->mesh.size_mm[2] = 32.0f;
     }
-    d->mesh.origin_mm[1] = -10.0f;
-    d->mesh.size_mm[1] = 20.0f;
+    /* 30 mm across the probe's 10 mm face (y, its elevation axis): with 20 mm the box's
+     * roller sides stood 5 mm beside the face and confined the tissue under a deep press
+     * (24 mm of 32: the column under the face had nowhere to go but two 5 mm strips; its
+     * tets inverted by the thousand, a muscle node passed the fixed bottom, and the tangled
+     * MSDS flung nodes past the guard's bound at the lift) */
+    d->mesh.origin_mm[1] = -15.0f;
+    d->mesh.size_mm[1] = 30.0f;
     d->mesh.origin_mm[2] = 0.0f;
     /* image frame = probe frame. The mannequin's tracker frame has Z up out of the body
      * (as the tracker emulator and a real tracker on the mannequin report it) and y toward
