@@ -811,14 +811,10 @@ static void control_step(sc_engine *e)
 static int set_filters(sc_engine *e)
 {
     /* exactly the protocol's receive ids, so that foreign traffic (a flood at full bus load
-     * included) stays in the controller: commands 0x080..0x084 and 0x087, their cryptographic
-     * PDUs 0x088..0x08C and 0x08F, classic pose 0x100..0x102, FD pose 0x110 */
+     * included) stays in the controller: commands 0x080..0x087, their cryptographic PDUs
+     * 0x088..0x08F, classic pose 0x100..0x102, FD pose 0x110 */
     const sc_can_filter f[] = {
-        {.id = SC_CANID_CMD_CASE, .mask = 0x7FCu, .flags = 0},  /* 0x080..0x083 */
-        {.id = SC_CANID_CMD_SYNC, .mask = 0x7FFu, .flags = 0},  /* 0x084 */
-        {.id = SC_CANID_AUTH_CASE, .mask = 0x7FCu, .flags = 0}, /* 0x088..0x08B */
-        {.id = SC_CANID_AUTH_SYNC, .mask = 0x7FFu, .flags = 0}, /* 0x08C */
-        {.id = SC_CANID_CMD_ASSESS, .mask = 0x7F7u, .flags = 0}, /* 0x087 and 0x08F */
+        {.id = SC_CANID_CMD_CASE, .mask = 0x7F0u, .flags = 0}, /* 0x080..0x08F */
         {.id = SC_CANID_POSE_POS, .mask = 0x7FEu, .flags = 0},  /* 0x100..0x101 */
         {.id = SC_CANID_POSE_AUX, .mask = 0x7FFu, .flags = 0},  /* 0x102 */
         {.id = SC_CANID_POSE_FD, .mask = 0x7FFu, .flags = 0},
