@@ -438,6 +438,53 @@ static int request_switch(sc_engine *e, const char *name)
     return SC_OK;
 }
 
+/* CmdVessels: the lumens' drive of the running tissue, kept for the cases loaded later.
+ * Pulsation off removes the arterial pressure pulse (the heart's clock runs on, so the
+ * Doppler's flow keeps its rhythm); the pulse pressure otherwise is config/sc_materials.h's. */
+static int apply_vessels(sc_engine *e, const sc_vessels_cmd *v)
+{
+#if SC_PHYS_LUMEN
+    sc_lumen_drive d = e->vessel_drive_set ? e->vessel_drive : sc_lumen_drive_default();
+    d.heart_rate_bpm = v->heart_rate_bpm;
+    d.resp_rate_bpm = v->resp_rate_bpm;
+    d.pulse_pa = v->pulse ? sc_lumen_drive_default().pulse_pa : 0.0f;
+    d.valsalva = v->valsalva ? 1u : 0u;
+    int rc = sc_lumen_drive_validate(&d);
+    if (rc == SC_OK && e->case_loaded) {
+        rc = sc_tissue_set_drive(running_tissue(e), &d);
+    }
+    if (rc == SC_OK) {
+        e->vessel_drive = d;
+        e->vessel_drive_set = 1u;
+        sc_log(&e->hal->log, SC_LOG_INFO, "vessels", SC_OK, (int64_t)v->heart_rate_bpm,
+               (int64_t)v->resp_rate_bpm);
+    }
+    return rc;
+#else
+    (void)e;
+    (void)v;
+    return SC_ERR_NOT_SUPPORTED;
+#endif
+}
+
+/* CmdDoppler: the running Doppler settings with the commanded colour switch, scale, steering
+ * and gain; sc_doppler_def_validate refuses e.g. a scale below four times the wall filter. */
+static int apply_doppler(sc_engine *e, const sc_doppler_cmd *c)
+{
+#if SC_ENABLE_DOPPLER
+    sc_doppler_def d = e->doppler.def;
+    d.enabled = c->on ? 1u : 0u;
+    d.prf_hz = c->prf_hz;
+    d.steer_deg = c->steer_deg;
+    d.gain_db = c->gain_db;
+    return sc_engine_set_doppler(e, &d);
+#else
+    (void)e;
+    (void)c;
+    return SC_ERR_NOT_SUPPORTED;
+#endif
+}
+
 static void apply_command(sc_engine *e, const sc_cmd *c)
 {
     int rc = SC_OK;
@@ -466,6 +513,12 @@ static void apply_command(sc_engine *e, const sc_cmd *c)
             sc_log(&e->hal->log, SC_LOG_INFO, "assess_call", rc, (int64_t)c->assess_call,
                    (int64_t)sc_assess_get(&e->assess)->score);
         }
+        break;
+    case SC_CMD_VESSELS:
+        rc = apply_vessels(e, &c->vessels);
+        break;
+    case SC_CMD_DOPPLER:
+        rc = apply_doppler(e, &c->doppler);
         break;
     case SC_CMD_RESET:
         if ((c->reset_target & SC_RESET_TISSUE) && e->case_loaded) {
@@ -587,6 +640,10 @@ static int swap_case(sc_engine *e, uint32_t slot)
     if (rc == SC_OK) {
         /* the pulsation's clock runs at the frame rate */
         rc = sc_tissue_set_frame_s(&e->tissue[slot], 1.0f / (float)e->def.sched.rate_hz);
+    }
+    if (rc == SC_OK && e->vessel_drive_set) {
+        /* CmdVessels' setting outlives the case */
+        rc = sc_tissue_set_drive(&e->tissue[slot], &e->vessel_drive);
     }
 #endif
     if (rc == SC_OK) {
@@ -754,14 +811,10 @@ static void control_step(sc_engine *e)
 static int set_filters(sc_engine *e)
 {
     /* exactly the protocol's receive ids, so that foreign traffic (a flood at full bus load
-     * included) stays in the controller: commands 0x080..0x084 and 0x087, their cryptographic
-     * PDUs 0x088..0x08C and 0x08F, classic pose 0x100..0x102, FD pose 0x110 */
+     * included) stays in the controller: commands 0x080..0x087, their cryptographic PDUs
+     * 0x088..0x08F, classic pose 0x100..0x102, FD pose 0x110 */
     const sc_can_filter f[] = {
-        {.id = SC_CANID_CMD_CASE, .mask = 0x7FCu, .flags = 0},  /* 0x080..0x083 */
-        {.id = SC_CANID_CMD_SYNC, .mask = 0x7FFu, .flags = 0},  /* 0x084 */
-        {.id = SC_CANID_AUTH_CASE, .mask = 0x7FCu, .flags = 0}, /* 0x088..0x08B */
-        {.id = SC_CANID_AUTH_SYNC, .mask = 0x7FFu, .flags = 0}, /* 0x08C */
-        {.id = SC_CANID_CMD_ASSESS, .mask = 0x7F7u, .flags = 0}, /* 0x087 and 0x08F */
+        {.id = SC_CANID_CMD_CASE, .mask = 0x7F0u, .flags = 0}, /* 0x080..0x08F */
         {.id = SC_CANID_POSE_POS, .mask = 0x7FEu, .flags = 0},  /* 0x100..0x101 */
         {.id = SC_CANID_POSE_AUX, .mask = 0x7FFu, .flags = 0},  /* 0x102 */
         {.id = SC_CANID_POSE_FD, .mask = 0x7FFu, .flags = 0},
@@ -1126,6 +1179,11 @@ int sc_engine_set_flow_phase(sc_engine *e, float cardiac_phase, float resp_phase
         return SC_ERR_INVALID_ARG;
     }
     return sc_doppler_set_phase(&e->doppler, cardiac_phase, resp_phase);
+}
+
+const sc_doppler_def *sc_engine_get_doppler_def(const sc_engine *e)
+{
+    return &e->doppler.def;
 }
 
 const sc_doppler_status *sc_engine_get_doppler_status(const sc_engine *e)

@@ -278,6 +278,10 @@ typedef struct sc_engine {
     sc_engine_hook_fn hook;
     void *hook_user;
     sc_assess assess;         /* the compression exam's assessment, updated every frame */
+#if SC_PHYS_LUMEN
+    sc_lumen_drive vessel_drive; /* the drive CmdVessels set (kept for the next case) */
+    uint8_t vessel_drive_set;    /* 1: a CmdVessels was applied; every new tissue gets it */
+#endif
 #if SC_STATE_STREAM
     sc_state_tx state_tx; /* console state stream (sc_state.h) */
 #endif
@@ -369,6 +373,8 @@ int sc_engine_set_flow_phase(sc_engine *e, float cardiac_phase, float resp_phase
 
 /* The last frame's Doppler status (colour pixels, aliasing, gate velocity). O(1). */
 const sc_doppler_status *sc_engine_get_doppler_status(const sc_engine *e);
+/* The Doppler settings in force (CmdDoppler changes enabled, prf_hz, steer_deg, gain_db). */
+const sc_doppler_def *sc_engine_get_doppler_def(const sc_engine *e);
 #endif
 
 #if SC_ENABLE_NEEDLE

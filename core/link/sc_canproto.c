@@ -60,6 +60,20 @@ static const sc_can_sig sigs_cmd_assess[] = {
     {"AssessAction", 16, 2, 0, 1.0f, 0.0f, 1.0f, 2.0f, ""},
     {"AssessCall", 18, 2, 0, 1.0f, 0.0f, 0.0f, 2.0f, ""},
 };
+static const sc_can_sig sigs_cmd_vessels[] = {
+    E2E_SIGS,
+    {"HeartRate", 16, 8, 0, 1.0f, 0.0f, 30.0f, 200.0f, "bpm"},
+    {"RespRate", 24, 8, 0, 1.0f, 0.0f, 0.0f, 40.0f, "1/min"},
+    {"Valsalva", 32, 1, 0, 1.0f, 0.0f, 0.0f, 1.0f, ""},
+    {"Pulsation", 33, 1, 0, 1.0f, 0.0f, 0.0f, 1.0f, ""},
+};
+static const sc_can_sig sigs_cmd_doppler[] = {
+    E2E_SIGS,
+    {"ColourOn", 16, 1, 0, 1.0f, 0.0f, 0.0f, 1.0f, ""},
+    {"Prf", 24, 16, 0, 1.0f, 0.0f, 100.0f, 20000.0f, "Hz"},
+    {"Steer", 40, 8, 1, 1.0f, 0.0f, -30.0f, 30.0f, "deg"},
+    {"ColourGain", 48, 8, 1, 0.5f, 0.0f, -30.0f, 30.0f, "dB"},
+};
 /* The cryptographic PDU (sc_secoc.h); the 40-bit MAC as two integer signals so that every
  * signal stays exact in float32 (MacA = MAC bytes 0..2, MacB = bytes 3..4, little-endian). */
 static const sc_can_sig sigs_auth[] = {
@@ -200,6 +214,8 @@ static const sc_can_msg_info msg_table[SC_MSG_COUNT] = {
     [SC_MSG_CMD_RESET] = MSG("CmdReset", SC_CANID_CMD_RESET, 8, 0, 0, 0, sigs_cmd_reset),
     [SC_MSG_CMD_SYNC] = MSG("CmdFreshnessSync", SC_CANID_CMD_SYNC, 8, 0, 0, 0, sigs_cmd_sync),
     [SC_MSG_CMD_ASSESS] = MSG("CmdAssessment", SC_CANID_CMD_ASSESS, 8, 0, 0, 0, sigs_cmd_assess),
+    [SC_MSG_CMD_VESSELS] = MSG("CmdVessels", SC_CANID_CMD_VESSELS, 8, 0, 0, 0, sigs_cmd_vessels),
+    [SC_MSG_CMD_DOPPLER] = MSG("CmdDoppler", SC_CANID_CMD_DOPPLER, 8, 0, 0, 0, sigs_cmd_doppler),
     [SC_MSG_POSE_POS] = MSG("ProbePosePos", SC_CANID_POSE_POS, 8, 0, 10, 100, sigs_pose_pos),
     [SC_MSG_POSE_QUAT] = MSG("ProbePoseQuat", SC_CANID_POSE_QUAT, 8, 0, 10, 100, sigs_pose_quat),
     [SC_MSG_POSE_AUX] = MSG("ProbePoseAux", SC_CANID_POSE_AUX, 8, 0, 10, 100, sigs_pose_aux),
@@ -214,6 +230,8 @@ static const sc_can_msg_info msg_table[SC_MSG_COUNT] = {
     [SC_MSG_AUTH_RESET] = MSG_AUTH("CmdAuthReset", SC_CANID_AUTH_CASE + 3),
     [SC_MSG_AUTH_SYNC] = MSG_AUTH("CmdAuthFreshnessSync", SC_CANID_AUTH_SYNC),
     [SC_MSG_AUTH_ASSESS] = MSG_AUTH("CmdAuthAssessment", SC_CANID_AUTH_ASSESS),
+    [SC_MSG_AUTH_VESSELS] = MSG_AUTH("CmdAuthVessels", SC_CANID_AUTH_VESSELS),
+    [SC_MSG_AUTH_DOPPLER] = MSG_AUTH("CmdAuthDoppler", SC_CANID_AUTH_DOPPLER),
     [SC_MSG_ASSESS_VESSELS] =
         MSG("AssessVessels", SC_CANID_ASSESS_VESSELS, 8, 0, 100, 0, sigs_assess_vessels),
     [SC_MSG_ASSESS_FORCE] =
@@ -229,6 +247,12 @@ static const sc_can_msg_info msg_table[SC_MSG_COUNT] = {
 _Static_assert(SC_CANID_AUTH_ASSESS == SC_CANID_CMD_ASSESS + SC_CANID_AUTH_OFFSET, "auth ids");
 _Static_assert(SC_MSG_AUTH_ASSESS - SC_MSG_AUTH_CASE == SC_MSG_CMD_ASSESS - SC_MSG_CMD_CASE,
                "one cryptographic PDU per command (assessment)");
+_Static_assert(SC_CANID_AUTH_VESSELS == SC_CANID_CMD_VESSELS + SC_CANID_AUTH_OFFSET &&
+                   SC_CANID_AUTH_DOPPLER == SC_CANID_CMD_DOPPLER + SC_CANID_AUTH_OFFSET,
+               "auth ids");
+_Static_assert(SC_MSG_AUTH_VESSELS - SC_MSG_AUTH_CASE == SC_MSG_CMD_VESSELS - SC_MSG_CMD_CASE &&
+                   SC_MSG_AUTH_DOPPLER - SC_MSG_AUTH_CASE == SC_MSG_CMD_DOPPLER - SC_MSG_CMD_CASE,
+               "one cryptographic PDU per command (vessels, Doppler)");
 _Static_assert(SC_CANID_AUTH_SYNC == SC_CANID_CMD_SYNC + SC_CANID_AUTH_OFFSET, "auth ids");
 _Static_assert(SC_MSG_AUTH_SYNC - SC_MSG_AUTH_CASE == SC_MSG_CMD_SYNC - SC_MSG_CMD_CASE,
                "one cryptographic PDU per command");
@@ -508,6 +532,8 @@ int sc_canproto_decode_pose_part(const sc_can_frame *f, sc_pose_msg *p)
     case SC_MSG_CMD_RESET:
     case SC_MSG_CMD_SYNC:
     case SC_MSG_CMD_ASSESS:
+    case SC_MSG_CMD_VESSELS:
+    case SC_MSG_CMD_DOPPLER:
     case SC_MSG_STATUS:
     case SC_MSG_TIMING:
     case SC_MSG_DIAG:
@@ -518,6 +544,8 @@ int sc_canproto_decode_pose_part(const sc_can_frame *f, sc_pose_msg *p)
     case SC_MSG_AUTH_RESET:
     case SC_MSG_AUTH_SYNC:
     case SC_MSG_AUTH_ASSESS:
+    case SC_MSG_AUTH_VESSELS:
+    case SC_MSG_AUTH_DOPPLER:
     case SC_MSG_ASSESS_VESSELS:
     case SC_MSG_ASSESS_FORCE:
     case SC_MSG_ASSESS_SCORE:
@@ -548,6 +576,10 @@ sc_msg sc_canproto_cmd_msg(sc_cmd_kind k)
         return SC_MSG_CMD_SYNC;
     case SC_CMD_ASSESS:
         return SC_MSG_CMD_ASSESS;
+    case SC_CMD_VESSELS:
+        return SC_MSG_CMD_VESSELS;
+    case SC_CMD_DOPPLER:
+        return SC_MSG_CMD_DOPPLER;
     }
     return SC_MSG_COUNT;
 }
@@ -620,6 +652,40 @@ int sc_canproto_encode_cmd(const sc_cmd *c, uint8_t counter, sc_can_frame *out)
         put_u(out, m, 2u, c->assess_action & 3u);
         put_u(out, m, 3u, c->assess_call & 3u);
         break;
+    case SC_CMD_VESSELS:
+        m = SC_MSG_CMD_VESSELS;
+        frame_begin(out, m);
+        rc = c->vessels.valsalva <= 1u && c->vessels.pulse <= 1u ? 0 : SC_ERR_CAN_SIGNAL;
+        if (rc == 0) {
+            rc = put_phys(out, m, 2u, c->vessels.heart_rate_bpm);
+        }
+        if (rc == 0) {
+            rc = put_phys(out, m, 3u, c->vessels.resp_rate_bpm);
+        }
+        put_u(out, m, 4u, c->vessels.valsalva & 1u);
+        put_u(out, m, 5u, c->vessels.pulse & 1u);
+        for (unsigned i = 2u; i <= 3u && rc == 0; i++) {
+            rc = in_range(out, m, i) ? 0 : SC_ERR_CAN_SIGNAL;
+        }
+        break;
+    case SC_CMD_DOPPLER:
+        m = SC_MSG_CMD_DOPPLER;
+        frame_begin(out, m);
+        rc = c->doppler.on <= 1u ? 0 : SC_ERR_CAN_SIGNAL;
+        put_u(out, m, 2u, c->doppler.on & 1u);
+        if (rc == 0) {
+            rc = put_phys(out, m, 3u, c->doppler.prf_hz);
+        }
+        if (rc == 0) {
+            rc = put_phys(out, m, 4u, c->doppler.steer_deg);
+        }
+        if (rc == 0) {
+            rc = put_phys(out, m, 5u, c->doppler.gain_db);
+        }
+        for (unsigned i = 3u; i <= 5u && rc == 0; i++) {
+            rc = in_range(out, m, i) ? 0 : SC_ERR_CAN_SIGNAL;
+        }
+        break;
     default:
         return SC_ERR_INVALID_ARG;
     }
@@ -677,6 +743,22 @@ int sc_canproto_decode_cmd(const sc_can_frame *f, sc_cmd *out)
         }
         nsig = 2;
         break;
+    case SC_MSG_CMD_VESSELS:
+        c.kind = SC_CMD_VESSELS;
+        c.vessels.heart_rate_bpm = get_phys(f, m, 2u);
+        c.vessels.resp_rate_bpm = get_phys(f, m, 3u);
+        c.vessels.valsalva = (uint8_t)get_u(f, m, 4u);
+        c.vessels.pulse = (uint8_t)get_u(f, m, 5u);
+        nsig = 4;
+        break;
+    case SC_MSG_CMD_DOPPLER:
+        c.kind = SC_CMD_DOPPLER;
+        c.doppler.on = (uint8_t)get_u(f, m, 2u);
+        c.doppler.prf_hz = get_phys(f, m, 3u);
+        c.doppler.steer_deg = get_phys(f, m, 4u);
+        c.doppler.gain_db = get_phys(f, m, 5u);
+        nsig = 4;
+        break;
     case SC_MSG_POSE_POS:
     case SC_MSG_POSE_QUAT:
     case SC_MSG_POSE_AUX:
@@ -691,6 +773,8 @@ int sc_canproto_decode_cmd(const sc_can_frame *f, sc_cmd *out)
     case SC_MSG_AUTH_RESET:
     case SC_MSG_AUTH_SYNC:
     case SC_MSG_AUTH_ASSESS:
+    case SC_MSG_AUTH_VESSELS:
+    case SC_MSG_AUTH_DOPPLER:
     case SC_MSG_ASSESS_VESSELS:
     case SC_MSG_ASSESS_FORCE:
     case SC_MSG_ASSESS_SCORE:
@@ -821,6 +905,8 @@ int sc_canproto_decode_status_part(const sc_can_frame *f, sc_status_msg *s)
     case SC_MSG_CMD_RESET:
     case SC_MSG_CMD_SYNC:
     case SC_MSG_CMD_ASSESS:
+    case SC_MSG_CMD_VESSELS:
+    case SC_MSG_CMD_DOPPLER:
     case SC_MSG_POSE_POS:
     case SC_MSG_POSE_QUAT:
     case SC_MSG_POSE_AUX:
@@ -831,6 +917,8 @@ int sc_canproto_decode_status_part(const sc_can_frame *f, sc_status_msg *s)
     case SC_MSG_AUTH_RESET:
     case SC_MSG_AUTH_SYNC:
     case SC_MSG_AUTH_ASSESS:
+    case SC_MSG_AUTH_VESSELS:
+    case SC_MSG_AUTH_DOPPLER:
     case SC_MSG_ASSESS_VESSELS:
     case SC_MSG_ASSESS_FORCE:
     case SC_MSG_ASSESS_SCORE:

@@ -4,8 +4,9 @@
  *
  * Messages (11-bit ids, Intel byte order, E2E header in bytes 0-1, see sc_e2e.h):
  *   0x080 CmdSelectCase  0x081 CmdSetMethod  0x082 CmdSetImaging  0x083 CmdReset
- *   0x084 CmdFreshnessSync  0x087 CmdAssessment                                  (in, event)
- *   0x088..0x08C, 0x08F CmdAuth*: the cryptographic PDU of command id - 8 (sc_secoc.h) (in)
+ *   0x084 CmdFreshnessSync  0x085 CmdVessels  0x086 CmdDoppler  0x087 CmdAssessment
+ *                                                                                   (in, event)
+ *   0x088..0x08F CmdAuth*: the cryptographic PDU of command id - 8 (sc_secoc.h) (in)
  *   0x100 ProbePosePos   0x101 ProbePoseQuat 0x102 ProbePoseAux                    (in, 10 ms)
  *   0x110 ProbePoseFD    (in, 10 ms, CAN FD 20 bytes: the three above in one frame)
  *   0x200 EngineStatus   0x201 EngineTiming  0x202 TrackerDiag  0x203 AuthDiag    (out, 100 ms)
@@ -38,6 +39,8 @@ typedef enum sc_msg {
     SC_MSG_CMD_RESET,
     SC_MSG_CMD_SYNC,
     SC_MSG_CMD_ASSESS, /* CmdAssessment 0x087: reset the assessment, the trainee's call */
+    SC_MSG_CMD_VESSELS, /* CmdVessels 0x085: heart and breathing rates, Valsalva, pulsation */
+    SC_MSG_CMD_DOPPLER, /* CmdDoppler 0x086: colour on/off, scale (PRF), steering, gain */
     SC_MSG_POSE_POS,
     SC_MSG_POSE_QUAT,
     SC_MSG_POSE_AUX,
@@ -52,6 +55,8 @@ typedef enum sc_msg {
     SC_MSG_AUTH_RESET,
     SC_MSG_AUTH_SYNC,
     SC_MSG_AUTH_ASSESS,
+    SC_MSG_AUTH_VESSELS,
+    SC_MSG_AUTH_DOPPLER,
     SC_MSG_ASSESS_VESSELS, /* the assessment's status frames (out) */
     SC_MSG_ASSESS_FORCE,
     SC_MSG_ASSESS_SCORE,
@@ -63,11 +68,11 @@ typedef enum sc_msg {
     SC_MSG_COUNT
 } sc_msg;
 
-#define SC_CMD_MSGS 6u /* commands SC_MSG_CMD_CASE..SC_MSG_CMD_ASSESS; SC_MSG_AUTH_* likewise */
+#define SC_CMD_MSGS 8u /* commands SC_MSG_CMD_CASE..SC_MSG_CMD_DOPPLER; SC_MSG_AUTH_* likewise */
 /* 1 for the secured commands (authentic PDUs), 1 for their cryptographic PDUs. */
-#define SC_MSG_IS_CMD(m)  ((unsigned)(m) <= (unsigned)SC_MSG_CMD_ASSESS)
+#define SC_MSG_IS_CMD(m)  ((unsigned)(m) <= (unsigned)SC_MSG_CMD_DOPPLER)
 #define SC_MSG_IS_AUTH(m)                                                                          \
-    ((unsigned)(m) >= (unsigned)SC_MSG_AUTH_CASE && (unsigned)(m) <= (unsigned)SC_MSG_AUTH_ASSESS)
+    ((unsigned)(m) >= (unsigned)SC_MSG_AUTH_CASE && (unsigned)(m) <= (unsigned)SC_MSG_AUTH_DOPPLER)
 #define SC_MSG_IS_NEEDLE_IN(m)                                                                   \
     ((unsigned)(m) >= (unsigned)SC_MSG_NEEDLE_POS && (unsigned)(m) <= (unsigned)SC_MSG_NEEDLE_AUX)
 
@@ -79,10 +84,14 @@ enum {
     SC_CANID_CMD_IMAGING = 0x082,
     SC_CANID_CMD_RESET = 0x083,
     SC_CANID_CMD_SYNC = 0x084,
-    SC_CANID_CMD_ASSESS = 0x087, /* 0x085, 0x086 left free for other commands */
+    SC_CANID_CMD_VESSELS = 0x085,
+    SC_CANID_CMD_DOPPLER = 0x086,
+    SC_CANID_CMD_ASSESS = 0x087,
     SC_CANID_AUTH_OFFSET = 0x008, /* CmdAuth id = command id + 8 */
     SC_CANID_AUTH_CASE = 0x088,
     SC_CANID_AUTH_SYNC = 0x08C,
+    SC_CANID_AUTH_VESSELS = 0x08D,
+    SC_CANID_AUTH_DOPPLER = 0x08E,
     SC_CANID_AUTH_ASSESS = 0x08F,
     SC_CANID_POSE_POS = 0x100,
     SC_CANID_POSE_QUAT = 0x101,
@@ -210,6 +219,8 @@ typedef enum sc_cmd_kind {
     SC_CMD_RESET = 4,
     SC_CMD_SYNC_FRESHNESS = 5, /* CmdFreshnessSync: the sender's freshness bits 16..63 */
     SC_CMD_ASSESS = 6,         /* CmdAssessment: reset the assessment, or the trainee's call */
+    SC_CMD_VESSELS = 7,        /* CmdVessels: the lumens' drive (heart, breathing, Valsalva) */
+    SC_CMD_DOPPLER = 8,        /* CmdDoppler: colour Doppler on/off, scale, steering, gain */
 } sc_cmd_kind;
 
 enum { SC_METHOD_MSDS = 0, SC_METHOD_FEM = 1 };
@@ -228,12 +239,36 @@ typedef struct sc_imaging_cmd {
     uint8_t geometry;    /* SC_SCAN_* */
 } sc_imaging_cmd;
 
+/* CmdVessels: heart rate 30..200 bpm, respiration 0..40 breaths/min (the lumen law also
+ * refuses 1..3: sc_lumen_drive_validate, counted by the engine), Valsalva held, the arterial
+ * pulse on (off: no pressure pulse, the heart's clock runs on for the Doppler flow). */
+typedef struct sc_vessels_cmd {
+    float heart_rate_bpm;
+    float resp_rate_bpm;
+    uint8_t valsalva; /* 0/1 */
+    uint8_t pulse;    /* 0/1 */
+} sc_vessels_cmd;
+
+/* CmdDoppler: colour (and spectral) Doppler on/off, scale as PRF 100..20000 Hz, steering
+ * -30..30 deg (1 deg steps), colour gain -30..30 dB (0.5 dB steps). The engine applies them
+ * with sc_engine_set_doppler (its validation, e.g. wall filter <= PRF/4, may still refuse). */
+typedef struct sc_doppler_cmd {
+    uint8_t on;
+    float prf_hz;
+    float steer_deg;
+    float gain_db;
+} sc_doppler_cmd;
+
 typedef struct sc_cmd {
     sc_cmd_kind kind;
     uint8_t case_id;        /* SELECT_CASE: 0..254 */
     uint8_t method;         /* SET_METHOD: SC_METHOD_* */
     uint8_t reset_target;   /* RESET: SC_RESET_* */
-    sc_imaging_cmd imaging; /* SET_IMAGING */
+    union {                     /* the kind's settings (one at a time: sc_cmd stays 48 B) */
+        sc_imaging_cmd imaging; /* SET_IMAGING */
+        sc_vessels_cmd vessels; /* VESSELS */
+        sc_doppler_cmd doppler; /* DOPPLER */
+    };
     uint64_t fv_high;       /* SYNC_FRESHNESS: freshness value >> 16, 0..2^48-1 */
     uint8_t sender;         /* the authenticated sender (set by the receiver; sc_secoc.h) */
     uint8_t assess_action;  /* ASSESS: SC_ASSESS_ACTION_* */

@@ -191,9 +191,10 @@ static sc_fault fault_of(sc_hs_episode_kind k)
     return SC_FAULT_TRACKER_DATA;
 }
 
-/* foreign ids next to the protocol's (0x087 and 0x08F are CmdAssessment and its MAC since
- * the assessment block; 0x097 and 0x09F differ from them in one bit) */
-static const uint16_t k_flood_ids[] = {0x085, 0x086, 0x097, 0x08D, 0x08E, 0x09F,
+/* foreign ids next to the protocol's (0x085..0x087 and 0x08D..0x08F are CmdVessels,
+ * CmdDoppler, CmdAssessment and their MACs; 0x095..0x097 and 0x09D..0x09F differ from them in
+ * one bit) */
+static const uint16_t k_flood_ids[] = {0x095, 0x096, 0x097, 0x09D, 0x09E, 0x09F,
                                        0x103, 0x104, 0x111, 0x555, 0x7FF};
 
 static void flood(sc_hs_fault_run *r, const sc_hs_episode *e, uint64_t t)

@@ -9,7 +9,7 @@
  *   busoff=START_S:DUR_S     the controller is bus-off: sends fail, error frames to every node
  *   silence=START_S:DUR_S    the tracker sends nothing
  *   flood=START_S:DUR_S      a foreign node fills the bus: frames of ids outside the protocol
- *                            (0x085, 0x086, 0x097, 0x08D, 0x08E, 0x09F, 0x103, 0x104,
+ *                            (0x095, 0x096, 0x097, 0x09D, 0x09E, 0x09F, 0x103, 0x104,
  *                            0x111, 0x555, 0x7FF)
  *                            at the bus's capacity, bitrate / 111 bits per 8-byte classic frame
  *                            (500 kbit/s: 4,504 frames/s); the bus is modelled without

@@ -43,6 +43,21 @@ static void each_protocol_command_parses(void **state)
     assert_int_equal(parse("{\"op\":\"assess\",\"action\":\"reset\"}", &m, &why), 0);
     assert_int_equal(m.cmd.assess_action, SC_ASSESS_ACTION_RESET);
     assert_int_equal(m.cmd.assess_call, SC_ASSESS_CALL_NONE);
+    assert_int_equal(parse("{\"op\":\"vessels\",\"heart_rate_bpm\":110,\"resp_rate_bpm\":0,"
+                           "\"valsalva\":1,\"pulse\":0}", &m, &why), 0);
+    assert_int_equal(m.cmd.kind, SC_CMD_VESSELS);
+    assert_float_equal(m.cmd.vessels.heart_rate_bpm, 110.0f, 0.0f);
+    assert_float_equal(m.cmd.vessels.resp_rate_bpm, 0.0f, 0.0f);
+    assert_int_equal(m.cmd.vessels.valsalva, 1);
+    assert_int_equal(m.cmd.vessels.pulse, 0);
+    assert_string_equal(m.name, "vessels");
+    assert_int_equal(parse("{\"op\":\"doppler\",\"colour\":\"off\",\"prf_hz\":2500,"
+                           "\"steer_deg\":-20,\"gain_db\":4.5}", &m, &why), 0);
+    assert_int_equal(m.cmd.kind, SC_CMD_DOPPLER);
+    assert_int_equal(m.cmd.doppler.on, 0);
+    assert_float_equal(m.cmd.doppler.prf_hz, 2500.0f, 0.0f);
+    assert_float_equal(m.cmd.doppler.steer_deg, -20.0f, 0.0f);
+    assert_float_equal(m.cmd.doppler.gain_db, 4.5f, 0.0f);
 }
 
 static void bad_messages_are_refused_with_a_reason(void **state)
@@ -68,6 +83,18 @@ static void bad_messages_are_refused_with_a_reason(void **state)
         "{\"op\":\"assess\",\"action\":\"call\",\"call\":\"maybe\"}",
         "{\"op\":\"assess\",\"action\":\"reset\",\"call\":\"dvt\"}", /* reset takes no call */
         "{\"op\":\"case\",\"id\":1e999}",
+        /* vessels: heart rate outside 30..200, breathing above 40, valsalva not 0|1, missing */
+        "{\"op\":\"vessels\",\"heart_rate_bpm\":20,\"resp_rate_bpm\":12,\"valsalva\":0,\"pulse\":1}",
+        "{\"op\":\"vessels\",\"heart_rate_bpm\":72,\"resp_rate_bpm\":41,\"valsalva\":0,\"pulse\":1}",
+        "{\"op\":\"vessels\",\"heart_rate_bpm\":72,\"resp_rate_bpm\":12,\"valsalva\":2,\"pulse\":1}",
+        "{\"op\":\"vessels\",\"heart_rate_bpm\":72,\"resp_rate_bpm\":12,\"valsalva\":\"1\",\"pulse\":1}",
+        "{\"op\":\"vessels\",\"heart_rate_bpm\":72}",
+        /* doppler: scale, steering, gain outside the DBC; colour not on|off; extra key */
+        "{\"op\":\"doppler\",\"colour\":\"on\",\"prf_hz\":50,\"steer_deg\":0,\"gain_db\":0}",
+        "{\"op\":\"doppler\",\"colour\":\"on\",\"prf_hz\":4000,\"steer_deg\":45,\"gain_db\":0}",
+        "{\"op\":\"doppler\",\"colour\":\"on\",\"prf_hz\":4000,\"steer_deg\":0,\"gain_db\":31}",
+        "{\"op\":\"doppler\",\"colour\":\"yes\",\"prf_hz\":4000,\"steer_deg\":0,\"gain_db\":0}",
+        "{\"op\":\"doppler\",\"colour\":\"on\",\"prf_hz\":4000,\"steer_deg\":0,\"gain_db\":0,\"x\":1}",
         "{\"op\":\"auth\",\"pass\":\"\\u0041\"}",          /* unsupported escape */
         "{\"op\":{\"nested\":1}}",
     };

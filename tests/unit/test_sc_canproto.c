@@ -518,6 +518,120 @@ static void assessment_command_round_trips_and_bad_pairs_are_refused(void **stat
     assert_false(SC_MSG_IS_AUTH(SC_MSG_ASSESS_VESSELS));
 }
 
+/* ---- the vessels' drive (0x085) and the Doppler settings (0x086) --------------------------- */
+
+static void vessels_command_round_trips_and_out_of_range_is_refused(void **state)
+{
+    (void)state;
+    const float hr[] = {30.0f, 72.0f, 200.0f};
+    const float rr[] = {0.0f, 15.0f, 40.0f};
+    for (int i = 0; i < 3; i++) {
+        sc_cmd c = {.kind = SC_CMD_VESSELS};
+        c.vessels = (sc_vessels_cmd){hr[i], rr[i], (uint8_t)(i & 1), (uint8_t)((i >> 1) & 1)};
+        sc_can_frame f;
+        assert_int_equal(sc_canproto_encode_cmd(&c, (uint8_t)i, &f), 0);
+        assert_int_equal(f.id, 0x085);
+        assert_true(e2e_ok(&f));
+        sc_cmd d;
+        assert_int_equal(sc_canproto_decode_cmd(&f, &d), 0);
+        assert_int_equal(d.kind, SC_CMD_VESSELS);
+        assert_float_equal(d.vessels.heart_rate_bpm, hr[i], 0.0f);
+        assert_float_equal(d.vessels.resp_rate_bpm, rr[i], 0.0f);
+        assert_int_equal(d.vessels.valsalva, i & 1);
+        assert_int_equal(d.vessels.pulse, (i >> 1) & 1);
+        float phys[SC_CANPROTO_MAX_SIGS];
+        sc_msg m;
+        assert_int_equal(sc_canproto_decode_phys(&f, &m, phys, SC_CANPROTO_MAX_SIGS), 0);
+        assert_int_equal(m, SC_MSG_CMD_VESSELS);
+        assert_float_equal(phys[2], hr[i], 0.0f);
+        assert_float_equal(phys[3], rr[i], 0.0f);
+    }
+    /* refused by the encoder: heart rate 29 / 201, breathing 41, a NaN, Valsalva 2 */
+    const sc_vessels_cmd bad[] = {{29.0f, 12.0f, 0, 1}, {201.0f, 12.0f, 0, 1},
+                                  {72.0f, 41.0f, 0, 1}, {NAN, 12.0f, 0, 1},
+                                  {72.0f, 12.0f, 2, 1}, {72.0f, 12.0f, 0, 3}};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        sc_cmd c = {.kind = SC_CMD_VESSELS};
+        c.vessels = bad[i];
+        sc_can_frame f;
+        assert_true(sc_canproto_encode_cmd(&c, 0, &f) != 0);
+    }
+    /* refused by the decoder: a frame built by hand with heart rate 250, then breathing 60 */
+    const uint8_t raw[2][2] = {{250u, 12u}, {72u, 60u}};
+    for (int i = 0; i < 2; i++) {
+        sc_can_frame f = {.id = 0x085, .len = 8};
+        f.data[2] = raw[i][0];
+        f.data[3] = raw[i][1];
+        assert_int_equal(sc_e2e_protect_with(0x085, 0, f.data, f.len), 0);
+        sc_cmd d;
+        assert_int_equal(sc_canproto_decode_cmd(&f, &d), SC_ERR_CAN_SIGNAL);
+    }
+    sc_can_frame pdu = {.id = 0x08D, .len = 8};
+    sc_msg m;
+    assert_int_equal(sc_canproto_classify(&pdu, &m), 0);
+    assert_int_equal(m, SC_MSG_AUTH_VESSELS);
+    assert_true(SC_MSG_IS_AUTH(m));
+    assert_true(SC_MSG_IS_CMD(SC_MSG_CMD_VESSELS));
+    assert_int_equal(sc_canproto_cmd_msg(SC_CMD_VESSELS), SC_MSG_CMD_VESSELS);
+}
+
+static void doppler_command_round_trips_and_out_of_range_is_refused(void **state)
+{
+    (void)state;
+    const sc_doppler_cmd ok[] = {{1u, 100.0f, -30.0f, -30.0f},
+                                 {0u, 4000.0f, 0.0f, 0.0f},
+                                 {1u, 20000.0f, 30.0f, 30.0f},
+                                 {1u, 2500.0f, -12.0f, 4.5f}};
+    for (size_t i = 0; i < sizeof ok / sizeof ok[0]; i++) {
+        sc_cmd c = {.kind = SC_CMD_DOPPLER};
+        c.doppler = ok[i];
+        sc_can_frame f;
+        assert_int_equal(sc_canproto_encode_cmd(&c, (uint8_t)i, &f), 0);
+        assert_int_equal(f.id, 0x086);
+        assert_true(e2e_ok(&f));
+        sc_cmd d;
+        assert_int_equal(sc_canproto_decode_cmd(&f, &d), 0);
+        assert_int_equal(d.kind, SC_CMD_DOPPLER);
+        assert_int_equal(d.doppler.on, ok[i].on);
+        assert_float_equal(d.doppler.prf_hz, ok[i].prf_hz, 0.0f);
+        assert_float_equal(d.doppler.steer_deg, ok[i].steer_deg, 0.0f);
+        assert_float_equal(d.doppler.gain_db, ok[i].gain_db, 0.0f);
+    }
+    const sc_doppler_cmd bad[] = {{1u, 99.0f, 0.0f, 0.0f},   {1u, 20001.0f, 0.0f, 0.0f},
+                                  {1u, 4000.0f, 31.0f, 0.0f}, {1u, 4000.0f, -31.0f, 0.0f},
+                                  {1u, 4000.0f, 0.0f, 30.5f}, {1u, 4000.0f, 0.0f, NAN},
+                                  {2u, 4000.0f, 0.0f, 0.0f}};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        sc_cmd c = {.kind = SC_CMD_DOPPLER};
+        c.doppler = bad[i];
+        sc_can_frame f;
+        assert_true(sc_canproto_encode_cmd(&c, 0, &f) != 0);
+    }
+    /* by hand: PRF 50 Hz (raw 50), steering 100 deg, gain -64 dB: each refused alone */
+    for (int i = 0; i < 3; i++) {
+        sc_can_frame f = {.id = 0x086, .len = 8};
+        f.data[2] = 1u;
+        f.data[3] = (uint8_t)(4000u & 0xFFu);
+        f.data[4] = (uint8_t)(4000u >> 8);
+        if (i == 0) {
+            f.data[3] = 50u;
+            f.data[4] = 0u;
+        } else if (i == 1) {
+            f.data[5] = 100u;
+        } else {
+            f.data[6] = 0x80u; /* -128 * 0.5 dB */
+        }
+        assert_int_equal(sc_e2e_protect_with(0x086, 0, f.data, f.len), 0);
+        sc_cmd d;
+        assert_int_equal(sc_canproto_decode_cmd(&f, &d), SC_ERR_CAN_SIGNAL);
+    }
+    sc_can_frame pdu = {.id = 0x08E, .len = 8};
+    sc_msg m;
+    assert_int_equal(sc_canproto_classify(&pdu, &m), 0);
+    assert_int_equal(m, SC_MSG_AUTH_DOPPLER);
+    assert_int_equal(sc_canproto_cmd_msg(SC_CMD_DOPPLER), SC_MSG_CMD_DOPPLER);
+}
+
 static void assessment_frames_decode_as_the_dbc_says(void **state)
 {
     (void)state;
@@ -627,6 +741,8 @@ int main(void)
         cmocka_unit_test(frames_with_unknown_id_wrong_length_or_format_are_classified_as_such),
         cmocka_unit_test(signals_of_a_message_do_not_overlap_and_fit_its_length),
         cmocka_unit_test(dbc_file_defines_exactly_the_codec_tables),
+        cmocka_unit_test(vessels_command_round_trips_and_out_of_range_is_refused),
+        cmocka_unit_test(doppler_command_round_trips_and_out_of_range_is_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

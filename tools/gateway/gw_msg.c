@@ -178,6 +178,12 @@ static int only(const member *m, int n, const char *const *keys)
     return 1;
 }
 
+/* 0 or 1 exactly */
+static int is_bit(double v)
+{
+    return v >= 0.0 && v <= 1.0 && !(floor(v) < v);
+}
+
 static int fail(const char **why, const char *reason)
 {
     *why = reason;
@@ -344,9 +350,43 @@ int gw_msg_parse(const char *text, size_t len, gw_msg *out, const char **why)
         r.op = GW_OP_REPLAY;
         r.name = "replay";
         strcpy(r.file, f->str);
+    } else if (strcmp(op->str, "vessels") == 0) {
+        /* the vessels' drive (CmdVessels): heart and breathing rates, Valsalva, pulsation */
+        static const char *const k[] = {"op",       "heart_rate_bpm", "resp_rate_bpm",
+                                        "valsalva", "pulse",          NULL};
+        const member *hr = find(m, n, "heart_rate_bpm", 0), *rr = find(m, n, "resp_rate_bpm", 0),
+                     *va = find(m, n, "valsalva", 0), *pu = find(m, n, "pulse", 0);
+        if (!only(m, n, k) || !hr || !rr || !va || !pu || !is_bit(va->num) || !is_bit(pu->num)) {
+            return fail(why, "vessels wants heart_rate_bpm (30..200), resp_rate_bpm (0..40) "
+                             "(numbers), valsalva and pulse (0|1)");
+        }
+        r.op = GW_OP_COMMAND;
+        r.name = "vessels";
+        r.cmd.kind = SC_CMD_VESSELS;
+        r.cmd.vessels.heart_rate_bpm = (float)hr->num;
+        r.cmd.vessels.resp_rate_bpm = (float)rr->num;
+        r.cmd.vessels.valsalva = va->num > 0.5 ? 1u : 0u;
+        r.cmd.vessels.pulse = pu->num > 0.5 ? 1u : 0u;
+    } else if (strcmp(op->str, "doppler") == 0) {
+        /* colour Doppler (CmdDoppler): on/off, scale, steering, colour gain */
+        static const char *const k[] = {"op", "colour", "prf_hz", "steer_deg", "gain_db", NULL};
+        const member *c = find(m, n, "colour", 1), *prf = find(m, n, "prf_hz", 0),
+                     *st = find(m, n, "steer_deg", 0), *g = find(m, n, "gain_db", 0);
+        if (!only(m, n, k) || !c || !prf || !st || !g ||
+            (strcmp(c->str, "on") != 0 && strcmp(c->str, "off") != 0)) {
+            return fail(why, "doppler wants colour (\"on\"|\"off\"), prf_hz (100..20000), "
+                             "steer_deg (-30..30), gain_db (-30..30)");
+        }
+        r.op = GW_OP_COMMAND;
+        r.name = "doppler";
+        r.cmd.kind = SC_CMD_DOPPLER;
+        r.cmd.doppler.on = strcmp(c->str, "on") == 0 ? 1u : 0u;
+        r.cmd.doppler.prf_hz = (float)prf->num;
+        r.cmd.doppler.steer_deg = (float)st->num;
+        r.cmd.doppler.gain_db = (float)g->num;
     } else {
         return fail(why, "unknown op (auth, ping, case, method, imaging, reset, assess, sessions, "
-                         "replay)");
+                         "replay, vessels, doppler)");
     }
     if (r.op == GW_OP_COMMAND) {
         sc_can_frame f;

@@ -19,6 +19,7 @@
  * AES-CMAC (sc_cmdsign.h) under the given key (default: the bench key). KIND=VALUE:
  *   case=N  method=msds|fem  reset=tissue|faults|all
  *   imaging=DEPTH_MM:GAIN_DB:DYN_RANGE_DB:TGC_DB_PER_CM:linear|curvilinear
+ *   vessels=HR_BPM:RR_PER_MIN:VALSALVA(0|1):PULSE(0|1)   doppler=on|off:PRF_HZ:STEER_DEG:GAIN_DB
  * Summary (samples, frames, injected faults) on stderr; exit 0, 2 on a usage error, 1 on an
  * I/O error. */
 #include <errno.h>
@@ -61,7 +62,11 @@ static void usage(void)
             "faults: bad-crc counter-jump repeat silence implausible\n"
             "commands: case=N method=msds|fem reset=tissue|faults|all\n"
             "          imaging=DEPTH_MM:GAIN_DB:DYN_RANGE_DB:TGC_DB_PER_CM:linear|curvilinear\n"
-            "          assess=reset call=normal|dvt (the compression exam's assessment)\n");
+            "          assess=reset call=normal|dvt (the compression exam's assessment)\n"
+            "          vessels=HR_BPM:RR_PER_MIN:VALSALVA(0|1):PULSE(0|1) (heart rate 30..200,\n"
+            "            respiration 0 or 4..40, Valsalva held, arterial pulse on)\n"
+            "          doppler=on|off:PRF_HZ:STEER_DEG:GAIN_DB (colour Doppler, scale 100..20000,\n"
+            "            steering -30..30, gain -30..30)\n");
 }
 
 /* A whole, finite number (NaN and infinities compare false with every range below). */
@@ -173,6 +178,32 @@ static int parse_command(const char *arg, timed_cmd *out)
         } else if (strcmp(val, "dvt") == 0) {
             c.assess_call = SC_ASSESS_CALL_DVT;
         } else {
+            return -1;
+        }
+    } else if (strcmp(buf, "vessels") == 0) {
+        /* vessels=HR:RR:VALSALVA(0|1):PULSE(0|1) */
+        unsigned va, pu;
+        char tail;
+        c.kind = SC_CMD_VESSELS;
+        if (sscanf(val, "%f:%f:%u:%u%c", &c.vessels.heart_rate_bpm, &c.vessels.resp_rate_bpm, &va,
+                   &pu, &tail) != 4 ||
+            va > 1u || pu > 1u) {
+            return -1;
+        }
+        c.vessels.valsalva = (uint8_t)va;
+        c.vessels.pulse = (uint8_t)pu;
+    } else if (strcmp(buf, "doppler") == 0) {
+        /* doppler=on|off:PRF_HZ:STEER_DEG:GAIN_DB */
+        char onoff[4];
+        char tail;
+        c.kind = SC_CMD_DOPPLER;
+        if (sscanf(val, "%3[a-z]:%f:%f:%f%c", onoff, &c.doppler.prf_hz, &c.doppler.steer_deg,
+                   &c.doppler.gain_db, &tail) != 4) {
+            return -1;
+        }
+        if (strcmp(onoff, "on") == 0) {
+            c.doppler.on = 1u;
+        } else if (strcmp(onoff, "off") != 0) {
             return -1;
         }
     } else if (strcmp(buf, "imaging") == 0) {

@@ -459,6 +459,33 @@ function imagingChanged() {
   }), 150);
 }
 for (const id of ['gain', 'tgc', 'depth', 'dr', 'geometry']) $(id).addEventListener('input', imagingChanged);
+// vessels (CmdVessels) and colour Doppler (CmdDoppler): every field at once, as each carries them
+let vesTimer = null, dopTimer = null;
+function vesselsChanged() {
+  $('hr-v').textContent = $('hr').value;
+  $('rr-v').textContent = $('rr').value;
+  clearTimeout(vesTimer);
+  const rr = +$('rr').value;
+  vesTimer = setTimeout(() => send({
+    op: 'vessels', heart_rate_bpm: +$('hr').value, resp_rate_bpm: rr < 4 ? 0 : rr,
+    valsalva: $('valsalva').getAttribute('aria-pressed') === 'true' ? 1 : 0, pulse: $('pulse').checked ? 1 : 0,
+  }), 150);
+}
+for (const id of ['hr', 'rr', 'pulse']) $(id).addEventListener('input', vesselsChanged);
+$('valsalva').onclick = () => {
+  const b = $('valsalva');
+  b.setAttribute('aria-pressed', b.getAttribute('aria-pressed') === 'true' ? 'false' : 'true');
+  vesselsChanged();
+};
+function dopplerChanged() {
+  for (const [id, out] of [['prf', 'prf-v'], ['steer', 'steer-v'], ['cgain', 'cgain-v']]) $(out).textContent = $(id).value;
+  clearTimeout(dopTimer);
+  dopTimer = setTimeout(() => send({
+    op: 'doppler', colour: $('colour').checked ? 'on' : 'off', prf_hz: +$('prf').value,
+    steer_deg: +$('steer').value, gain_db: +$('cgain').value,
+  }), 150);
+}
+for (const id of ['colour', 'prf', 'steer', 'cgain']) $(id).addEventListener('input', dopplerChanged);
 let methodPendingUntil = 0, pendingMethod = null;
 for (const r of document.querySelectorAll('input[name=method]')) {
   r.onchange = () => {
