@@ -6,8 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
-/* The 5x7 font (the viewer's, tools/viewer/vw_overlay.c: the platform library cannot use a
- * tool's code). */
+/* The 5x7 font, shared with the viewer (tools/viewer/vw_overlay.c calls sc_overlay_text). */
 /* Rows top to bottom, bit 4 = leftmost column. */
 static const uint8_t k_digits[10][7] = {
     {0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E}, {0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E},
