@@ -29,6 +29,7 @@
 #include "sc_labels.h"
 #include "sc_test_cmd.h"
 #include "sc_test_press.h"
+#include "sc_test_signal.h"
 #include "sc_trkemu.h"
 
 static sc_hs_rig rig;
@@ -128,40 +129,6 @@ static int send_doppler(uint8_t on, float prf, float steer, float gain)
     return send(&c);
 }
 
-/* the frequency (Hz) of the largest DFT bin of x (mean removed), bins k / (n dt), k >= 1 */
-static double peak_hz(const float *x, uint32_t n, double dt)
-{
-    double mean = 0.0;
-    for (uint32_t i = 0; i < n; i++) {
-        mean += x[i];
-    }
-    mean /= n;
-    double best = -1.0, best_hz = 0.0;
-    for (uint32_t k = 1; k < n / 2u; k++) {
-        double re = 0.0, im = 0.0;
-        for (uint32_t i = 0; i < n; i++) {
-            const double a = 6.283185307179586 * (double)k * (double)i / (double)n;
-            re += (x[i] - mean) * cos(a);
-            im += (x[i] - mean) * sin(a);
-        }
-        const double pw = re * re + im * im;
-        if (pw > best) {
-            best = pw;
-            best_hz = (double)k / ((double)n * dt);
-        }
-    }
-    return best_hz;
-}
-
-static float mean_of(const float *x, uint32_t n)
-{
-    float s = 0.0f;
-    for (uint32_t i = 0; i < n; i++) {
-        s += x[i];
-    }
-    return s / (float)n;
-}
-
 static void heart_rate_command_sets_the_arterys_pulse(void **state)
 {
     (void)state;
@@ -175,7 +142,7 @@ static void heart_rate_command_sets_the_arterys_pulse(void **state)
         assert_float_equal(sc_test_press_tissue(&rig)->lumen.drive.heart_rate_bpm, bpm[i], 0.0f);
         record(hz, SC_LABEL_ARTERY, NULL); /* settle */
         record(n, SC_LABEL_ARTERY, series);
-        const double f = peak_hz(series, n, 1.0 / hz);
+        const double f = sc_test_peak_hz(series, n, 1.0 / hz);
         print_message("CmdVessels %.0f / min: artery image area peak at %.3f Hz (set %.3f Hz)\n",
                       (double)bpm[i], f, (double)bpm[i] / 60.0);
         assert_true(fabs(f - (double)bpm[i] / 60.0) <= 0.125 + 1e-9); /* bins 0.25 Hz apart */
@@ -201,13 +168,13 @@ static void valsalva_command_distends_the_vein(void **state)
     const uint32_t hz = rig.engine.def.sched.rate_hz;
     assert_int_equal(send_vessels(72.0f, 0.0f, 0u, 0u), 1); /* still vessels */
     record(hz, SC_LABEL_VEIN, series);
-    const float before = mean_of(series + hz / 2u, hz / 2u);
+    const float before = sc_test_mean(series + hz / 2u, hz / 2u);
     assert_int_equal(send_vessels(72.0f, 0.0f, 1u, 0u), 1);
     record(2u * hz, SC_LABEL_VEIN, series);
-    const float during = mean_of(series + hz, hz);
+    const float during = sc_test_mean(series + hz, hz);
     assert_int_equal(send_vessels(72.0f, 0.0f, 0u, 0u), 1);
     record(2u * hz, SC_LABEL_VEIN, series);
-    const float after = mean_of(series + hz, hz);
+    const float after = sc_test_mean(series + hz, hz);
     print_message("CmdVessels Valsalva: vein image area %.3f, held %.3f (%+.1f%%), released %.3f\n",
                   (double)before, (double)during, 100.0 * (double)(during / before - 1.0f),
                   (double)after);

@@ -21,6 +21,7 @@
 #include "sc_hs_rig.h"
 #include "sc_labels.h"
 #include "sc_test_press.h"
+#include "sc_test_signal.h"
 #include "sc_trkemu.h"
 
 static sc_hs_rig rig;
@@ -86,31 +87,6 @@ static void record(uint64_t t0, int *more, uint32_t frames, uint32_t label, floa
     }
 }
 
-/* the frequency (Hz) of the largest DFT bin of x (mean removed), bins k / (n dt), k >= 1 */
-static double peak_hz(const float *x, uint32_t n, double dt)
-{
-    double mean = 0.0;
-    for (uint32_t i = 0; i < n; i++) {
-        mean += x[i];
-    }
-    mean /= n;
-    double best = -1.0, best_hz = 0.0;
-    for (uint32_t k = 1; k < n / 2u; k++) {
-        double re = 0.0, im = 0.0;
-        for (uint32_t i = 0; i < n; i++) {
-            const double a = 6.283185307179586 * (double)k * (double)i / (double)n;
-            re += (x[i] - mean) * cos(a);
-            im += (x[i] - mean) * sin(a);
-        }
-        const double pw = re * re + im * im;
-        if (pw > best) {
-            best = pw;
-            best_hz = (double)k / ((double)n * dt);
-        }
-    }
-    return best_hz;
-}
-
 static void min_max(const float *x, uint32_t n, float *lo, float *hi)
 {
     *lo = x[0];
@@ -133,7 +109,7 @@ static uint64_t pulse_run(sc_tissue_method m, float bpm)
     int more = 1;
     record(t0, &more, (uint32_t)(SETTLE_S * hz), SC_LABEL_ARTERY, NULL);
     record(t0, &more, n, SC_LABEL_ARTERY, series);
-    const double f = peak_hz(series, n, 1.0 / hz);
+    const double f = sc_test_peak_hz(series, n, 1.0 / hz);
     float lo, hi;
     min_max(series, n, &lo, &hi);
     const float pp = (hi - lo) / (0.5f * (hi + lo));
@@ -161,15 +137,6 @@ static void artery_pulsates_at_the_set_heart_rate(void **state)
     }
 }
 
-static float mean_of(const float *x, uint32_t n)
-{
-    float s = 0.0f;
-    for (uint32_t i = 0; i < n; i++) {
-        s += x[i];
-    }
-    return s / (float)n;
-}
-
 static void valsalva_distends_the_vein(void **state)
 {
     (void)state;
@@ -182,13 +149,13 @@ static void valsalva_distends_the_vein(void **state)
         const uint32_t hz = rig.engine.def.sched.rate_hz;
         int more = 1;
         record(t0, &more, hz, SC_LABEL_VEIN, series);
-        const float before = mean_of(series + hz / 2u, hz / 2u);
+        const float before = sc_test_mean(series + hz / 2u, hz / 2u);
         sc_tissue_set_valsalva(sc_test_press_tissue(&rig), 1);
         record(t0, &more, 2u * hz, SC_LABEL_VEIN, series);
-        const float during = mean_of(series + hz, hz);
+        const float during = sc_test_mean(series + hz, hz);
         sc_tissue_set_valsalva(sc_test_press_tissue(&rig), 0);
         record(t0, &more, 2u * hz, SC_LABEL_VEIN, series);
-        const float after = mean_of(series + hz, hz);
+        const float after = sc_test_mean(series + hz, hz);
         print_message("neck-ijv %s: vein image area %.3f, Valsalva %.3f (%+.1f%%), after %.3f\n",
                       meth == SC_TISSUE_MSDS ? "msds" : "fem", (double)before, (double)during,
                       100.0 * (double)(during / before - 1.0f), (double)after);
