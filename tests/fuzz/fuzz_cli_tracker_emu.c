@@ -20,7 +20,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     sc_fuzz_quiet(0);
     SC_FUZZ_CHECK(rc == -1 || rc == 0 || rc == 2);
     if (rc < 0) {
-        SC_FUZZ_CHECK((a.iface == NULL) != (a.log_path == NULL));
+        /* exactly one output, as parse_cli requires: the bus, a log, or CAN over UDP */
+        SC_FUZZ_CHECK((a.iface != NULL) + (a.log_path != NULL) + (a.udp != NULL) == 1);
         SC_FUZZ_CHECK(a.t0_s >= 0.0 && a.t0_s < 1e11);
         SC_FUZZ_CHECK(a.def.n_faults <= SC_EMU_MAX_FAULTS);
         for (size_t f = 0; f < a.def.n_faults; f++) {
