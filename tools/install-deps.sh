@@ -12,7 +12,8 @@ base=(build-essential cmake pkg-config libccd-dev libcmocka-dev libpng-dev zlib1
       python3-pydicom python3-numpy
       libdcmtk-dev libteem-dev teem-apps libmbedtls-dev
       python3 python3-canmatrix libsdl2-dev xvfb xauth can-utils
-      libwebsockets-dev chromium)
+      libwebsockets-dev chromium
+      libbullet-dev)
 cross=(gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi
        gcc-aarch64-linux-gnu qemu-user-static dpkg-dev)
 cross_arm64=(libcmocka-dev:arm64 libccd-dev:arm64 zlib1g-dev:arm64 libpng-dev:arm64
