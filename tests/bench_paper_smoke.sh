@@ -2,7 +2,7 @@
 # bench_paper_smoke.sh BENCH CHECK WORKDIR: bench-paper at its smallest settings, then its
 # outputs checked (no timing asserted):
 #  1. exit status 0 and both tables printed;
-#  2. the CSV: header and 16 fields per row, one row per mesh x method x workers x run (2 x 2 x
+#  2. the CSV: header and 18 fields per row, one row per mesh x method x workers x run (2 x 2 x
 #     2 x 2 = 16) plus Bullet's 2 x 2 when it was built in (bench-paper-check);
 #  3. Fig. 9: a PNG that decodes, with bars (bench-paper-check);
 #  4. the output sink wrote B-scan frames (PNG files in the sink's folder).

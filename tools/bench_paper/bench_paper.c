@@ -78,6 +78,7 @@ typedef struct row {
     int valid;
     uint32_t nodes, tets;
     double step, step_min, step_max, cpu, coll, sampl, out, with_out, with_min, with_max;
+    double sampl_cpu, out_cpu; /* frame thread CPU ms of the B-scan (least disturbed run) */
     double disp_mm;
     uint64_t hash;
 } row;
@@ -95,6 +96,14 @@ static uint64_t cpu_ns(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
+}
+
+/* the calling thread's CPU time: the B-scan runs on the frame thread alone */
+static uint64_t thread_cpu_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
     return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
 }
 
@@ -425,7 +434,7 @@ static void build_scene(const uint32_t mesh[3])
 
 static void csv_row(FILE *csv, const uint32_t mesh[3], uint32_t nodes, uint32_t tets, int m,
                     uint32_t w, int run, int frames, double step, double cpu, double coll,
-                    double sampl, double out, double disp)
+                    double sampl, double out, double disp, double sampl_cpu, double out_cpu)
 {
     if (!csv) {
         return;
@@ -433,10 +442,10 @@ static void csv_row(FILE *csv, const uint32_t mesh[3], uint32_t nodes, uint32_t 
     fprintf(csv, "%ux%ux%u,%u,%u,%s,%u,%d,%d,%.4f,%.4f,", mesh[0], mesh[1], mesh[2], nodes, tets,
             k_method_name[m], (unsigned)w, run, frames, step, cpu);
     if (m == M_BULLET) {
-        fprintf(csv, ",,,,%.2f,,%.3f\n", 1000.0 / step, disp);
+        fprintf(csv, ",,,,%.2f,,%.3f,,\n", 1000.0 / step, disp);
     } else {
-        fprintf(csv, "%.4f,%.4f,%.4f,%.4f,%.2f,%.2f,%.3f\n", coll, sampl, out, step + out,
-                1000.0 / step, 1000.0 / (step + out), disp);
+        fprintf(csv, "%.4f,%.4f,%.4f,%.4f,%.2f,%.2f,%.3f,%.4f,%.4f\n", coll, sampl, out, step + out,
+                1000.0 / step, 1000.0 / (step + out), disp, sampl_cpu, out_cpu);
     }
 }
 
@@ -480,9 +489,9 @@ static int bench_ours(const uint32_t mesh[3], method m, const sc_pool_dev *pool,
         {g_t.mesh.cell_mm[0], g_t.mesh.cell_mm[1], g_t.mesh.cell_mm[2]}};
     static sc_contact_set cs;
     static uint64_t st[MAX_FRAMES], cp[MAX_FRAMES], co[MAX_FRAMES], sa[MAX_FRAMES],
-        ou[MAX_FRAMES], wo[MAX_FRAMES];
+        ou[MAX_FRAMES], wo[MAX_FRAMES], sac[MAX_FRAMES], ouc[MAX_FRAMES];
     double r_step[MAX_REPEATS], r_cpu[MAX_REPEATS], r_coll[MAX_REPEATS], r_sampl[MAX_REPEATS],
-        r_out[MAX_REPEATS], r_with[MAX_REPEATS];
+        r_out[MAX_REPEATS], r_with[MAX_REPEATS], r_sac[MAX_REPEATS], r_ouc[MAX_REPEATS];
     static uint32_t frame_no;
     for (int r = 0; r < o->repeats; r++) {
         for (int f = 0; f < o->frames; f++) {
@@ -496,11 +505,13 @@ static int bench_ours(const uint32_t mesh[3], method m, const sc_pool_dev *pool,
             }
             sc_collider_detect(&g_t.collider, &g, g_t.nodes.x, g_t.nodes.y, g_t.nodes.z,
                                g_t.mesh.node_fixed, g_t.stats.max_disp_mm, &cs);
+            const uint64_t c2 = thread_cpu_ns();
             const uint64_t t2 = now_ns();
             const int contact = g_t.stats.contacts > 0u;
             rc = sc_bscan_frame(&g_bscan, &g_t.mesh, &g_t.nodes, &g_scene.vol, &to_volume,
                                 contact, &k_null_dev, frame_no);
             const uint64_t t3 = now_ns();
+            const uint64_t c3 = thread_cpu_ns();
             if (rc != SC_OK) {
                 return rc;
             }
@@ -508,6 +519,8 @@ static int bench_ours(const uint32_t mesh[3], method m, const sc_pool_dev *pool,
             rc = sc_bscan_frame(&g_bscan, &g_t.mesh, &g_t.nodes, &g_scene.vol, &to_volume,
                                 contact, &g_sink.dev, frame_no % 8u);
             const uint64_t t4 = now_ns();
+            ouc[f] = thread_cpu_ns() - c3;
+            sac[f] = c3 - c2;
             frame_no++;
             /* a sink still busy with the last frame (the PNG writer) or a link down is the
              * sink's count, as in the engine (imaging_errors) */
@@ -526,8 +539,11 @@ static int bench_ours(const uint32_t mesh[3], method m, const sc_pool_dev *pool,
         r_sampl[r] = median_ms(sa, o->frames);
         r_out[r] = median_ms(ou, o->frames);
         r_with[r] = median_ms(wo, o->frames);
+        r_sac[r] = median_ms(sac, o->frames);
+        r_ouc[r] = median_ms(ouc, o->frames);
         csv_row(csv, mesh, g_t.mesh.node_count, g_t.mesh.tet_count, (int)m, w, r, o->frames,
-                r_step[r], r_cpu[r], r_coll[r], r_sampl[r], r_out[r], g_t.stats.max_disp_mm);
+                r_step[r], r_cpu[r], r_coll[r], r_sampl[r], r_out[r], g_t.stats.max_disp_mm,
+                r_sac[r], r_ouc[r]);
     }
     out->valid = 1;
     out->nodes = g_t.mesh.node_count;
@@ -537,6 +553,10 @@ static int bench_ours(const uint32_t mesh[3], method m, const sc_pool_dev *pool,
     out->step_max = r_step[o->repeats - 1];
     qsort(r_cpu, (size_t)o->repeats, sizeof r_cpu[0], cmp_d);
     out->cpu = r_cpu[0]; /* the least disturbed run, as bench-scale */
+    qsort(r_sac, (size_t)o->repeats, sizeof r_sac[0], cmp_d);
+    qsort(r_ouc, (size_t)o->repeats, sizeof r_ouc[0], cmp_d);
+    out->sampl_cpu = r_sac[0];
+    out->out_cpu = r_ouc[0];
     out->coll = median_d(r_coll, o->repeats);
     out->sampl = median_d(r_sampl, o->repeats);
     out->out = median_d(r_out, o->repeats);
@@ -601,7 +621,7 @@ static int bench_bullet(const uint32_t mesh[3], const opts *o, row *out, FILE *c
         r_step[r] = median_ms(st, o->frames);
         r_cpu[r] = median_ms(cp, o->frames);
         csv_row(csv, mesh, sm->node_count, sm->tet_count, M_BULLET, 1u, r, o->frames, r_step[r],
-                r_cpu[r], 0.0, 0.0, 0.0, bb_max_disp_mm(s));
+                r_cpu[r], 0.0, 0.0, 0.0, bb_max_disp_mm(s), 0.0, 0.0);
     }
     out->valid = 1;
     out->nodes = sm->node_count;
@@ -644,11 +664,12 @@ static void paper_figures(const uint32_t mesh[3], double *msds, double *fem, dou
 
 static void print_tables(const opts *o)
 {
-    printf("\nTable I (ms per frame, wall-clock median over runs, [min..max of the runs' "
-           "medians]; cpu = process CPU ms of the step, least disturbed run)\n");
-    printf("%-9s %6s %7s %-6s %2s %9s %21s %8s %8s %9s %8s %7s | %s\n", "mesh", "nodes", "tets",
-           "method", "w", "step ms", "spread", "cpu ms", "coll ms", "sampl ms", "out ms",
-           "disp mm", "paper ms");
+    printf("\nTable I (ms per frame. wall: median over runs of the runs' medians, [min..max of "
+           "them]; cpu: CPU time, least disturbed run's median: the step's process CPU (all "
+           "workers), the B-scan's frame-thread CPU)\n");
+    printf("%-9s %6s %7s %-6s %2s %9s %21s %8s %8s %9s %9s %8s %8s %7s | %s\n", "mesh", "nodes",
+           "tets", "method", "w", "step wall", "spread", "step cpu", "coll", "sampl wal",
+           "sampl cpu", "out wall", "out cpu", "disp mm", "paper ms");
     for (int mi = 0; mi < o->nmesh; mi++) {
         double pms, pfe, a, b, c, dd;
         paper_figures(o->mesh[mi], &pms, &pfe, &a, &b, &c, &dd);
@@ -664,26 +685,29 @@ static void print_tables(const opts *o)
                     snprintf(pbuf, sizeof pbuf, "%.0f", paper);
                 }
                 if (m == M_BULLET) {
-                    printf("%2ux%2ux%2u  %6u %7u %-6s %2u %9.3f %9.3f..%9.3f %8.3f %8s %9s %8s "
-                           "%7.2f | %s\n",
+                    printf("%2ux%2ux%2u  %6u %7u %-6s %2u %9.3f %9.3f..%9.3f %8.3f %8s %9s %9s "
+                           "%8s %8s %7.2f | %s\n",
                            o->mesh[mi][0], o->mesh[mi][1], o->mesh[mi][2], r->nodes, r->tets,
                            k_method_name[m], 1u, r->step, r->step_min, r->step_max, r->cpu, "-",
-                           "-", "-", r->disp_mm, pbuf);
+                           "-", "-", "-", "-", r->disp_mm, pbuf);
                 } else {
                     printf("%2ux%2ux%2u  %6u %7u %-6s %2u %9.3f %9.3f..%9.3f %8.3f %8.3f %9.3f "
-                           "%8.3f %7.2f | %s\n",
+                           "%9.3f %8.3f %8.3f %7.2f | %s\n",
                            o->mesh[mi][0], o->mesh[mi][1], o->mesh[mi][2], r->nodes, r->tets,
                            k_method_name[m], (unsigned)o->workers[wi], r->step, r->step_min,
-                           r->step_max, r->cpu, r->coll, r->sampl, r->out, r->disp_mm, pbuf);
+                           r->step_max, r->cpu, r->coll, r->sampl, r->sampl_cpu, r->out,
+                           r->out_cpu, r->disp_mm, pbuf);
                 }
             }
         }
     }
-    printf("\nTable II (frames per second: without output = 1000 / step, with output = 1000 / "
-           "(step + B-scan into the %s sink); [from the slowest .. fastest run])\n",
+    printf("\nTable II (frames per second. without output = 1000 / step, with output = 1000 / "
+           "(step + B-scan into the %s sink); wall: median [slowest .. fastest run]; cpu: from "
+           "the CPU times of Table I)\n",
            o->sink);
-    printf("%-9s %-6s %2s %9s %19s %9s %19s | %s\n", "mesh", "method", "w", "fps no out",
-           "spread", "fps out", "spread", "paper no vis (vis)");
+    printf("%-9s %-6s %2s %9s %19s %9s %19s %9s %9s | %s\n", "mesh", "method", "w",
+           "no out", "spread", "with out", "spread", "no out cpu", "out cpu",
+           "paper no vis (vis)");
     for (int mi = 0; mi < o->nmesh; mi++) {
         double pms, pfe, no, vis, nof, visf;
         paper_figures(o->mesh[mi], &pms, &pfe, &no, &vis, &nof, &visf);
@@ -699,11 +723,13 @@ static void print_tables(const opts *o)
                 } else if (m == M_FEM && nof > 0.0) {
                     snprintf(pbuf, sizeof pbuf, "%.3g (%.3g)", nof, visf);
                 }
-                printf("%2ux%2ux%2u  %-6s %2u %9.1f %8.1f..%8.1f %9.1f %8.1f..%8.1f | %s\n",
+                printf("%2ux%2ux%2u  %-6s %2u %9.1f %8.1f..%8.1f %9.1f %8.1f..%8.1f %10.1f %9.1f "
+                       "| %s\n",
                        o->mesh[mi][0], o->mesh[mi][1], o->mesh[mi][2], k_method_name[m],
                        (unsigned)o->workers[wi], 1000.0 / r->step, 1000.0 / r->step_max,
                        1000.0 / r->step_min, 1000.0 / r->with_out, 1000.0 / r->with_max,
-                       1000.0 / r->with_min, pbuf);
+                       1000.0 / r->with_min, 1000.0 / r->cpu, 1000.0 / (r->cpu + r->out_cpu),
+                       pbuf);
             }
         }
     }
@@ -794,7 +820,7 @@ int main(int argc, char **argv)
     }
     fprintf(csv, "mesh,nodes,tets,method,workers,run,frames,step_ms,step_cpu_ms,collision_ms,"
                  "sampling_ms,output_ms,frame_with_output_ms,fps_without_output,"
-                 "fps_with_output,max_disp_mm\n");
+                 "fps_with_output,max_disp_mm,sampling_cpu_ms,output_cpu_ms\n");
     if (sink_open(&o, &g_sink) != 0) {
         fclose(csv);
         return 1;

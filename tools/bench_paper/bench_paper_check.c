@@ -1,6 +1,6 @@
 /* bench_paper_check.c: the smoke test's checker of bench-paper's outputs (no timing asserted).
  *   bench-paper-check CSV PNG ROWS
- * CSV: the header bench-paper writes, then at least ROWS rows of 16 fields each: the mesh as
+ * CSV: the header bench-paper writes, then at least ROWS rows of 18 fields each: the mesh as
  * NXxNYxNZ, positive node and tet counts, a known method, a worker count, run and frame
  * numbers, finite non-negative times and rates (the sampling and output fields empty exactly on
  * Bullet's rows). PNG: decodes with libpng, at least 200 x 200 pixels, and has at least two
@@ -13,7 +13,8 @@
 
 static const char *const k_header =
     "mesh,nodes,tets,method,workers,run,frames,step_ms,step_cpu_ms,collision_ms,sampling_ms,"
-    "output_ms,frame_with_output_ms,fps_without_output,fps_with_output,max_disp_mm";
+    "output_ms,frame_with_output_ms,fps_without_output,fps_with_output,max_disp_mm,"
+    "sampling_cpu_ms,output_cpu_ms";
 
 static int fail(const char *what, long line)
 {
@@ -64,11 +65,11 @@ static int check_csv(const char *path, long min_rows)
             }
             continue;
         }
-        char *field[17];
+        char *field[19];
         int nf = 0;
         char *p = line;
         for (;;) {
-            if (nf == 17) {
+            if (nf == 19) {
                 break;
             }
             field[nf++] = p;
@@ -79,8 +80,8 @@ static int check_csv(const char *path, long min_rows)
             *c = '\0';
             p = c + 1;
         }
-        if (nf != 16) {
-            rc = fail("not 16 fields", n);
+        if (nf != 18) {
+            rc = fail("not 18 fields", n);
             break;
         }
         unsigned a, b, c;
@@ -108,7 +109,7 @@ static int check_csv(const char *path, long min_rows)
             rc = fail("node count is not NX*NY*NZ", n);
             break;
         }
-        for (int i = 7; i <= 15 && rc == 0; i++) {
+        for (int i = 7; i <= 17 && rc == 0; i++) {
             const int may_be_empty = bullet && i >= 9 && i != 13 && i != 15;
             if (may_be_empty ? field[i][0] != '\0' : !is_num(field[i])) {
                 rc = fail(may_be_empty ? "Bullet row with an imaging time" : "bad number", n);
