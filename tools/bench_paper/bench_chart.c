@@ -8,11 +8,11 @@
 #include "sc_png_write.h"
 
 #define W 1200
-#define H 640
+#define H 600
 #define ML 110 /* left margin (axis labels) */
 #define MR 20
 #define MT 50  /* title */
-#define MB 130 /* group names and legend */
+#define MB 90 /* group names and legend */
 
 static uint8_t g_px[H][W][3];
 
