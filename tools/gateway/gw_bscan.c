@@ -148,3 +148,97 @@ size_t gw_bscan_build(uint8_t *out, size_t cap, const sc_dlink_done *d, gw_spect
     }
     return (size_t)(m - out);
 }
+
+static uint16_t get_u16(const uint8_t *p)
+{
+    return (uint16_t)(p[0] | (p[1] << 8));
+}
+
+static uint32_t get_u32(const uint8_t *p)
+{
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
+}
+
+static float get_f32(const uint8_t *p)
+{
+    const uint32_t u = get_u32(p);
+    float f;
+    memcpy(&f, &u, sizeof f);
+    return f;
+}
+
+int gw_bscan_parse(const uint8_t *m, size_t n, gw_bscan_view *v)
+{
+    memset(v, 0, sizeof *v);
+    if (n < GW_BSCAN_HDR || m[0] != 'B' || (m[1] & ~0x07u) != 0u || m[2] != 0u || m[3] != 0u) {
+        return -1;
+    }
+    v->flags = m[1];
+    v->frame_no = get_u32(m + 4);
+    v->lines = get_u16(m + 8);
+    v->samples = get_u16(m + 10);
+    v->geometry_id = get_u16(m + 12);
+    v->link_flags = get_u16(m + 14);
+    v->depth_mm = get_f32(m + 16);
+    v->width_mm = get_f32(m + 20);
+    v->radius_mm = get_f32(m + 24);
+    v->vein_pm = get_u16(m + 28);
+    v->artery_pm = get_u16(m + 30);
+    if (v->lines == 0u || v->samples == 0u || v->lines > SC_MAX_SCAN_LINES ||
+        v->samples > SC_MAX_SCAN_SAMPLES) {
+        return -1;
+    }
+    size_t p = GW_BSCAN_HDR;
+    const size_t img = (size_t)v->lines * v->samples;
+    if (n - p < img) {
+        return -1;
+    }
+    v->image = m + p;
+    p += img;
+    if (v->flags & GW_BSCAN_HAS_PARAMS) {
+        if (n - p < GW_BSCAN_PARAMS) {
+            return -1;
+        }
+        v->params = m + p;
+        p += GW_BSCAN_PARAMS;
+    }
+    if ((v->flags & GW_BSCAN_HAS_COLOUR) && !(v->flags & GW_BSCAN_HAS_DOPPLER)) {
+        return -1; /* colour needs its box */
+    }
+    if (v->flags & GW_BSCAN_HAS_DOPPLER) {
+        if (n - p < GW_BSCAN_DOPPLER) {
+            return -1;
+        }
+        const uint8_t *d = m + p;
+        v->doppler = d;
+        v->box_line_lo = get_u16(d);
+        v->box_line_hi = get_u16(d + 2);
+        v->box_sample_lo = get_u16(d + 4);
+        v->box_sample_hi = get_u16(d + 6);
+        v->bins = get_u16(d + 26);
+        v->columns = get_u16(d + 28);
+        if (v->box_line_lo >= v->box_line_hi || v->box_line_hi > v->lines ||
+            v->box_sample_lo >= v->box_sample_hi || v->box_sample_hi > v->samples ||
+            v->bins > SC_DLINK_SPECTRUM_MAX || v->columns > GW_BSCAN_COLUMNS ||
+            get_u16(d + 30) != 0u) {
+            return -1;
+        }
+        p += GW_BSCAN_DOPPLER;
+        const size_t cols = (size_t)v->columns * (4u + v->bins);
+        if (n - p < cols) {
+            return -1;
+        }
+        v->spectrum = v->columns ? m + p : NULL;
+        p += cols;
+        if (v->flags & GW_BSCAN_HAS_COLOUR) {
+            const size_t box = (size_t)(v->box_line_hi - v->box_line_lo) *
+                               (size_t)(v->box_sample_hi - v->box_sample_lo);
+            if (n - p < box) {
+                return -1;
+            }
+            v->colour = (const int8_t *)(m + p);
+            p += box;
+        }
+    }
+    return p == n ? 0 : -1;
+}

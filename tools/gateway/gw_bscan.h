@@ -47,4 +47,24 @@ void gw_spectrum_clear(gw_spectrum_hist *h);
  * frame is not shown (inconsistent with its own geometry, or cap too small). */
 size_t gw_bscan_build(uint8_t *out, size_t cap, const sc_dlink_done *d, gw_spectrum_hist *h);
 
+/* A 'B' message read back (the page's decoder, tools/console/www/scanner.js decodeBscan, in C:
+ * the tests' reference). Pointers into the message. */
+typedef struct gw_bscan_view {
+    uint8_t flags;
+    uint32_t frame_no;
+    uint16_t lines, samples, geometry_id, link_flags;
+    float depth_mm, width_mm, radius_mm;
+    uint16_t vein_pm, artery_pm;
+    const uint8_t *image;   /* lines x samples, line after line */
+    const uint8_t *params;  /* GW_BSCAN_PARAMS bytes, or NULL */
+    const uint8_t *doppler; /* GW_BSCAN_DOPPLER bytes, or NULL */
+    uint16_t box_line_lo, box_line_hi, box_sample_lo, box_sample_hi, bins, columns;
+    const uint8_t *spectrum; /* columns x (u32 frame, bins bytes), or NULL */
+    const int8_t *colour;    /* box lines x box samples, or NULL */
+} gw_bscan_view;
+
+/* Read message m (n bytes). Returns 0, or -1 when it is not a 'B' message, is shorter or longer
+ * than its header and sections say, or its box or columns disagree with its geometry. */
+int gw_bscan_parse(const uint8_t *m, size_t n, gw_bscan_view *v);
+
 #endif /* GW_BSCAN_H */
