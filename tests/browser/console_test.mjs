@@ -249,6 +249,10 @@ if (scenario === 'sessions') {
   const [c1, f1] = await sp();
   if (!(c1 - c0 >= 2 && c1 - c0 >= 0.5 * (f1 - f0) && c1 - c0 <= f1 - f0 + GW_COLUMNS))
     await fail(`the spectrum scrolled ${c1 - c0} columns while the display link advanced ${f1 - f0} frames`);
+  const sz = await page.evaluate(() => { const f = window.sc.scanner.frame, d = f.doppler;
+    return `${window.sc.bscanBytes} B (${f.lines}x${f.samples} image, box ${d.lineHi - d.lineLo}x${d.sampleHi - d.sampleLo}, ${d.columns.length} columns of ${d.bins} bins)`; });
+  ok(`B-scan message with colour: ${sz}`);
+  await page.locator('#spectrum').screenshot({ path: path.join(outDir, 'spectrum.png') });
   ok(`spectrum: ${c1 - c0} columns while the display link advanced ${f1 - f0} frames (one column per frame, ${GW_COLUMNS} kept by the gateway)`);
   // colour off: no colour pixel anywhere in the panel
   await page.locator('#colour').setChecked(false);

@@ -460,7 +460,7 @@ function connect() {
     if (typeof ev.data === 'string') { try { onJson(JSON.parse(ev.data)); } catch (e) { log('bad reply'); } return; }
     const u8 = new Uint8Array(ev.data);
     if (u8[0] === 0x53) onRecord(ev.data);
-    else if (u8[0] === 0x42) onBscan(new DataView(ev.data), u8);
+    else if (u8[0] === 0x42) { sc.bscanBytes = u8.length; onBscan(new DataView(ev.data), u8); }
   };
 }
 connect();

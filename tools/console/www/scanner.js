@@ -270,6 +270,9 @@ export function createScanner(panel, spectrum) {
     const cm = (d.nyquistMmS / 10).toFixed(0);
     sctx.fillText(`+${cm}`, SW - 38, 9); sctx.fillText('0', SW - 38, SH / 2 + 4); sctx.fillText(`-${cm}`, SW - 38, SH - 2);
     sctx.fillText('cm/s', SW - 38, SH / 2 - 12);
+    const gate = `PW gate ${d.gateVelocityMmS >= 0 ? '+' : ''}${(d.gateVelocityMmS / 10).toFixed(1)} cm/s`;
+    sctx.fillStyle = '#000'; sctx.fillRect(0, 0, sctx.measureText(gate).width + 5, 12); // over the oldest columns
+    sctx.fillStyle = '#fff'; sctx.fillText(gate, 3, 10);
     state.gateVelocityMmS = d.gateVelocityMmS;
   }
 
