@@ -82,6 +82,7 @@ async function waitFor(page, fn, arg, what, ms = 20000) {
 const [canPort, statePort, dlinkPort, httpPort] = [await freeUdp(), await freeUdp(), await freeUdp(), await freeTcp()];
 const pass = 'instructor';
 const GW_COLUMNS = 16; // tools/gateway/gw_bscan.h GW_BSCAN_COLUMNS
+const GATE_X_MM = 4.6; // doppler: the probe's offset that puts neck-ijv's artery under the gate
 // sessions: a recorded bundle (another case than the live engine's, 3 s of the press script, the
 // trainee's call) and a broken one in the gateway's sessions folder
 const sessDir = path.join(outDir, 'sessions');
@@ -192,13 +193,14 @@ if (scenario === 'sessions') {
   ok(`replay ended (every image hash matched, last replay frame seen ${maxFrame}/${bundle.frames}); back on the live engine at frame ${await page.evaluate(() => window.sc.frame.frames)}`);
 } else if (scenario === 'doppler') {
   await waitFor(page, () => window.sc.surf && window.sc.surf.count >= 2, null, 'surfaces of the case');
-  // the probe on the skin over the default point, light contact, held, its beam tilted 20 deg
+  // the probe on the skin 4.6 mm beside the default point (the artery under the pulsed-wave
+  // gate, which sits mid-image at 20 mm), light contact, held, its beam tilted 20 deg
   // about the aperture (x) axis: the vessels cross the image plane, and a beam square to them
   // sees no velocity along it (cos 90 deg), as on a scanner
   const csv = path.join(outDir, 'hold.csv');
   const tilt = (20 * Math.PI) / 180, qw = Math.cos((Math.PI + tilt) / 2), qx = Math.sin((Math.PI + tilt) / 2);
   const rows = [[0, 30], [0.5, 30], [1.5, 0], [2.5, -1], [120, -1]];
-  writeFileSync(csv, rows.map(([t, z]) => `${t},0,0,${z},${qw.toFixed(5)},${qx.toFixed(5)},0,0,${(Math.max(0, -z) * 0.5).toFixed(2)}`).join('\n') + '\n');
+  writeFileSync(csv, rows.map(([t, z]) => `${t},${GATE_X_MM},0,${z},${qw.toFixed(5)},${qx.toFixed(5)},0,0,${(Math.max(0, -z) * 0.5).toFixed(2)}`).join('\n') + '\n');
   const emu = start('sc-tracker-emu', [path.join(build, 'tools/tracker_emu/sc-tracker-emu'), '--csv', csv, '--duration-s', '120', '--rate-hz', '30',
     '--udp', `127.0.0.1:${canPort}`]);
   // (30 poses a second: on this loaded host the engine may run at a fraction of real time, and
@@ -244,6 +246,7 @@ if (scenario === 'sessions') {
   await page.locator('#scene').screenshot({ path: path.join(outDir, 'scene-colour.png') }); // the image plane, for a reader
   // the spectrum scrolls (one column per engine frame) and the gate reads the flow model
   const sp = () => page.evaluate(() => [window.sc.scanner.spectrumColumns, window.sc.scanner.frame.frameNo]);
+  await page.evaluate(() => { window.sc.scanner.gateMaxMmS = 0; });
   const [c0, f0] = await sp();
   await sleep(2000);
   const [c1, f1] = await sp();
@@ -252,8 +255,11 @@ if (scenario === 'sessions') {
   const sz = await page.evaluate(() => { const f = window.sc.scanner.frame, d = f.doppler;
     return `${window.sc.bscanBytes} B (${f.lines}x${f.samples} image, box ${d.lineHi - d.lineLo}x${d.sampleHi - d.sampleLo}, ${d.columns.length} columns of ${d.bins} bins)`; });
   ok(`B-scan message with colour: ${sz}`);
+  const gateMax = await page.evaluate(() => window.sc.scanner.gateMaxMmS);
   await page.locator('#spectrum').screenshot({ path: path.join(outDir, 'spectrum.png') });
-  ok(`spectrum: ${c1 - c0} columns while the display link advanced ${f1 - f0} frames (one column per frame, ${GW_COLUMNS} kept by the gateway)`);
+  // the gate in the artery: flow toward the probe (red, as the artery's colour)
+  if (!(gateMax > 0)) await fail(`the pulsed-wave gate saw no flow toward the probe (max ${gateMax} mm/s)`);
+  ok(`spectrum: ${c1 - c0} columns while the display link advanced ${f1 - f0} frames (one column per frame, ${GW_COLUMNS} kept by the gateway); gate velocity up to ${gateMax.toFixed(0)} mm/s toward the probe`);
   // colour off: no colour pixel anywhere in the panel
   await page.locator('#colour').setChecked(false);
   await waitFor(page, () => !window.sc.scanner.frame.colour, null, 'frames without colour');

@@ -274,6 +274,7 @@ export function createScanner(panel, spectrum) {
     sctx.fillStyle = '#000'; sctx.fillRect(0, 0, sctx.measureText(gate).width + 5, 12); // over the oldest columns
     sctx.fillStyle = '#fff'; sctx.fillText(gate, 3, 10);
     state.gateVelocityMmS = d.gateVelocityMmS;
+    state.gateMaxMmS = Math.max(state.gateMaxMmS ?? 0, d.gateVelocityMmS);
   }
 
   // where the raster lies in the image frame (mm), for the image plane of the 3D view: the
