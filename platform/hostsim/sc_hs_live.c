@@ -61,6 +61,28 @@ static int tee_end(void *ctx, const sc_display_end_info *end)
     return sc_display_frame_end(&l->recorder, end);
 }
 
+/* colour Doppler (display link version 3): to the display link and the recorder alike */
+static int tee_colour(void *ctx, uint32_t fno, uint16_t li, uint16_t first, const int8_t *v,
+                      uint16_t count)
+{
+    sc_hs_live *l = ctx;
+    if (l->have_dlink) {
+        sc_display_dev d = sc_udp_display_dev(&l->dlink);
+        (void)sc_display_colour_line(&d, fno, li, first, v, count);
+    }
+    return sc_display_colour_line(&l->recorder, fno, li, first, v, count);
+}
+
+static int tee_doppler(void *ctx, const sc_display_doppler_info *info)
+{
+    sc_hs_live *l = ctx;
+    if (l->have_dlink) {
+        sc_display_dev d = sc_udp_display_dev(&l->dlink);
+        (void)sc_display_doppler(&d, info);
+    }
+    return sc_display_doppler(&l->recorder, info);
+}
+
 static int tee_state(void *ctx, sc_display_link_state *st)
 {
     sc_hs_live *l = ctx;
@@ -131,7 +153,8 @@ int sc_hs_live_open(sc_hs_live *l, const sc_hs_live_def *def, sc_hs_rig *rig, ch
         l->have_dlink = 1;
     }
     static const sc_display_ops tee = {
-        .frame_begin = tee_begin, .line = tee_line, .frame_end = tee_end, .link_state = tee_state};
+        .frame_begin = tee_begin, .line = tee_line, .frame_end = tee_end, .link_state = tee_state,
+        .colour_line = tee_colour, .doppler = tee_doppler};
     l->recorder = rig->hal.display;
     rig->hal.display = (sc_display_dev){.ops = &tee, .ctx = l};
     if (def->state_target || def->state_file) {

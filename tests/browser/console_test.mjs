@@ -11,6 +11,11 @@
 //             page with its score (sc-gateway --sessions); refused names and a broken bundle are
 //             answered; the replay button replays it into the console (its frames, its case), and
 //             the console is back on the live engine after it
+//   doppler   the probe held on the skin: with colour on, the B-scan panel (a screenshot) shows
+//             red/blue pixels inside the artery's section (cut from the live mesh), none anywhere
+//             with colour off; the spectrum scrolls; after a depth change the overlay's depth
+//             readout and scale match the engine's imaging depth; a curvilinear probe is drawn
+//             as a fan from its probe-face radius
 // Exit 0 pass, 1 fail, 77 skipped (chromium genuinely unavailable).
 import { spawn, spawnSync } from 'node:child_process';
 import { existsSync, mkdirSync, readFileSync, writeFileSync } from 'node:fs';
@@ -76,6 +81,8 @@ async function waitFor(page, fn, arg, what, ms = 20000) {
 
 const [canPort, statePort, dlinkPort, httpPort] = [await freeUdp(), await freeUdp(), await freeUdp(), await freeTcp()];
 const pass = 'instructor';
+const GW_COLUMNS = 16; // tools/gateway/gw_bscan.h GW_BSCAN_COLUMNS
+const GATE_X_MM = 4.6; // doppler: the probe's offset that puts neck-ijv's artery under the gate
 // sessions: a recorded bundle (another case than the live engine's, 3 s of the press script, the
 // trainee's call) and a broken one in the gateway's sessions folder
 const sessDir = path.join(outDir, 'sessions');
@@ -184,6 +191,121 @@ if (scenario === 'sessions') {
   if (!(maxFrame >= 0.9 * bundle.frames)) await fail(`the page saw the replay only up to frame ${maxFrame} of ${bundle.frames}`);
   await waitFor(page, (c) => window.sc.frame.caseCrc === c && window.sc.frame.frames > 0, live.crc, 'back on the live engine');
   ok(`replay ended (every image hash matched, last replay frame seen ${maxFrame}/${bundle.frames}); back on the live engine at frame ${await page.evaluate(() => window.sc.frame.frames)}`);
+} else if (scenario === 'doppler') {
+  await waitFor(page, () => window.sc.surf && window.sc.surf.count >= 2, null, 'surfaces of the case');
+  // the probe on the skin 4.6 mm beside the default point (the artery under the pulsed-wave
+  // gate, which sits mid-image at 20 mm), light contact, held, its beam tilted 20 deg
+  // about the aperture (x) axis: the vessels cross the image plane, and a beam square to them
+  // sees no velocity along it (cos 90 deg), as on a scanner
+  const csv = path.join(outDir, 'hold.csv');
+  const tilt = (20 * Math.PI) / 180, qw = Math.cos((Math.PI + tilt) / 2), qx = Math.sin((Math.PI + tilt) / 2);
+  const rows = [[0, 30], [0.5, 30], [1.5, 0], [2.5, -1], [120, -1]];
+  writeFileSync(csv, rows.map(([t, z]) => `${t},${GATE_X_MM},0,${z},${qw.toFixed(5)},${qx.toFixed(5)},0,0,${(Math.max(0, -z) * 0.5).toFixed(2)}`).join('\n') + '\n');
+  const emu = start('sc-tracker-emu', [path.join(build, 'tools/tracker_emu/sc-tracker-emu'), '--csv', csv, '--duration-s', '120', '--rate-hz', '30',
+    '--udp', `127.0.0.1:${canPort}`]);
+  // (30 poses a second: on this loaded host the engine may run at a fraction of real time, and
+  // 100 Hz of tracker frames would queue up in front of the page's commands)
+  // colour on from the page's Colour Doppler panel (every field is sent with the slider)
+  await page.locator('#colour').setChecked(true);
+  await page.locator('#prf').fill('3000');
+  await waitFor(page, () => window.sc.frame.contact === 1 && window.sc.scanner?.frame?.colour && window.sc.scanner.frame.doppler.nyquistMmS > 0,
+    null, 'frames with colour in contact', 40000);
+  // (the surfaces' triangles arrive in rounds: slower on a loaded host)
+  await waitFor(page, () => window.scSectionPx(5) !== null, null, 'the artery crosses the image plane', 60000);
+  // red/blue pixels of the panel (screenshots, what the user sees) inside a box
+  async function colourPixels(label, box) {
+    const png = await page.locator('#bscan').screenshot({ path: path.join(outDir, `bscan-${label}.png`) });
+    return page.evaluate(async ([b64, box]) => {
+      const img = await createImageBitmap(await (await fetch(`data:image/png;base64,${b64}`)).blob());
+      const c = new OffscreenCanvas(img.width, img.height), x = c.getContext('2d');
+      x.drawImage(img, 0, 0);
+      const d = x.getImageData(0, 0, img.width, img.height).data;
+      let red = 0, blue = 0, all = 0;
+      for (let y = 0; y < img.height; y++) for (let xx = 0; xx < img.width; xx++) {
+        const o = (y * img.width + xx) * 4, r = d[o], g = d[o + 1], b = d[o + 2];
+        const isRed = r >= 90 && r - b >= 60 && r - g >= 0, isBlue = b >= 90 && b - r >= 60 && b - g >= 0;
+        if (!isRed && !isBlue) continue;
+        all++;
+        if (box && xx >= box.x0 && xx <= box.x1 && y >= box.y0 && y <= box.y1) { red += isRed; blue += isBlue; }
+      }
+      return { red, blue, all, w: img.width, h: img.height };
+    }, [png.toString('base64'), box]);
+  }
+  let best = null;
+  for (let i = 0; i < 8 && !(best && best.red + best.blue >= 30); i++) {
+    const box = await page.evaluate(() => window.scSectionPx(5));
+    const n = await colourPixels(`colour-on-${i}`, box);
+    if (!best || n.red + n.blue > best.red + best.blue) best = { ...n, box };
+    await sleep(250);
+  }
+  const bx = best.box;
+  ok(`colour on: ${best.red} red + ${best.blue} blue px inside the artery's section (panel px ${bx.x0.toFixed(0)}..${bx.x1.toFixed(0)} x ${bx.y0.toFixed(0)}..${bx.y1.toFixed(0)}; ` +
+     `${bx.mm.x0.toFixed(1)}..${bx.mm.x1.toFixed(1)} mm lateral, ${bx.mm.z0.toFixed(1)}..${bx.mm.z1.toFixed(1)} mm deep), ${best.all} colour px in the panel`);
+  if (Math.abs(best.w - 290) > 1 || Math.abs(best.h - 290) > 1) await fail(`the panel screenshot is ${best.w}x${best.h}, want 290x290 (the canvas unscaled)`);
+  if (!(best.red + best.blue >= 30)) await fail(`too few colour pixels inside the artery with colour on: ${best.red + best.blue}`);
+  await page.locator('#scene').screenshot({ path: path.join(outDir, 'scene-colour.png') }); // the image plane, for a reader
+  // the spectrum scrolls (one column per engine frame) and the gate reads the flow model
+  const sp = () => page.evaluate(() => [window.sc.scanner.spectrumColumns, window.sc.scanner.frame.frameNo]);
+  await page.evaluate(() => { window.sc.scanner.gateMaxMmS = 0; });
+  const [c0, f0] = await sp();
+  await sleep(2000);
+  const [c1, f1] = await sp();
+  if (!(c1 - c0 >= 2 && c1 - c0 >= 0.5 * (f1 - f0) && c1 - c0 <= f1 - f0 + GW_COLUMNS))
+    await fail(`the spectrum scrolled ${c1 - c0} columns while the display link advanced ${f1 - f0} frames`);
+  const sz = await page.evaluate(() => { const f = window.sc.scanner.frame, d = f.doppler;
+    return `${window.sc.bscanBytes} B (${f.lines}x${f.samples} image, box ${d.lineHi - d.lineLo}x${d.sampleHi - d.sampleLo}, ${d.columns.length} columns of ${d.bins} bins)`; });
+  ok(`B-scan message with colour: ${sz}`);
+  const gateMax = await page.evaluate(() => window.sc.scanner.gateMaxMmS);
+  await page.locator('#spectrum').screenshot({ path: path.join(outDir, 'spectrum.png') });
+  // the gate in the artery: flow toward the probe (red, as the artery's colour)
+  if (!(gateMax > 0)) await fail(`the pulsed-wave gate saw no flow toward the probe (max ${gateMax} mm/s)`);
+  ok(`spectrum: ${c1 - c0} columns while the display link advanced ${f1 - f0} frames (one column per frame, ${GW_COLUMNS} kept by the gateway); gate velocity up to ${gateMax.toFixed(0)} mm/s toward the probe`);
+  // colour off: no colour pixel anywhere in the panel
+  await page.locator('#colour').setChecked(false);
+  await waitFor(page, () => !window.sc.scanner.frame.colour, null, 'frames without colour');
+  await sleep(300);
+  const off = await colourPixels('colour-off', null);
+  if (off.all !== 0) await fail(`${off.all} colour pixels in the panel with colour off`);
+  ok('colour off: no red or blue pixel in the panel');
+  // depth: the overlay's readout and scale follow the engine's imaging depth
+  await page.locator('#depth').fill('30');
+  await waitFor(page, () => Math.abs(window.sc.frame.depthMm - 30) < 0.01 && Math.abs(window.sc.scanner.frame.depthMm - 30) < 0.01,
+    null, 'the engine images 30 mm deep');
+  await sleep(200);
+  // the image's last row (the scan-converted image, transparent outside it) in the middle column
+  const ov = await page.evaluate(() => {
+    const c = window.scScannerImage(), x = c.getContext('2d'), col = x.getImageData(c.width >> 1, 0, 1, c.height).data;
+    let bottom = -1;
+    for (let y = 0; y < c.height; y++) if (col[4 * y + 3] > 0) bottom = y;
+    return { o: window.sc.scanner.overlay, engine: window.sc.frame.depthMm, bottom };
+  });
+  const want = `D${(ov.engine / 10).toFixed(1)}CM`;
+  if (!ov.o.readout[0].includes(want)) await fail(`overlay readout "${ov.o.readout[0]}" lacks ${want}`);
+  const last = ov.o.ticks[ov.o.ticks.length - 1];
+  if (last.mm !== 30 || Math.abs(last.y - ov.bottom) > 1) await fail(`the depth scale's last tick: ${JSON.stringify(last)}, want 30 mm at the image's bottom row ${ov.bottom}`);
+  ok(`overlay: "${ov.o.readout.join(' | ')}"; engine depth ${ov.engine} mm; scale ${ov.o.ticks.length} ticks, 3 cm at y ${last.y} (image's last row ${ov.bottom}); focus ${JSON.stringify(ov.o.focus)}`);
+  await page.locator('#bscan').screenshot({ path: path.join(outDir, 'bscan-depth30.png') });
+  // curvilinear: the fan (its probe-face radius) leaves the panel's top corners black
+  await page.locator('#geometry').selectOption('curvilinear');
+  await waitFor(page, () => window.sc.scanner.frame.geometry === 1, null, 'curvilinear frames');
+  await sleep(300);
+  const fan = await page.evaluate(() => {
+    const f = window.sc.scanner.frame, c = document.querySelector('#bscan').getContext('2d');
+    const at = (x, y) => c.getImageData(x, y, 1, 1).data;
+    // each depth tick on the fan's right edge: the image inside it, nothing outside it
+    const img = window.scScannerImage().getContext('2d'), alpha = (x, y) => img.getImageData(x, y, 1, 1).data[3];
+    const ticks = window.sc.scanner.overlay.ticks;
+    const offEdge = ticks.filter((t) => t.x + 3 < 290 && !(alpha(t.x - 3, t.y) > 0 && alpha(t.x + 3, t.y) === 0));
+    return { radius: f.radiusMm, sector: f.widthMm, corner: [...at(1, 60)], last: ticks.at(-1), ticks: ticks.length, offEdge };
+  });
+  await page.locator('#bscan').screenshot({ path: path.join(outDir, 'bscan-curvilinear.png') });
+  if (!(fan.radius > 0)) await fail(`curvilinear frames carry no probe-face radius: ${JSON.stringify(fan)}`);
+  if (fan.corner[0] + fan.corner[1] + fan.corner[2] !== 0) await fail(`the panel's top left corner is not black outside the fan: ${fan.corner}`);
+  if (fan.offEdge.length > 0 || fan.ticks < 6) await fail(`depth ticks off the fan's edge: ${JSON.stringify(fan.offEdge)} (${fan.ticks} ticks)`);
+  ok(`curvilinear: radius ${fan.radius} mm, sector ${fan.sector} deg; ${fan.ticks} depth ticks on the fan's right edge, the last ${JSON.stringify(fan.last)}`);
+  await page.locator('#geometry').selectOption('linear');
+  emu.kill('SIGTERM');
+  await stopped(emu);
 } else if (scenario === 'press') {
   await waitFor(page, () => window.sc.surf && window.sc.surf.count >= 2, null, 'surfaces of the case');
   await sleep(2500); // every triangle and vertex round has arrived

@@ -50,6 +50,7 @@
 #include "sc_case.h"
 #include "sc_cmdsign.h"
 #include "sc_dlink.h"
+#include "gw_bscan.h"
 #include "sc_err.h"
 #include "sc_socketcan.h"
 #include "sc_state.h"
@@ -58,8 +59,7 @@
 
 #define RING 2048u
 #define MAX_CAT 32u
-#define BSCAN_HDR 32u
-#define BSCAN_MAX (BSCAN_HDR + SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES)
+#define BSCAN_MAX GW_BSCAN_MAX /* with the colour box, parameters and spectrum (gw_bscan.h) */
 #define TEXT_MAX 16384u
 #define SESS_MAX 64u                  /* bundles listed */
 #define SESS_JSON_MAX 49152u          /* the list's JSON */
@@ -298,36 +298,21 @@ static void on_state(const uint8_t *b, size_t n)
     pthread_mutex_unlock(&g.lock);
 }
 
-static void put_u16(uint8_t *p, uint16_t v)
+static void on_frame(const sc_dlink_done *d, int src)
 {
-    p[0] = (uint8_t)v;
-    p[1] = (uint8_t)(v >> 8);
-}
-
-static void on_frame(const sc_dlink_done *d)
-{
-    const uint32_t lines = d->frame.line_count, samples = d->frame.samples;
-    if (lines * samples + BSCAN_HDR > BSCAN_MAX) {
-        return;
+    static gw_spectrum_hist spec; /* receive thread only */
+    static int spec_src = -1;
+    if (src != spec_src) { /* another engine: its frame numbers restart */
+        gw_spectrum_clear(&spec);
+        spec_src = src;
     }
     pthread_mutex_lock(&g.lock);
-    uint8_t *h = g.bscan;
-    memset(h, 0, BSCAN_HDR);
-    h[0] = 'B';
-    memcpy(h + 4, &d->frame.frame_no, 4);
-    put_u16(h + 8, (uint16_t)lines);
-    put_u16(h + 10, (uint16_t)samples);
-    put_u16(h + 12, d->frame.geometry_id);
-    put_u16(h + 14, d->frame.flags);
-    memcpy(h + 16, &d->begin.depth_mm, 4);
-    memcpy(h + 20, &d->begin.width_mm, 4);
-    memcpy(h + 24, &d->begin.radius_mm, 4);
-    put_u16(h + 28, d->end.compression_pm);
-    put_u16(h + 30, d->end.artery_compression_pm);
-    memcpy(h + BSCAN_HDR, d->image, (size_t)lines * samples);
-    g.bscan_len = BSCAN_HDR + lines * samples;
-    g.bscan_gen++;
-    g.dlink_frames++;
+    const size_t n = gw_bscan_build(g.bscan, sizeof g.bscan, d, &spec);
+    if (n > 0u) {
+        g.bscan_len = (uint32_t)n;
+        g.bscan_gen++;
+        g.dlink_frames++;
+    }
     pthread_mutex_unlock(&g.lock);
 }
 
@@ -374,7 +359,7 @@ static void *rx_thread(void *arg)
                 }
                 const int r = sc_dlink_asm_push(&as[src], buf, (size_t)n);
                 if (r == 1) {
-                    on_frame(&as[src].done);
+                    on_frame(&as[src].done, src);
                     woke = 1;
                 } else if (r < 0) {
                     pthread_mutex_lock(&g.lock);

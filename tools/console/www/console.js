@@ -3,6 +3,7 @@
 // JSON replies; sends the JSON commands of tools/gateway/gw_msg.h.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { createScanner, decodeBscan } from './scanner.js';
 
 const HEALTH = ['init', 'running', 'degraded', 'fault'];
 const LABEL = { 4: 'vein', 5: 'artery', 7: 'thrombus' };
@@ -44,8 +45,12 @@ probe.add(probeBody);
 const imageGroup = new THREE.Group(); // image -> probe calibration
 probe.add(imageGroup);
 const bscanCanvas = $('bscan');
-const bscanTex = new THREE.CanvasTexture(bscanCanvas);
+// the scanner display (scanner.js): the panel with its overlay; the plane shows its image
+// (scan-converted grey and colour, transparent outside the image), skin row at the face
+const scanner = createScanner(bscanCanvas, $('spectrum'));
+const bscanTex = new THREE.CanvasTexture(scanner.image);
 bscanTex.magFilter = THREE.LinearFilter;
+bscanTex.flipY = false; // canvas row 0 (the skin) at the plane's -y, which is image z = 0 side
 const plane = new THREE.Mesh(new THREE.PlaneGeometry(1, 1),
   new THREE.MeshBasicMaterial({ map: bscanTex, side: THREE.DoubleSide, transparent: true, opacity: 0.85 }));
 plane.rotation.x = Math.PI / 2; // plane's y -> image z (depth)
@@ -180,31 +185,43 @@ window.scNormalView = () => {
 };
 
 // ---- B-scan -----------------------------------------------------------------------------------
-const bctx = bscanCanvas.getContext('2d');
-let bimg = null;
 function onBscan(dv, u8) {
-  const lines = dv.getUint16(8, true), samples = dv.getUint16(10, true);
-  const depth = dv.getFloat32(16, true), width = dv.getFloat32(20, true);
   sc.bscanFrames++;
   if (sc.frozen) return;
-  if (bscanCanvas.width !== lines || bscanCanvas.height !== samples) {
-    bscanCanvas.width = lines; bscanCanvas.height = samples; bimg = null;
-  }
-  if (!bimg) bimg = bctx.createImageData(lines, samples);
-  const px = bimg.data;
-  for (let l = 0; l < lines; l++) {
-    const off = 32 + l * samples;
-    for (let k = 0; k < samples; k++) {
-      const v = u8[off + k], o = (k * lines + l) * 4;
-      px[o] = px[o + 1] = px[o + 2] = v; px[o + 3] = 255;
-    }
-  }
-  bctx.putImageData(bimg, 0, 0);
+  const f = decodeBscan(dv, u8);
+  if (!f) { sc.bscanBad = (sc.bscanBad ?? 0) + 1; return; }
+  scanner.draw(f);
+  sc.scanner = scanner.state;
   bscanTex.needsUpdate = true;
   needsRender = true;
-  plane.scale.set(width > 0 && dv.getUint16(12, true) === 0 ? width : 40, depth, 1);
-  plane.position.set(0, 0, depth / 2);
+  const e = scanner.planeExtent();
+  plane.scale.set(e.width, e.height, 1);
+  plane.position.set(0, 0, e.centreZ);
 }
+window.scScannerImage = () => scanner.image;
+// a vessel's section in the image plane, in panel pixels (tests): the bounding box of where the
+// vessel's surface triangles (the live mesh) cross the image plane (image frame y = 0)
+window.scSectionPx = (label) => {
+  const s = surfaces.find((x) => x.kind === 1 && x.label === label);
+  if (!s || !s.indexDone || !positions) return null;
+  root.updateMatrixWorld(true);
+  const toImage = new THREE.Matrix4().copy(plane.parent.matrixWorld).invert().multiply(root.matrixWorld);
+  const idx = s.mesh.geometry.index.array, pos = s.mesh.geometry.attributes.position.array;
+  const v = [0, 1, 2].map(() => new THREE.Vector3());
+  let x0 = Infinity, x1 = -Infinity, z0 = Infinity, z1 = -Infinity, n = 0;
+  for (let t = 0; t < idx.length; t += 3) {
+    for (let j = 0; j < 3; j++) v[j].fromArray(pos, idx[t + j] * 3).applyMatrix4(toImage);
+    for (let j = 0; j < 3; j++) {
+      const a = v[j], b = v[(j + 1) % 3];
+      if ((a.y < 0) === (b.y < 0)) continue;
+      const u = a.y / (a.y - b.y), x = a.x + u * (b.x - a.x), z = a.z + u * (b.z - a.z);
+      x0 = Math.min(x0, x); x1 = Math.max(x1, x); z0 = Math.min(z0, z); z1 = Math.max(z1, z); n++;
+    }
+  }
+  if (n === 0) return null;
+  const p0 = scanner.toPanel(x0, z0), p1 = scanner.toPanel(x1, z1);
+  return p0 && p1 ? { x0: p0[0], y0: p0[1], x1: p1[0], y1: p1[1], mm: { x0, x1, z0, z1 } } : null;
+};
 
 // ---- state records ----------------------------------------------------------------------------
 function text(u8, off, n) {
@@ -443,7 +460,7 @@ function connect() {
     if (typeof ev.data === 'string') { try { onJson(JSON.parse(ev.data)); } catch (e) { log('bad reply'); } return; }
     const u8 = new Uint8Array(ev.data);
     if (u8[0] === 0x53) onRecord(ev.data);
-    else if (u8[0] === 0x42) onBscan(new DataView(ev.data), u8);
+    else if (u8[0] === 0x42) { sc.bscanBytes = u8.length; onBscan(new DataView(ev.data), u8); }
   };
 }
 connect();
