@@ -61,10 +61,12 @@ static inline __m256i pair_level(__m256i g, int sh, __m256i tx)
 }
 
 /* 4 display values from 4 int64 sums: 0 below 1 << 26, 255 from 255 << 26, else sum >> 26 */
-static inline __m256i display4(__m256i ifx4, __m256i la, const int64_t *lut)
+static inline __m256i display4(__m256i ifx4, __m256i la, const int64_t *lut, __m256i m64)
 {
+    /* lanes past the span read nothing (the table may end there) */
     const __m256i sum = _mm256_add_epi64(_mm256_mul_epi32(ifx4, la),
-                                         _mm256_loadu_si256((const __m256i *)(const void *)lut));
+                                         _mm256_maskload_epi64((const long long *)(const void *)lut,
+                                                               m64));
     __m256i v = _mm256_srli_epi64(sum, 26);
     v = _mm256_blendv_epi8(v, _mm256_setzero_si256(),
                            _mm256_cmpgt_epi64(_mm256_set1_epi64x((int64_t)1 << 26), sum));
@@ -92,79 +94,85 @@ void sc_bscan_span_x86_64_v3(const vol_regs v, const int64_t *restrict lut_b_fx,
                              int64_t DY, int64_t DZ, uint8_t *restrict out,
                              uint8_t *restrict lab_out)
 {
-    uint32_t k = k0;
-    if (k1 - k0 >= 8u) {
-        lanes lx = lanes_init(X, DX), ly = lanes_init(Y, DY), lz = lanes_init(Z, DZ);
-        const __m256i wmask = _mm256_set1_epi32(SC_W_ONE - 1);
-        const __m256i half = _mm256_set1_epi32(SC_W_ONE / 2 - 1);
-        const __m256i vsy = _mm256_set1_epi32((int32_t)v.sy);
-        const __m256i vsz = _mm256_set1_epi32((int32_t)v.sz);
-        const __m256i vsyz2 = _mm256_set1_epi32((int32_t)(v.sy + v.sz) - 2);
-        const __m256i la = _mm256_set1_epi64x(v.la);
-        const __m256i outside = _mm256_set1_epi32(SC_LABEL_OUTSIDE);
-        const __m256i three = _mm256_set1_epi32(3);
-        const int *vox = (const int *)(const void *)v.vox;
-        for (; k + 8u <= k1; k += 8u) {
-            const __m256i tx = _mm256_and_si256(lx.hi, wmask);
-            const __m256i ty = _mm256_and_si256(ly.hi, wmask);
-            const __m256i tz = _mm256_and_si256(lz.hi, wmask);
-            const __m256i base = _mm256_add_epi32(
-                _mm256_add_epi32(_mm256_srli_epi32(lx.hi, SC_W_BITS),
-                                 _mm256_mullo_epi32(_mm256_srli_epi32(ly.hi, SC_W_BITS), vsy)),
-                _mm256_mullo_epi32(_mm256_srli_epi32(lz.hi, SC_W_BITS), vsz));
-            /* 4 bytes from each row start; the last row from 2 before it (never past the end:
-             * the +1 neighbour of the last row is the volume's last byte at most) */
-            const __m256i g00 = _mm256_i32gather_epi32(vox, base, 1);
-            const __m256i g10 = _mm256_i32gather_epi32(vox, _mm256_add_epi32(base, vsy), 1);
-            const __m256i g01 = _mm256_i32gather_epi32(vox, _mm256_add_epi32(base, vsz), 1);
-            const __m256i g11 = _mm256_i32gather_epi32(vox, _mm256_add_epi32(base, vsyz2), 1);
-            const __m256i c00 = pair_level(g00, 0, tx), c10 = pair_level(g10, 0, tx);
-            const __m256i c01 = pair_level(g01, 0, tx), c11 = pair_level(g11, 16, tx);
-            const __m256i c0 = lerp(c00, c10, ty), c1 = lerp(c01, c11, ty);
-            const __m256i ifx = lerp(c0, c1, tz);
-            __m256i label;
-            if (v.lab != NULL) {
-                /* nearest voxel: + 1 where the weight is >= 1/2 */
-                const __m256i li = _mm256_add_epi32(
-                    _mm256_add_epi32(base, _mm256_srli_epi32(tx, SC_W_BITS - 1)),
-                    _mm256_add_epi32(_mm256_and_si256(_mm256_cmpgt_epi32(ty, half), vsy),
-                                     _mm256_and_si256(_mm256_cmpgt_epi32(tz, half), vsz)));
-                /* the dword ending at the label (or starting at it near the array's start) */
-                const __m256i at = _mm256_max_epi32(_mm256_sub_epi32(li, three),
-                                                    _mm256_setzero_si256());
-                const __m256i g = _mm256_i32gather_epi32((const int *)(const void *)v.lab, at, 1);
-                label = _mm256_and_si256(
-                    _mm256_srlv_epi32(g, _mm256_slli_epi32(_mm256_sub_epi32(li, at), 3)),
-                    _mm256_set1_epi32(0xff));
-            } else {
-                label = _mm256_set1_epi32(SC_LABEL_MUSCLE);
-            }
-            const __m256i d_lo = display4(_mm256_cvtepu32_epi64(_mm256_castsi256_si128(ifx)), la,
-                                          lut_b_fx + k);
-            const __m256i d_hi = display4(
-                _mm256_cvtepu32_epi64(_mm256_extracti128_si256(ifx, 1)), la, lut_b_fx + k + 4);
-            /* the low dwords of the 8 int64 into 8 dwords, in order */
-            const __m256i sel = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
-            const __m256i disp = _mm256_blend_epi32(_mm256_permutevar8x32_epi32(d_lo, sel),
-                                                    _mm256_permutevar8x32_epi32(d_hi, sel), 0xf0);
-            const __m256i shown =
-                _mm256_andnot_si256(_mm256_cmpeq_epi32(label, outside), disp);
+    if (k1 <= k0) {
+        return;
+    }
+    lanes lx = lanes_init(X, DX), ly = lanes_init(Y, DY), lz = lanes_init(Z, DZ);
+    const __m256i wmask = _mm256_set1_epi32(SC_W_ONE - 1);
+    const __m256i half = _mm256_set1_epi32(SC_W_ONE / 2 - 1);
+    const __m256i vsy = _mm256_set1_epi32((int32_t)v.sy);
+    const __m256i vsz = _mm256_set1_epi32((int32_t)v.sz);
+    const __m256i vsyz2 = _mm256_set1_epi32((int32_t)(v.sy + v.sz) - 2);
+    const __m256i la = _mm256_set1_epi64x(v.la);
+    const __m256i outside = _mm256_set1_epi32(SC_LABEL_OUTSIDE);
+    const __m256i three = _mm256_set1_epi32(3);
+    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    const int *vox = (const int *)(const void *)v.vox;
+    const int *labp = (const int *)(const void *)v.lab;
+    for (uint32_t k = k0; k < k1; k += 8u) {
+        /* the lanes of this span: all 8, or the last few (the others gather and load nothing:
+         * their positions may be anywhere) */
+        const uint32_t r = k1 - k < 8u ? k1 - k : 8u;
+        const __m256i m = _mm256_cmpgt_epi32(_mm256_set1_epi32((int32_t)r), lane);
+        const __m256i tx = _mm256_and_si256(lx.hi, wmask);
+        const __m256i ty = _mm256_and_si256(ly.hi, wmask);
+        const __m256i tz = _mm256_and_si256(lz.hi, wmask);
+        const __m256i base = _mm256_add_epi32(
+            _mm256_add_epi32(_mm256_srli_epi32(lx.hi, SC_W_BITS),
+                             _mm256_mullo_epi32(_mm256_srli_epi32(ly.hi, SC_W_BITS), vsy)),
+            _mm256_mullo_epi32(_mm256_srli_epi32(lz.hi, SC_W_BITS), vsz));
+        /* 4 bytes from each row start; the last row from 2 before it (never past the end: the
+         * +1 neighbour of the last row is the volume's last byte at most) */
+        const __m256i z = _mm256_setzero_si256();
+        const __m256i g00 = _mm256_mask_i32gather_epi32(z, vox, base, m, 1);
+        const __m256i g10 = _mm256_mask_i32gather_epi32(z, vox, _mm256_add_epi32(base, vsy), m, 1);
+        const __m256i g01 = _mm256_mask_i32gather_epi32(z, vox, _mm256_add_epi32(base, vsz), m, 1);
+        const __m256i g11 =
+            _mm256_mask_i32gather_epi32(z, vox, _mm256_add_epi32(base, vsyz2), m, 1);
+        const __m256i c00 = pair_level(g00, 0, tx), c10 = pair_level(g10, 0, tx);
+        const __m256i c01 = pair_level(g01, 0, tx), c11 = pair_level(g11, 16, tx);
+        const __m256i c0 = lerp(c00, c10, ty), c1 = lerp(c01, c11, ty);
+        const __m256i ifx = lerp(c0, c1, tz);
+        __m256i label;
+        if (labp != NULL) {
+            /* nearest voxel: + 1 where the weight is >= 1/2 */
+            const __m256i li = _mm256_add_epi32(
+                _mm256_add_epi32(base, _mm256_srli_epi32(tx, SC_W_BITS - 1)),
+                _mm256_add_epi32(_mm256_and_si256(_mm256_cmpgt_epi32(ty, half), vsy),
+                                 _mm256_and_si256(_mm256_cmpgt_epi32(tz, half), vsz)));
+            /* the dword ending at the label (or starting at it near the array's start) */
+            const __m256i at = _mm256_max_epi32(_mm256_sub_epi32(li, three), z);
+            const __m256i g = _mm256_mask_i32gather_epi32(z, labp, at, m, 1);
+            label = _mm256_and_si256(
+                _mm256_srlv_epi32(g, _mm256_slli_epi32(_mm256_sub_epi32(li, at), 3)),
+                _mm256_set1_epi32(0xff));
+        } else {
+            label = _mm256_set1_epi32(SC_LABEL_MUSCLE);
+        }
+        const __m256i d_lo =
+            display4(_mm256_cvtepu32_epi64(_mm256_castsi256_si128(ifx)), la, lut_b_fx + k,
+                     _mm256_cvtepi32_epi64(_mm256_castsi256_si128(m)));
+        const __m256i d_hi =
+            display4(_mm256_cvtepu32_epi64(_mm256_extracti128_si256(ifx, 1)), la,
+                     lut_b_fx + k + 4, _mm256_cvtepi32_epi64(_mm256_extracti128_si256(m, 1)));
+        /* the low dwords of the 8 int64 into 8 dwords, in order */
+        const __m256i sel = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
+        const __m256i disp = _mm256_blend_epi32(_mm256_permutevar8x32_epi32(d_lo, sel),
+                                                _mm256_permutevar8x32_epi32(d_hi, sel), 0xf0);
+        const __m256i shown = _mm256_andnot_si256(_mm256_cmpeq_epi32(label, outside), disp);
+        if (r == 8u) {
             store_bytes(out + k, shown);
             store_bytes(lab_out + k, label);
-            lanes_step(&lx);
-            lanes_step(&ly);
-            lanes_step(&lz);
+        } else {
+            uint8_t t[16];
+            store_bytes(t, shown);
+            store_bytes(t + 8, label);
+            memcpy(out + k, t, r);
+            memcpy(lab_out + k, t + 8, r);
         }
-        const int64_t done = (int64_t)(k - k0);
-        X += done * DX;
-        Y += done * DY;
-        Z += done * DZ;
-    }
-    for (; k < k1; k++) {
-        sc_bscan_sample_fx(v, lut_b_fx, k, X, Y, Z, out, lab_out);
-        X += DX;
-        Y += DY;
-        Z += DZ;
+        lanes_step(&lx);
+        lanes_step(&ly);
+        lanes_step(&lz);
     }
 }
 #else
