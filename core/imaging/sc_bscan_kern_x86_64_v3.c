@@ -18,18 +18,27 @@ typedef struct lanes {
     __m256i hi, lo, dhi, dlo;
 } lanes;
 
-static lanes lanes_init(int64_t x, int64_t d)
+/* the 8 lanes' positions x + HALF + j d (j = 0..7) split at bit 22, in vector registers (a
+ * scalar fill read back as a vector stalls on the store forwarding: a span is often short).
+ * Lanes past the span may hold anything (their results are never used); the others are >= 0,
+ * where the logical shift is the arithmetic one. */
+static inline __m256i pack_lo32(__m256i a, __m256i b)
 {
-    int32_t hi[8], lo[8];
-    for (int j = 0; j < 8; j++) {
-        const int64_t p = x + SC_W_HALF + (int64_t)j * d;
-        hi[j] = (int32_t)(p >> SC_LOW_BITS);
-        lo[j] = (int32_t)(p & SC_LOW_MASK);
-    }
+    const __m256i sel = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
+    return _mm256_blend_epi32(_mm256_permutevar8x32_epi32(a, sel),
+                              _mm256_permutevar8x32_epi32(b, sel), 0xf0);
+}
+
+static inline lanes lanes_init(int64_t x, int64_t d)
+{
+    const __m256i p0 = _mm256_add_epi64(_mm256_set1_epi64x(x + SC_W_HALF),
+                                        _mm256_setr_epi64x(0, d, 2 * d, 3 * d));
+    const __m256i p1 = _mm256_add_epi64(p0, _mm256_set1_epi64x(4 * d));
+    const __m256i m = _mm256_set1_epi64x(SC_LOW_MASK);
     const int64_t d8 = 8 * d;
     lanes l;
-    l.hi = _mm256_loadu_si256((const __m256i *)(const void *)hi);
-    l.lo = _mm256_loadu_si256((const __m256i *)(const void *)lo);
+    l.hi = pack_lo32(_mm256_srli_epi64(p0, SC_LOW_BITS), _mm256_srli_epi64(p1, SC_LOW_BITS));
+    l.lo = pack_lo32(_mm256_and_si256(p0, m), _mm256_and_si256(p1, m));
     l.dhi = _mm256_set1_epi32((int32_t)(d8 >> SC_LOW_BITS)); /* floor: exact split */
     l.dlo = _mm256_set1_epi32((int32_t)(d8 & SC_LOW_MASK));
     return l;
