@@ -10,6 +10,7 @@
  * no unit conversion.
  */
 #include "sc_bscan.h"
+#include "sc_bscan_kern.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -1071,6 +1072,7 @@ typedef struct vol_ctx {
     float sp_mm[3];         /* voxel spacing */
     float slab[3];          /* voxels of the slab the continuation beyond a face repeats */
     float beyond_gl_per_mm; /* darkening beyond the volume, grey levels per mm */
+    sc_bscan_span_fn span; /* the selected variant's sampler of spans clear of the border */
 } vol_ctx;
 
 /* Positions are 32.32 fixed point (int64): stepping along a span adds exactly, the step's
@@ -1084,62 +1086,8 @@ static int64_t to_fx32(float v)
     return (int64_t)(v * SC_FX_ONE);
 }
 
-/* One sample at 32.32 position (X, Y, Z), clamped into [0, xmax]: trilinear with 10-bit
- * weights rounded to nearest (within 0.2 grey level of the exact value for neighbour
- * differences up to 128), nearest label, display table. */
-#define SC_W_BITS 10
-#define SC_W_ONE  (1 << SC_W_BITS)
-#define SC_W_HALF ((int64_t)1 << (31 - SC_W_BITS)) /* half a weight step in 32.32 */
-
-/* One sample at 32.32 position (X, Y, Z), clamped into [0, xmax]: trilinear with 10-bit
- * weights rounded to nearest (within 0.2 grey level of the exact value for neighbour
- * differences up to 128), nearest label, display table. The volume has at least 2 voxels
- * along every axis (checked per frame), so the +1 neighbours are 1, sy and sz away. The
- * volume's values are passed by value so that the byte stores (which may alias anything) do
- * not force reloads. */
-#define SC_W_BITS 10
-#define SC_W_ONE  (1 << SC_W_BITS)
-#define SC_W_HALF ((int64_t)1 << (31 - SC_W_BITS)) /* half a weight step in 32.32 */
-
-typedef struct vol_regs {
-    const uint8_t *vox, *lab;
-    size_t sy, sz;
-    int64_t la;
-} vol_regs;
-
-static inline void sample_fx(const vol_regs v, const int64_t *restrict lut_b_fx, uint32_t k,
-                             int64_t X, int64_t Y, int64_t Z, uint8_t *restrict out,
-                             uint8_t *restrict lab_out)
-{
-    X += SC_W_HALF;
-    Y += SC_W_HALF;
-    Z += SC_W_HALF;
-    const int32_t tx = (int32_t)((X >> (32 - SC_W_BITS)) & (SC_W_ONE - 1));
-    const int32_t ty = (int32_t)((Y >> (32 - SC_W_BITS)) & (SC_W_ONE - 1));
-    const int32_t tz = (int32_t)((Z >> (32 - SC_W_BITS)) & (SC_W_ONE - 1));
-    const size_t base = (size_t)(X >> 32) + v.sy * (size_t)(Y >> 32) + v.sz * (size_t)(Z >> 32);
-    const uint8_t *r00 = v.vox + base, *r10 = r00 + v.sy, *r01 = r00 + v.sz, *r11 = r01 + v.sy;
-    /* 18 bits after the first level, 28 bits inside the later ones: int32 is enough */
-    const int32_t c00 = r00[0] * SC_W_ONE + tx * (r00[1] - r00[0]);
-    const int32_t c10 = r10[0] * SC_W_ONE + tx * (r10[1] - r10[0]);
-    const int32_t c01 = r01[0] * SC_W_ONE + tx * (r01[1] - r01[0]);
-    const int32_t c11 = r11[0] * SC_W_ONE + tx * (r11[1] - r11[0]);
-    const int32_t c0 = (c00 * SC_W_ONE + ty * (c10 - c00) + SC_W_ONE / 2) >> SC_W_BITS;
-    const int32_t c1 = (c01 * SC_W_ONE + ty * (c11 - c01) + SC_W_ONE / 2) >> SC_W_BITS;
-    const int32_t ifx = (c0 * SC_W_ONE + tz * (c1 - c0) + SC_W_ONE / 2) >> SC_W_BITS;
-    uint8_t label = (uint8_t)SC_LABEL_MUSCLE; /* volumes without a label map */
-    if (v.lab != NULL) {                      /* nearest voxel's label */
-        label = v.lab[base + (size_t)(tx >> (SC_W_BITS - 1)) + (ty >= SC_W_ONE / 2 ? v.sy : 0u) +
-                      (tz >= SC_W_ONE / 2 ? v.sz : 0u)];
-    }
-    lab_out[k] = label;
-    /* display: out = (A * I + B[k]) >> 26 with I in 1/1024 grey, A = lut_a in 16.16 and
-     * B = lut_b in 38.26 with the rounding half folded in */
-    const int64_t sum = v.la * (int64_t)ifx + lut_b_fx[k];
-    out[k] = (uint8_t)(label == (uint8_t)SC_LABEL_OUTSIDE || sum < ((int64_t)1 << 26)
-                           ? 0
-                           : (sum >= ((int64_t)255 << 26) ? 255 : (sum >> 26)));
-}
+/* One sample: sc_bscan_sample_fx (sc_bscan_kern.h, shared with the span kernels). */
+#define sample_fx sc_bscan_sample_fx
 
 static int64_t clamp_fx(int64_t x, int64_t hi)
 {
@@ -1213,6 +1161,34 @@ static void beyond_sample(const vol_ctx *vc, const vol_regs vr, const int64_t *r
 
 /* Samples [k0, k1) at voxel positions a + k b, all inside the volume box (the ends are, and the
  * box is convex). */
+/* Steps j of [0, n) whose position x + j d lies in [0, xm] (an interval: the position is
+ * monotonic in j): [*lo, *hi), empty as lo >= hi. Exact integer arithmetic. */
+static void clear_steps(int64_t x, int64_t d, int64_t xm, int64_t n, int64_t *lo, int64_t *hi)
+{
+    int64_t a = 0, z = n;
+    if (d == 0) {
+        if (x < 0 || x > xm) {
+            z = 0;
+        }
+    } else if (d > 0) {
+        if (x < 0) {
+            a = (-x + d - 1) / d; /* ceil */
+        }
+        z = x > xm ? 0 : (xm - x) / d + 1;
+    } else {
+        const int64_t e = -d;
+        z = x < 0 ? 0 : x / e + 1;
+        if (x > xm) {
+            a = (x - xm + e - 1) / e;
+        }
+    }
+    *lo = a > *lo ? a : *lo;
+    *hi = z < *hi ? z : *hi;
+}
+
+/* Samples [k0, k1) at voxel positions a + k b, all inside the volume box (the ends are, and the
+ * box is convex). The part clear of the half-voxel border (no clamping: an interval) goes to the
+ * selected span kernel, the ends clamped sample by sample: the same values either way. */
 static void sample_span_inside(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1,
                                const float a[3], const float bb[3])
 {
@@ -1224,21 +1200,28 @@ static void sample_span_inside(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint
     int64_t X = to_fx32(a[0] + (float)k0 * bb[0]), Y = to_fx32(a[1] + (float)k0 * bb[1]),
             Z = to_fx32(a[2] + (float)k0 * bb[2]);
     const int64_t DX = to_fx32(bb[0]), DY = to_fx32(bb[1]), DZ = to_fx32(bb[2]);
-    const int64_t j1 = (int64_t)(k1 - 1u - k0);
-    const int64_t xe = X + j1 * DX, ye = Y + j1 * DY, ze = Z + j1 * DZ;
-    if (X >= 0 && xe >= 0 && Y >= 0 && ye >= 0 && Z >= 0 && ze >= 0 && X <= xm0 && xe <= xm0 &&
-        Y <= xm1 && ye <= xm1 && Z <= xm2 && ze <= xm2) {
-        /* clear of the half-voxel border at both ends, so everywhere: no clamping */
-        for (uint32_t k = k0; k < k1; k++) {
-            sample_fx(vr, lut, k, X, Y, Z, out, lab);
-            X += DX;
-            Y += DY;
-            Z += DZ;
-        }
-        return;
+    const int64_t n = (int64_t)(k1 - k0);
+    int64_t jlo = 0, jhi = n;
+    clear_steps(X, DX, xm0, n, &jlo, &jhi);
+    clear_steps(Y, DY, xm1, n, &jlo, &jhi);
+    clear_steps(Z, DZ, xm2, n, &jlo, &jhi);
+    if (jlo >= jhi) {
+        jlo = jhi = n; /* nowhere clear: all clamped */
     }
-    for (uint32_t k = k0; k < k1; k++) {
-        sample_fx(vr, lut, k, clamp_fx(X, xm0), clamp_fx(Y, xm1), clamp_fx(Z, xm2), out, lab);
+    for (int64_t j = 0; j < n; j++) {
+        if (j == jlo) {
+            /* clear of the half-voxel border: no clamping */
+            vc->span(vr, lut, k0 + (uint32_t)jlo, k0 + (uint32_t)jhi, X, Y, Z, DX, DY, DZ, out,
+                     lab);
+            const int64_t m = jhi - jlo;
+            X += m * DX;
+            Y += m * DY;
+            Z += m * DZ;
+            j = jhi - 1;
+            continue;
+        }
+        sample_fx(vr, lut, k0 + (uint32_t)j, clamp_fx(X, xm0), clamp_fx(Y, xm1), clamp_fx(Z, xm2),
+                  out, lab);
         X += DX;
         Y += DY;
         Z += DZ;
@@ -1257,6 +1240,25 @@ static int in_volume_k(const vol_ctx *vc, const float a[3], const float bb[3], u
 static void sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1, const float a[3],
                         const float bb[3])
 {
+    {
+        /* the common case first (a mesh run is one tet's crossing, a few samples): both ends
+         * clear of the half-voxel border, so every sample is, and the per-sample box test below
+         * would find the whole span inside (the fixed-point positions differ from the float ones
+         * by < 1e-4 voxel, the box is wider by half a voxel): straight to the span kernel, with
+         * the positions sample_span_inside would step */
+        const int64_t X = to_fx32(a[0] + (float)k0 * bb[0]), Y = to_fx32(a[1] + (float)k0 * bb[1]),
+                      Z = to_fx32(a[2] + (float)k0 * bb[2]);
+        const int64_t DX = to_fx32(bb[0]), DY = to_fx32(bb[1]), DZ = to_fx32(bb[2]);
+        const int64_t j1 = (int64_t)(k1 - 1u - k0);
+        const int64_t xe = X + j1 * DX, ye = Y + j1 * DY, ze = Z + j1 * DZ;
+        if (k1 > k0 && X >= 0 && xe >= 0 && Y >= 0 && ye >= 0 && Z >= 0 && ze >= 0 &&
+            X <= vc->xmax[0] && xe <= vc->xmax[0] && Y <= vc->xmax[1] && ye <= vc->xmax[1] &&
+            Z <= vc->xmax[2] && ze <= vc->xmax[2]) {
+            const vol_regs vr = {vc->vox, vc->lab, vc->stride[1], vc->stride[2], vc->la};
+            vc->span(vr, b->lut_b_fx, k0, k1, X, Y, Z, DX, DY, DZ, b->line_out, b->line_label);
+            return;
+        }
+    }
     /* the line parameter range inside the box, per axis: -1/2 <= a + k b < hi */
     float lo = (float)k0, hi = (float)k1;
     for (uint32_t d = 0; d < 3u && lo < hi; d++) {
@@ -1562,6 +1564,7 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
         vc.slab[d] = slab < 1.0f ? 1.0f : (slab > most ? most : slab);
     }
     vc.beyond_gl_per_mm = 255.0f * SC_BSCAN_BEYOND_DB_PER_MM / b->def.dynamic_range_db;
+    vc.span = sc_bscan_span_selected();
     vc.sy32 = volume->dim[0];
     vc.sz32 = volume->dim[0] * volume->dim[1];
     area_acc acc;

@@ -499,6 +499,19 @@ void sc_doppler_line_hook(void *ctx, const sc_bscan_line_view *v)
         const uint32_t gate_mid = ((uint32_t)d->gate_k0 + d->gate_k1) / 2u;
         uint32_t ri = 0;
         for (uint32_t k = k_first; k < k_hi && k < v->samples_n; k++) {
+            const uint8_t lk = v->labels[k];
+            if ((lk != SC_LABEL_VEIN && lk != SC_LABEL_ARTERY) || !d->vessel[lk].valid) {
+                /* no flow here (sample_velocity would say so): no colour, nothing in the gate;
+                 * the position is not needed (most of the box is tissue) */
+                if (in_box && k >= d->box_k0 && k < d->box_k1) {
+                    d->colour[k - d->box_k0] = 0;
+                }
+                if (is_gate && k == gate_mid) {
+                    d->status.gate_in_lumen = 0u;
+                    d->status.gate_velocity_mm_s = 0.0f;
+                }
+                continue;
+            }
             while (ri < v->run_count && v->runs[ri].k1 <= k) {
                 ri++;
             }

@@ -13,9 +13,11 @@
 
 #include "../../tools/bench_bscan/bscan_scene.h"
 #include "sc_bscan.h"
+#include "sc_cpu.h"
 #include "sc_err.h"
 #include "sc_hs_display.h"
 #include "sc_mesh.h"
+#include "sc_simd.h"
 
 #define IMG_MAX (SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES)
 
@@ -598,6 +600,38 @@ static void golden_image_hash_is_stable(void **state)
     assert_true(g_disp.hashes[0] == h1); /* identical across runs */
     print_message("golden hash 0x%016llx\n", (unsigned long long)h1);
     assert_true(h1 == GOLDEN_HASH);
+    /* every kernel variant this build and CPU have (sc_bscan_kern.h): the same image; with the
+     * acoustics on too, and at a pose whose lines run beyond the volume (clamped ends) */
+    const sc_simd keep = sc_simd_selected();
+    sc_bscan_def da = d;
+    da.acoustics = 1u;
+    const sc_xform deep = scn_probe(19.0f, 10.5f, 7.0f, 40.0f);
+    (void)sc_simd_select(SC_SIMD_GENERIC);
+    render(&d, &probe, 1, g_a);
+    sc_bscan_status st0 = g_b.status; /* the compression measure (rest labels) too */
+    render(&da, &probe, 1, g_a);
+    const uint64_t ha = g_disp.hashes[0];
+    render(&d, &deep, 1, g_a);
+    const uint64_t hd = g_disp.hashes[0];
+    uint32_t variants = 0;
+    for (int v = 0; v < (int)SC_SIMD_COUNT; v++) {
+        if (!sc_simd_built((sc_simd)v) || v > (int)sc_cpu_best_simd()) {
+            continue;
+        }
+        assert_int_equal(sc_simd_select((sc_simd)v), SC_OK);
+        render(&d, &probe, 1, g_a);
+        assert_true(g_disp.hashes[0] == GOLDEN_HASH);
+        assert_memory_equal(g_b.status.area_now_mm2, st0.area_now_mm2, sizeof st0.area_now_mm2);
+        assert_memory_equal(g_b.status.area_rest_mm2, st0.area_rest_mm2,
+                            sizeof st0.area_rest_mm2);
+        render(&da, &probe, 1, g_a);
+        assert_true(g_disp.hashes[0] == ha);
+        render(&d, &deep, 1, g_a);
+        assert_true(g_disp.hashes[0] == hd);
+        variants++;
+    }
+    (void)sc_simd_select(keep);
+    print_message("golden hash in %u kernel variants\n", variants);
 }
 
 /* ---- argument checks --------------------------------------------------------------------- */

@@ -18,6 +18,8 @@
 #include <time.h>
 
 #include "bench_contact.h"
+#include "sc_cpu.h"
+#include "sc_simd.h"
 #include "bscan_scene.h"
 #include "sc_bscan.h"
 #include "sc_doppler.h"
@@ -304,6 +306,11 @@ static void print_needle_row(const sc_xform *probe, int frames)
 
 int main(int argc, char **argv)
 {
+    /* the engine programs' kernel variant (sonocomp, sc-hostsim select it at start) */
+    if (sc_cpu_select_simd() != SC_OK) {
+        fprintf(stderr, "bench_bscan: SONOCOMP_SIMD names no variant of this CPU\n");
+    }
+    printf("kernels: %s\n", sc_simd_name(sc_simd_selected()));
     if (argc > 1 && strcmp(argv[1], "contact") == 0) {
         const char *cases = argc > 2 ? argv[2] : SC_DEFAULT_CASES_DIR;
         const char *name = argc > 3 ? argv[3] : "neck-ijv";

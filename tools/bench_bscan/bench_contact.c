@@ -221,6 +221,19 @@ int bench_contact_run(const char *cases_dir, const char *case_name, int method, 
         printf("  imaging, walker, acoustics %s: min %.3f, median %.3f ms per frame\n",
                keep ? "off" : "on", mn2, med2);
     }
+    {
+        /* the B-mode alone: the engine's line hook (colour Doppler, the needle) off */
+        sc_bscan *bs = &g_rig.engine.bscan;
+        const sc_bscan_line_hook_fn hook = bs->line_hook;
+        void *hook_ctx = bs->line_hook_ctx;
+        sc_bscan_set_line_hook(bs, NULL, NULL);
+        double mn2, med2;
+        time_imaging(SC_BSCAN_MAP_WALK, frames, &mn2, &med2, &fb, 0);
+        sc_bscan_set_line_hook(bs, hook, hook_ctx);
+        printf("  imaging, walker, line hook (colour Doppler) %s: min %.3f, median %.3f ms per "
+               "frame\n",
+               hook != NULL ? "off" : "(none)", mn2, med2);
+    }
     time_imaging(SC_BSCAN_MAP_REGIONS, frames / 4 + 1, &mn, &med, &fb, 0);
     printf("  imaging, region path (R = %u): min %.3f, median %.3f ms per frame\n",
            e->bscan.def.regions_n, mn, med);

@@ -1,0 +1,26 @@
+/* sc_bscan_kern.c: the portable span sampler and the variant choice (sc_bscan_kern.h). */
+#include "sc_bscan_kern.h"
+
+#include "sc_simd.h"
+
+void sc_bscan_span_generic(const vol_regs v, const int64_t *restrict lut_b_fx, uint32_t k0,
+                           uint32_t k1, int64_t X, int64_t Y, int64_t Z, int64_t DX, int64_t DY,
+                           int64_t DZ, uint8_t *restrict out, uint8_t *restrict lab_out)
+{
+    for (uint32_t k = k0; k < k1; k++) {
+        sc_bscan_sample_fx(v, lut_b_fx, k, X, Y, Z, out, lab_out);
+        X += DX;
+        Y += DY;
+        Z += DZ;
+    }
+}
+
+sc_bscan_span_fn sc_bscan_span_selected(void)
+{
+#if defined(SC_SIMD_X86_64_V3_BUILT)
+    if (sc_simd_selected() != SC_SIMD_GENERIC) { /* v3 or v4: both have AVX2 */
+        return sc_bscan_span_x86_64_v3;
+    }
+#endif
+    return sc_bscan_span_generic;
+}

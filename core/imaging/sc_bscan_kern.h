@@ -1,0 +1,89 @@
+/*
+ * sc_bscan_kern.h: the B-scan's sampling loop (internal to sc_bscan.c), per instruction-set
+ * variant (core/physics/sc_simd.h): the portable one (sc_bscan_kern.c, one sample at a time)
+ * and the x86-64-v3 one (sc_bscan_kern_x86_64_v3.c, AVX2: eight samples at a time with
+ * gathers). Integer arithmetic throughout, so every variant gives the same bytes: a variant is
+ * a speed choice only (tests/unit/test_sc_bscan_kern.c compares them).
+ */
+#ifndef SC_BSCAN_KERN_H
+#define SC_BSCAN_KERN_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sc_labels.h"
+
+/* Trilinear weights: 10 bits, rounded to nearest (half a weight step added to the position). */
+#define SC_W_BITS 10
+#define SC_W_ONE  (1 << SC_W_BITS)
+#define SC_W_HALF ((int64_t)1 << (31 - SC_W_BITS)) /* half a weight step in 32.32 */
+
+/* The volume as the sampler sees it: values, labels (NULL: none), the y and z strides, the
+ * display gain lut_a in 16.16. Passed by value so that the byte stores (which may alias
+ * anything) do not force reloads. */
+typedef struct vol_regs {
+    const uint8_t *vox, *lab;
+    size_t sy, sz;
+    int64_t la;
+} vol_regs;
+
+/* One sample at 32.32 position (X, Y, Z), inside [0, xmax] (the caller clamps): trilinear with
+ * 10-bit weights rounded to nearest (within 0.2 grey level of the exact value for neighbour
+ * differences up to 128), nearest label, display table. The volume has at least 2 voxels along
+ * every axis, so the +1 neighbours are 1, sy and sz away. */
+static inline void sc_bscan_sample_fx(const vol_regs v, const int64_t *restrict lut_b_fx,
+                                      uint32_t k, int64_t X, int64_t Y, int64_t Z,
+                                      uint8_t *restrict out, uint8_t *restrict lab_out)
+{
+    X += SC_W_HALF;
+    Y += SC_W_HALF;
+    Z += SC_W_HALF;
+    const int32_t tx = (int32_t)((X >> (32 - SC_W_BITS)) & (SC_W_ONE - 1));
+    const int32_t ty = (int32_t)((Y >> (32 - SC_W_BITS)) & (SC_W_ONE - 1));
+    const int32_t tz = (int32_t)((Z >> (32 - SC_W_BITS)) & (SC_W_ONE - 1));
+    const size_t base = (size_t)(X >> 32) + v.sy * (size_t)(Y >> 32) + v.sz * (size_t)(Z >> 32);
+    const uint8_t *r00 = v.vox + base, *r10 = r00 + v.sy, *r01 = r00 + v.sz, *r11 = r01 + v.sy;
+    /* 18 bits after the first level, 28 bits inside the later ones: int32 is enough */
+    const int32_t c00 = r00[0] * SC_W_ONE + tx * (r00[1] - r00[0]);
+    const int32_t c10 = r10[0] * SC_W_ONE + tx * (r10[1] - r10[0]);
+    const int32_t c01 = r01[0] * SC_W_ONE + tx * (r01[1] - r01[0]);
+    const int32_t c11 = r11[0] * SC_W_ONE + tx * (r11[1] - r11[0]);
+    const int32_t c0 = (c00 * SC_W_ONE + ty * (c10 - c00) + SC_W_ONE / 2) >> SC_W_BITS;
+    const int32_t c1 = (c01 * SC_W_ONE + ty * (c11 - c01) + SC_W_ONE / 2) >> SC_W_BITS;
+    const int32_t ifx = (c0 * SC_W_ONE + tz * (c1 - c0) + SC_W_ONE / 2) >> SC_W_BITS;
+    uint8_t label = (uint8_t)SC_LABEL_MUSCLE; /* volumes without a label map */
+    if (v.lab != NULL) {                      /* nearest voxel's label */
+        label = v.lab[base + (size_t)(tx >> (SC_W_BITS - 1)) + (ty >= SC_W_ONE / 2 ? v.sy : 0u) +
+                      (tz >= SC_W_ONE / 2 ? v.sz : 0u)];
+    }
+    lab_out[k] = label;
+    /* display: out = (A * I + B[k]) >> 26 with I in 1/1024 grey, A = lut_a in 16.16 and
+     * B = lut_b in 38.26 with the rounding half folded in */
+    const int64_t sum = v.la * (int64_t)ifx + lut_b_fx[k];
+    out[k] = (uint8_t)(label == (uint8_t)SC_LABEL_OUTSIDE || sum < ((int64_t)1 << 26)
+                           ? 0
+                           : (sum >= ((int64_t)255 << 26) ? 255 : (sum >> 26)));
+}
+
+/* Samples [k0, k1) at 32.32 positions (X, Y, Z) + (k - k0) (DX, DY, DZ), every one inside
+ * [0, xmax] of its axis (checked by the caller at both ends); out[k], lab_out[k] written. The
+ * volume has fewer than 2^31 voxels (SC_MAX_VOLUME_VOXELS). */
+typedef void (*sc_bscan_span_fn)(const vol_regs v, const int64_t *restrict lut_b_fx, uint32_t k0,
+                                 uint32_t k1, int64_t X, int64_t Y, int64_t Z, int64_t DX,
+                                 int64_t DY, int64_t DZ, uint8_t *restrict out,
+                                 uint8_t *restrict lab_out);
+
+void sc_bscan_span_generic(const vol_regs v, const int64_t *restrict lut_b_fx, uint32_t k0,
+                           uint32_t k1, int64_t X, int64_t Y, int64_t Z, int64_t DX, int64_t DY,
+                           int64_t DZ, uint8_t *restrict out, uint8_t *restrict lab_out);
+#if defined(SC_SIMD_X86_64_V3_BUILT)
+void sc_bscan_span_x86_64_v3(const vol_regs v, const int64_t *restrict lut_b_fx, uint32_t k0,
+                             uint32_t k1, int64_t X, int64_t Y, int64_t Z, int64_t DX,
+                             int64_t DY, int64_t DZ, uint8_t *restrict out,
+                             uint8_t *restrict lab_out);
+#endif
+
+/* The selected variant's span sampler (sc_simd_selected()). */
+sc_bscan_span_fn sc_bscan_span_selected(void);
+
+#endif /* SC_BSCAN_KERN_H */

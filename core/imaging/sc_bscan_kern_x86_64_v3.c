@@ -1,0 +1,189 @@
+/* sc_bscan_kern_x86_64_v3.c: the span sampler for the x86-64-v3 level (AVX2), built with
+ * -march=x86-64-v3 where the compiler takes it (SC_SIMD_X86_64_V3_BUILT); elsewhere this unit is
+ * empty. Eight samples at a time: the positions stepped exactly in 32-bit lanes (the 32.32
+ * position split at bit 22 into the part the sampler reads, voxel index and 10-bit weight, and
+ * the 22 bits below, whose carry is added), the 2x2 neighbour pairs and the label gathered, the
+ * same integer arithmetic as sc_bscan_sample_fx lane by lane: the same bytes. */
+#if defined(SC_SIMD_X86_64_V3_BUILT)
+#include <immintrin.h>
+#include <string.h>
+
+#include "sc_bscan_kern.h"
+
+#define SC_LOW_BITS (32 - SC_W_BITS) /* 22: below the weight */
+#define SC_LOW_MASK ((1 << SC_LOW_BITS) - 1)
+
+/* 8 lanes of one axis: hi = position >> 22 (index << 10 | weight), lo = the 22 bits below */
+typedef struct lanes {
+    __m256i hi, lo, dhi, dlo;
+} lanes;
+
+/* the 8 lanes' positions x + HALF + j d (j = 0..7) split at bit 22, in vector registers (a
+ * scalar fill read back as a vector stalls on the store forwarding: a span is often short).
+ * Lanes past the span may hold anything (their results are never used); the others are >= 0,
+ * where the logical shift is the arithmetic one. */
+static inline __m256i pack_lo32(__m256i a, __m256i b)
+{
+    const __m256i sel = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
+    return _mm256_blend_epi32(_mm256_permutevar8x32_epi32(a, sel),
+                              _mm256_permutevar8x32_epi32(b, sel), 0xf0);
+}
+
+static inline lanes lanes_init(int64_t x, int64_t d)
+{
+    const __m256i p0 = _mm256_add_epi64(_mm256_set1_epi64x(x + SC_W_HALF),
+                                        _mm256_setr_epi64x(0, d, 2 * d, 3 * d));
+    const __m256i p1 = _mm256_add_epi64(p0, _mm256_set1_epi64x(4 * d));
+    const __m256i m = _mm256_set1_epi64x(SC_LOW_MASK);
+    const int64_t d8 = 8 * d;
+    lanes l;
+    l.hi = pack_lo32(_mm256_srli_epi64(p0, SC_LOW_BITS), _mm256_srli_epi64(p1, SC_LOW_BITS));
+    l.lo = pack_lo32(_mm256_and_si256(p0, m), _mm256_and_si256(p1, m));
+    l.dhi = _mm256_set1_epi32((int32_t)(d8 >> SC_LOW_BITS)); /* floor: exact split */
+    l.dlo = _mm256_set1_epi32((int32_t)(d8 & SC_LOW_MASK));
+    return l;
+}
+
+static inline void lanes_step(lanes *l)
+{
+    const __m256i lo = _mm256_add_epi32(l->lo, l->dlo); /* < 2^23 */
+    l->hi = _mm256_add_epi32(_mm256_add_epi32(l->hi, l->dhi), _mm256_srli_epi32(lo, SC_LOW_BITS));
+    l->lo = _mm256_and_si256(lo, _mm256_set1_epi32(SC_LOW_MASK));
+}
+
+/* one level of the interpolation: (a * 1024 + t * (b - a) + 512) >> 10 */
+static inline __m256i lerp(__m256i a, __m256i b, __m256i t)
+{
+    const __m256i s = _mm256_add_epi32(_mm256_slli_epi32(a, SC_W_BITS),
+                                       _mm256_mullo_epi32(t, _mm256_sub_epi32(b, a)));
+    return _mm256_srai_epi32(_mm256_add_epi32(s, _mm256_set1_epi32(SC_W_ONE / 2)), SC_W_BITS);
+}
+
+/* the first interpolation level from a gathered dword: byte `sh`/8 and the next one */
+static inline __m256i pair_level(__m256i g, int sh, __m256i tx)
+{
+    const __m256i m = _mm256_set1_epi32(0xff);
+    const __m256i a = _mm256_and_si256(_mm256_srli_epi32(g, sh), m);
+    const __m256i b = _mm256_and_si256(_mm256_srli_epi32(g, sh + 8), m);
+    return _mm256_add_epi32(_mm256_slli_epi32(a, SC_W_BITS),
+                            _mm256_mullo_epi32(tx, _mm256_sub_epi32(b, a)));
+}
+
+/* 4 display values from 4 int64 sums: 0 below 1 << 26, 255 from 255 << 26, else sum >> 26 */
+static inline __m256i display4(__m256i ifx4, __m256i la, const int64_t *lut, __m256i m64)
+{
+    /* lanes past the span read nothing (the table may end there) */
+    const __m256i sum = _mm256_add_epi64(_mm256_mul_epi32(ifx4, la),
+                                         _mm256_maskload_epi64((const long long *)(const void *)lut,
+                                                               m64));
+    __m256i v = _mm256_srli_epi64(sum, 26);
+    v = _mm256_blendv_epi8(v, _mm256_setzero_si256(),
+                           _mm256_cmpgt_epi64(_mm256_set1_epi64x((int64_t)1 << 26), sum));
+    v = _mm256_blendv_epi8(
+        v, _mm256_set1_epi64x(255),
+        _mm256_cmpgt_epi64(sum, _mm256_set1_epi64x(((int64_t)255 << 26) - 1)));
+    return v;
+}
+
+/* the low byte of each of 8 dwords, to dst[0..8) */
+static inline void store_bytes(uint8_t *dst, __m256i v)
+{
+    const __m256i pick = _mm256_setr_epi8(0, 4, 8, 12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,
+                                          -1, 0, 4, 8, 12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,
+                                          -1, -1);
+    const __m256i p = _mm256_shuffle_epi8(v, pick);
+    const int32_t lo = _mm256_cvtsi256_si32(p);
+    const int32_t hi = _mm256_extract_epi32(p, 4);
+    memcpy(dst, &lo, 4);
+    memcpy(dst + 4, &hi, 4);
+}
+
+void sc_bscan_span_x86_64_v3(const vol_regs v, const int64_t *restrict lut_b_fx, uint32_t k0,
+                             uint32_t k1, int64_t X, int64_t Y, int64_t Z, int64_t DX,
+                             int64_t DY, int64_t DZ, uint8_t *restrict out,
+                             uint8_t *restrict lab_out)
+{
+    if (k1 <= k0) {
+        return;
+    }
+    lanes lx = lanes_init(X, DX), ly = lanes_init(Y, DY), lz = lanes_init(Z, DZ);
+    const __m256i wmask = _mm256_set1_epi32(SC_W_ONE - 1);
+    const __m256i half = _mm256_set1_epi32(SC_W_ONE / 2 - 1);
+    const __m256i vsy = _mm256_set1_epi32((int32_t)v.sy);
+    const __m256i vsz = _mm256_set1_epi32((int32_t)v.sz);
+    const __m256i vsyz2 = _mm256_set1_epi32((int32_t)(v.sy + v.sz) - 2);
+    const __m256i la = _mm256_set1_epi64x(v.la);
+    const __m256i outside = _mm256_set1_epi32(SC_LABEL_OUTSIDE);
+    const __m256i three = _mm256_set1_epi32(3);
+    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    const int *vox = (const int *)(const void *)v.vox;
+    const int *labp = (const int *)(const void *)v.lab;
+    for (uint32_t k = k0; k < k1; k += 8u) {
+        /* the lanes of this span: all 8, or the last few (the others gather and load nothing:
+         * their positions may be anywhere) */
+        const uint32_t r = k1 - k < 8u ? k1 - k : 8u;
+        const __m256i m = _mm256_cmpgt_epi32(_mm256_set1_epi32((int32_t)r), lane);
+        const __m256i tx = _mm256_and_si256(lx.hi, wmask);
+        const __m256i ty = _mm256_and_si256(ly.hi, wmask);
+        const __m256i tz = _mm256_and_si256(lz.hi, wmask);
+        const __m256i base = _mm256_add_epi32(
+            _mm256_add_epi32(_mm256_srli_epi32(lx.hi, SC_W_BITS),
+                             _mm256_mullo_epi32(_mm256_srli_epi32(ly.hi, SC_W_BITS), vsy)),
+            _mm256_mullo_epi32(_mm256_srli_epi32(lz.hi, SC_W_BITS), vsz));
+        /* 4 bytes from each row start; the last row from 2 before it (never past the end: the
+         * +1 neighbour of the last row is the volume's last byte at most) */
+        const __m256i z = _mm256_setzero_si256();
+        const __m256i g00 = _mm256_mask_i32gather_epi32(z, vox, base, m, 1);
+        const __m256i g10 = _mm256_mask_i32gather_epi32(z, vox, _mm256_add_epi32(base, vsy), m, 1);
+        const __m256i g01 = _mm256_mask_i32gather_epi32(z, vox, _mm256_add_epi32(base, vsz), m, 1);
+        const __m256i g11 =
+            _mm256_mask_i32gather_epi32(z, vox, _mm256_add_epi32(base, vsyz2), m, 1);
+        const __m256i c00 = pair_level(g00, 0, tx), c10 = pair_level(g10, 0, tx);
+        const __m256i c01 = pair_level(g01, 0, tx), c11 = pair_level(g11, 16, tx);
+        const __m256i c0 = lerp(c00, c10, ty), c1 = lerp(c01, c11, ty);
+        const __m256i ifx = lerp(c0, c1, tz);
+        __m256i label;
+        if (labp != NULL) {
+            /* nearest voxel: + 1 where the weight is >= 1/2 */
+            const __m256i li = _mm256_add_epi32(
+                _mm256_add_epi32(base, _mm256_srli_epi32(tx, SC_W_BITS - 1)),
+                _mm256_add_epi32(_mm256_and_si256(_mm256_cmpgt_epi32(ty, half), vsy),
+                                 _mm256_and_si256(_mm256_cmpgt_epi32(tz, half), vsz)));
+            /* the dword ending at the label (or starting at it near the array's start) */
+            const __m256i at = _mm256_max_epi32(_mm256_sub_epi32(li, three), z);
+            const __m256i g = _mm256_mask_i32gather_epi32(z, labp, at, m, 1);
+            label = _mm256_and_si256(
+                _mm256_srlv_epi32(g, _mm256_slli_epi32(_mm256_sub_epi32(li, at), 3)),
+                _mm256_set1_epi32(0xff));
+        } else {
+            label = _mm256_set1_epi32(SC_LABEL_MUSCLE);
+        }
+        const __m256i d_lo =
+            display4(_mm256_cvtepu32_epi64(_mm256_castsi256_si128(ifx)), la, lut_b_fx + k,
+                     _mm256_cvtepi32_epi64(_mm256_castsi256_si128(m)));
+        const __m256i d_hi =
+            display4(_mm256_cvtepu32_epi64(_mm256_extracti128_si256(ifx, 1)), la,
+                     lut_b_fx + k + 4, _mm256_cvtepi32_epi64(_mm256_extracti128_si256(m, 1)));
+        /* the low dwords of the 8 int64 into 8 dwords, in order */
+        const __m256i sel = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
+        const __m256i disp = _mm256_blend_epi32(_mm256_permutevar8x32_epi32(d_lo, sel),
+                                                _mm256_permutevar8x32_epi32(d_hi, sel), 0xf0);
+        const __m256i shown = _mm256_andnot_si256(_mm256_cmpeq_epi32(label, outside), disp);
+        if (r == 8u) {
+            store_bytes(out + k, shown);
+            store_bytes(lab_out + k, label);
+        } else {
+            uint8_t t[16];
+            store_bytes(t, shown);
+            store_bytes(t + 8, label);
+            memcpy(out + k, t, r);
+            memcpy(lab_out + k, t + 8, r);
+        }
+        lanes_step(&lx);
+        lanes_step(&ly);
+        lanes_step(&lz);
+    }
+}
+#else
+typedef int sc_bscan_kern_x86_64_v3_unused; /* ISO C: a translation unit is not empty */
+#endif

@@ -1,0 +1,144 @@
+/* test_sc_bscan_kern.c: the B-scan's span sampler gives the same bytes in every variant
+ * (sc_bscan_kern.h): random spans (every direction, lengths with and without a remainder of 8,
+ * positions up to both ends of every axis) through a random volume with and without labels,
+ * generic against each variant this build and CPU have. */
+#include "sc_test.h"
+
+#include <string.h>
+
+#include "sc_bscan_kern.h"
+#include "sc_cpu.h"
+#include "sc_err.h"
+#include "sc_simd.h"
+
+enum { NX = 37, NY = 29, NZ = 23, N = 600 };
+
+static uint8_t g_vox[NX * NY * NZ];
+static uint8_t g_lab[NX * NY * NZ];
+static int64_t g_lut[N];
+static uint32_t g_rng = 12345u;
+
+static uint32_t rnd(void)
+{
+    g_rng = g_rng * 1664525u + 1013904223u;
+    return g_rng >> 8;
+}
+
+/* a position in [0, xm] of 32.32 */
+static int64_t pos(int64_t xm)
+{
+    const uint32_t r = rnd() % 16u;
+    if (r == 0u) {
+        return 0;
+    }
+    if (r == 1u) {
+        return xm;
+    }
+    return (int64_t)(((uint64_t)rnd() << 24 | rnd()) % (uint64_t)(xm + 1));
+}
+
+static void fill(void)
+{
+    for (uint32_t i = 0; i < NX * NY * NZ; i++) {
+        g_vox[i] = (uint8_t)rnd();
+        g_lab[i] = (uint8_t)(rnd() % (uint32_t)SC_LABEL_COUNT);
+    }
+    for (uint32_t k = 0; k < N; k++) {
+        /* the display table's range: gain, TGC and range of sc_bscan_def */
+        g_lut[k] = ((int64_t)(rnd() % 600000u) - 300000) * 65536;
+    }
+}
+
+/* spans of random length and direction, every sample inside [0, xmax] */
+static uint32_t compare(sc_bscan_span_fn f, int with_labels, int64_t la)
+{
+    const int64_t xm[3] = {((int64_t)(NX - 1) << 32) - 1 - SC_W_HALF,
+                           ((int64_t)(NY - 1) << 32) - 1 - SC_W_HALF,
+                           ((int64_t)(NZ - 1) << 32) - 1 - SC_W_HALF};
+    const vol_regs v = {g_vox, with_labels ? g_lab : NULL, NX, (size_t)NX * NY, la};
+    uint32_t spans = 0;
+    for (uint32_t it = 0; it < 3000u; it++) {
+        const uint32_t len = 1u + rnd() % (it % 3u == 0u ? 20u : 400u);
+        const uint32_t k0 = rnd() % (N - len);
+        int64_t p0[3], p1[3], d[3];
+        for (int a = 0; a < 3; a++) {
+            p0[a] = pos(xm[a]);
+            p1[a] = rnd() % 8u == 0u ? p0[a] : pos(xm[a]);
+            d[a] = len > 1u ? (p1[a] - p0[a]) / (int64_t)(len - 1u) : 0;
+        }
+        uint8_t o1[N], l1[N], o2[N], l2[N];
+        memset(o1, 0xa5, sizeof o1);
+        memset(l1, 0xa5, sizeof l1);
+        memset(o2, 0xa5, sizeof o2);
+        memset(l2, 0xa5, sizeof l2);
+        sc_bscan_span_generic(v, g_lut, k0, k0 + len, p0[0], p0[1], p0[2], d[0], d[1], d[2], o1,
+                              l1);
+        f(v, g_lut, k0, k0 + len, p0[0], p0[1], p0[2], d[0], d[1], d[2], o2, l2);
+        assert_memory_equal(o1, o2, sizeof o1);
+        assert_memory_equal(l1, l2, sizeof l1);
+        spans++;
+    }
+    return spans;
+}
+
+static void test_variants_agree(void **state)
+{
+    (void)state;
+    fill();
+    const sc_simd keep = sc_simd_selected();
+    const sc_simd best = sc_cpu_best_simd();
+    uint32_t tried = 0;
+    for (int s = 0; s < (int)SC_SIMD_COUNT; s++) {
+        if (!sc_simd_built((sc_simd)s) || s > (int)best) {
+            continue;
+        }
+        assert_int_equal(sc_simd_select((sc_simd)s), SC_OK);
+        const sc_bscan_span_fn f = sc_bscan_span_selected();
+        assert_non_null(f);
+        /* lut_a 1 (volume shown unchanged) and 12 (120 dB over 10) */
+        assert_int_equal(compare(f, 1, 65536), 3000u);
+        assert_int_equal(compare(f, 0, 65536), 3000u);
+        assert_int_equal(compare(f, 1, 12 * 65536), 3000u);
+        tried++;
+    }
+    (void)sc_simd_select(keep);
+    print_message("span sampler variants compared with the generic one: %u\n", tried);
+    assert_true(tried >= 1u);
+}
+
+/* The generic sampler against the formula: a voxel centre gives the voxel, the midpoint of two
+ * gives their mean rounded, the label is the nearest voxel's. */
+static void test_generic_values(void **state)
+{
+    (void)state;
+    fill();
+    const vol_regs v = {g_vox, g_lab, NX, (size_t)NX * NY, 65536};
+    /* out = (lut_a I + B) >> 26 with I = value * 1024 and lut_a = 1: B = 1/2 grey rounds */
+    const int64_t lut[2] = {(int64_t)1 << 25, (int64_t)1 << 25};
+    uint8_t o[2], l[2];
+    const uint32_t i = 5, j = 7, k = 9;
+    const size_t at = i + (size_t)NX * (j + (size_t)NY * k);
+    sc_bscan_span_generic(v, lut, 0, 1, (int64_t)i << 32, (int64_t)j << 32, (int64_t)k << 32, 0,
+                          0, 0, o, l);
+    assert_int_equal(l[0], g_lab[at]);
+    if (g_lab[at] != SC_LABEL_OUTSIDE) {
+        assert_int_equal(o[0], g_vox[at]);
+    }
+    /* halfway between voxels i and i + 1 along x: their mean, rounded half up; the label
+     * of the voxel at or past the middle (i + 1) */
+    sc_bscan_span_generic(v, lut, 0, 1, ((int64_t)i << 32) + ((int64_t)1 << 31), (int64_t)j << 32,
+                          (int64_t)k << 32, 0, 0, 0, o, l);
+    assert_int_equal(l[0], g_lab[at + 1u]);
+    if (g_lab[at + 1u] != SC_LABEL_OUTSIDE) {
+        assert_int_equal(o[0], (g_vox[at] + g_vox[at + 1u] + 1) / 2);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_variants_agree),
+        cmocka_unit_test(test_generic_values),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
