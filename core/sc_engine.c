@@ -1171,6 +1171,18 @@ static void state_stream(sc_engine *e, uint64_t now)
     for (uint32_t i = 0; i < 8u && i < SC_BSCAN_TGC_BANDS; i++) {
         in.tgc_db[i] = b->tgc_db[i];
     }
+    in.material_rebuilds = e->counters.material_rebuilds;
+    in.material_refused = e->counters.material_refused;
+    if (e->case_loaded) {
+        const sc_tissue *rt = &e->tissue[e->active];
+        in.mat = &rt->mat;
+        in.mat_override_mask = e->mat_run.label_mask;
+        in.mat_sim_override = e->mat_run.sim_set;
+        in.cg_iterations = (uint8_t)(rt->fem.def.cg_iterations > 255u ? 255u
+                                                                       : rt->fem.def.cg_iterations);
+        in.corotated = rt->fem.def.corotated;
+        in.damping_s = rt->msds.gamma_per_k_s;
+    }
     if (e->case_loaded && e->tissue_out.mesh != NULL && e->tissue_out.nodes != NULL) {
         in.c = &e->slot.c;
         in.mesh = e->tissue_out.mesh;

@@ -210,6 +210,9 @@ static void bad_values_and_a_busy_engine_are_refused_and_counted(void **state)
     assert_int_equal(rig.engine.sw.phase, SC_SWITCH_IDLE);
     /* (on the bus the codec refuses them first: test_sc_canproto) */
     sc_cmd ok = material(SC_LABEL_MUSCLE, 30.0f, 0.45f);
+    ok.material.cg_iterations = 20u; /* the solver's parameters too */
+    ok.material.damping_s = 0.2f;
+    ok.material.corotated = 1u;
     assert_int_equal(send(&ok), 1);
     /* while its rebuild runs another one is refused (busy), counted */
     const uint64_t cmd_refused = rig.engine.counters.commands_refused;
@@ -220,6 +223,12 @@ static void bad_values_and_a_busy_engine_are_refused_and_counted(void **state)
     (void)run_until_rebuilt(0u);
     assert_float_equal(sc_test_press_tissue(&rig)->mat.row[SC_LABEL_MUSCLE].e_pa, 30.0e3f, 1.0f);
     assert_float_equal(sc_test_press_tissue(&rig)->mat.row[SC_LABEL_FAT].e_pa, 3.5e3f, 0.5f);
+    assert_int_equal(sc_test_press_tissue(&rig)->fem.def.cg_iterations, 20u);
+    assert_int_equal(sc_test_press_tissue(&rig)->fem.def.corotated, 1u);
+    assert_float_equal(sc_test_press_tissue(&rig)->fem.def.rayleigh_beta_s, 0.2f, 1e-3f);
+    assert_float_equal(sc_test_press_tissue(&rig)->msds.gamma_per_k_s, 0.2f, 1e-3f);
+    run(60u);
+    assert_int_equal(rig.engine.counters.phys_resets, 0u);
     /* a case switch restores the case's own */
     assert_int_equal(sc_engine_select_case(&rig.engine, "neck-ijv.scase"), SC_OK);
     uint32_t n = 0;
@@ -230,6 +239,9 @@ static void bad_values_and_a_busy_engine_are_refused_and_counted(void **state)
     assert_int_equal(rig.engine.counters.case_loads, loads + 1u);
     assert_int_equal(sc_engine_get_material(&rig.engine)->label_mask, 0u);
     assert_float_equal(sc_test_press_tissue(&rig)->mat.row[SC_LABEL_MUSCLE].e_pa, 15.0e3f, 0.5f);
+    assert_int_equal(sc_test_press_tissue(&rig)->fem.def.cg_iterations,
+                     rig.engine.def.tissue.fem.cg_iterations);
+    assert_float_equal(sc_test_press_tissue(&rig)->msds.gamma_per_k_s, 0.1f, 1e-6f);
     assert_int_equal(rig.engine.counters.material_rebuilds, 1u);
 }
 
