@@ -6,8 +6,9 @@
  *   - the engine rebuilds the running case's tissue with the commanded fat (E 3.5 -> 0.7 kPa)
  *     off the frame path (a switch to the same case through the standby slot, counted in
  *     material_rebuilds), the new tissue's table holds it, the solver parameters too;
- *   - at the same press the softer fat deforms more: the vein below it is compressed less
- *     (the fat takes the press) and the tissue pushes back with less force; both measured;
+ *   - the softer fat deforms more: at the same press depth the tissue pushes back with less
+ *     force and the vein beside it is compressed less (the fat takes the press); the same
+ *     force takes the probe deeper (measured in 0.5 mm steps);
  *   - CmdReset (tissue) restores the case's own materials by the same rebuild: the image
  *     hashes of the frames after it are those of a fresh load under the same press;
  *   - bad values reach the engine and are refused and counted; a command while the rebuild
@@ -46,11 +47,9 @@ static float vein_ratio(void)
     return b->areas_valid ? b->area_ratio[SC_LABEL_VEIN] : -1.0f;
 }
 
-/* the probe PRESS_MM into the skin over the middle of the mesh's top for the whole run */
-static void rig_up(void)
+/* from now on the probe depth_mm into the skin over the middle of the mesh's top */
+static void press_at(float depth_mm)
 {
-    sc_test_press_rig_up(&rig, &storage, SC_BINARY_DIR "/cases", "neck-ijv.scase",
-                         SC_TISSUE_MSDS);
     const sc_case *cs = &rig.engine.slot.c;
     const float p_vol[3] = {cs->mesh.origin_mm[0] + 0.5f * cs->mesh.size_mm[0],
                             cs->mesh.origin_mm[1] + 0.5f * cs->mesh.size_mm[1],
@@ -59,7 +58,7 @@ static void rig_up(void)
     sc_emu_def ed = sc_emu_default_def();
     float top[3];
     sc_xform_apply(&v2t, p_vol, top);
-    sc_emu_row r = {0.0, {top[0], top[1], top[2] - PRESS_MM}, {0, 0, 0, 0}, -1.0f};
+    sc_emu_row r = {0.0, {top[0], top[1], top[2] - depth_mm}, {0, 0, 0, 0}, -1.0f};
     memcpy(r.q, ed.base_q, sizeof r.q);
     rows[0] = r;
     r.t_s = 60.0;
@@ -71,6 +70,14 @@ static void rig_up(void)
     assert_int_equal(sc_emu_init(&emu, &ed), SC_OK);
     t0 = rig.clock.now_ns;
     more = 1;
+}
+
+/* the engine on neck-ijv (MSDS), the probe PRESS_MM into the skin for the whole run */
+static void rig_up(void)
+{
+    sc_test_press_rig_up(&rig, &storage, SC_BINARY_DIR "/cases", "neck-ijv.scase",
+                         SC_TISSUE_MSDS);
+    press_at(PRESS_MM);
 }
 
 static void run(uint32_t frames)
@@ -164,6 +171,22 @@ static void softer_fat_deforms_more_and_reset_restores_the_hashes(void **state)
                   (double)force_soft, (double)dev_soft, took);
     assert_true(force_soft < 0.8f * force_own);
     assert_true(vein_soft > vein_own + 0.02f);
+    /* the same press (force): the soft fat lets the probe in deeper; 0.5 mm steps */
+    float depth_same_force = 0.0f, force_there = 0.0f;
+    for (int step = 1; step <= 12 && !(force_there >= force_own); step++) {
+        depth_same_force = PRESS_MM + 0.5f * (float)step;
+        press_at(depth_same_force);
+        run(60u);
+        force_there = sc_tissue_probe_force_n(sc_test_press_tissue(&rig), NULL);
+    }
+    assert_true(force_there >= force_own);
+    print_message("fat 0.7 kPa: the 3.5 kPa fat's force at %.1f mm (%.2f N) is reached at %.1f mm "
+                  "(%.2f N)\n",
+                  (double)PRESS_MM, (double)force_own, (double)depth_same_force,
+                  (double)force_there);
+    assert_true(depth_same_force >= PRESS_MM + 1.0f);
+    press_at(PRESS_MM);
+    run(60u);
 
     /* reset (tissue): the case's own materials, rebuilt; the frames after the swap are those
      * of the fresh load, hash for hash */
