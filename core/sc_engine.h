@@ -38,7 +38,9 @@
  *            every state_period_ms a few fixed records handed to the state device, never
  *            waiting (O(state_vert_records x 112) vertex interpolations).
  *   control  between this frame and the next, in the frame's slack: the queued commands
- *            (O(SC_CAN_CMD_QUEUE_MAX)), then at most one slice of a pending case switch:
+ *            (O(SC_CAN_CMD_QUEUE_MAX); a CmdMaterial starts a switch to the running case with
+ *            its overrides, sc_engine_set_material), then at most one slice of a pending case
+ *            switch:
  *              open      the storage mapping, the file's framing (O(sections));
  *              validate  at most case_check_slice_bytes of CRC / label pass (sc_case.h);
  *              build     the next case's tissue in the standby slot, one build phase per
