@@ -224,6 +224,16 @@ if (scenario === 'sessions') {
   const mm = await page.evaluate(() => window.sc.material);
   if (mm.labels.nerve.overridden) await fail('the command sent during the rebuild was applied');
   ok(`busy: muscle 30 kPa applied, the nerve command during its rebuild refused (${mm.refused} refused); gateway: ${await page.evaluate((e0) => window.sc.errors[e0].reason.slice(0, 60), e0)}`);
+  // a client without the pass phrase sees the materials but cannot change them
+  const viewer = await browser.newPage({ viewport: { width: 900, height: 600 } });
+  await viewer.goto(url);
+  await waitFor(viewer, () => window.sc?.material?.labels?.muscle && Math.abs(window.sc.material.labels.muscle.eKpa - 30) < 0.05,
+    null, 'a second client sees the engine\'s materials');
+  await viewer.locator('[data-testid=mat-e-skin]').fill('1');
+  await waitFor(viewer, () => window.sc.errors.some((e) => e.op === 'material' && /locked/.test(e.reason)), null,
+    'the locked client\'s material command refused');
+  await viewer.close();
+  ok('a client without the pass phrase: materials shown, its material command refused (controls locked)');
   // "case materials": CmdReset tissue restores the case's own
   await page.click('[data-testid=mat-restore]');
   await waitFor(page, () => window.sc.material.mask === 0 && !window.sc.material.simOverride &&
