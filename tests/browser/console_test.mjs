@@ -208,6 +208,7 @@ if (scenario === 'sessions') {
   await page.locator('[data-testid=mat-damping]').fill('0.2');
   await waitFor(page, () => Math.abs(window.sc.material.dampingS - 0.2) < 0.002 && window.sc.material.simOverride &&
     Math.abs(window.sc.material.labels.fat.eKpa - 0.7) < 0.01, null, 'the engine runs with damping 0.2 s', 30000);
+  await page.locator('#tissue-panel').screenshot({ path: path.join(outDir, 'tissue-panel.png') });
   ok(`damping slider: engine's damping ${await page.evaluate(() => window.sc.material.dampingS.toFixed(3))} s, fat still 0.7 kPa`);
   // two commands back to back: the second arrives while the first one's rebuild runs (refused
   // by the engine, counted); a Poisson ratio outside the protocol is refused by the gateway
