@@ -52,7 +52,7 @@ typedef enum sc_state_type {
     SC_STATE_TRIS = 4,
     SC_STATE_CATALOGUE = 5,
     SC_STATE_ASSESSMENT = 6, /* the exam's assessment record (sc_assess.h) */
-    SC_STATE_MATERIAL = 8,   /* the running tissue's materials and solver parameters */
+    SC_STATE_MATERIAL = 7,   /* the running tissue's materials and solver parameters */
 } sc_state_type;
 
 /* MATERIAL payload: 32 bytes of head and SC_STATE_MATERIAL_ROWS rows of (E Pa, nu). */

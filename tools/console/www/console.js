@@ -355,7 +355,7 @@ function onRecord(buf) {
   else if (type === 3) onVerts(dv, p);
   else if (type === 4) onTris(dv, p);
   else if (type === 6) onAssessment(dv, p);
-  else if (type === 8) onMaterial(dv, p);
+  else if (type === 7) onMaterial(dv, p);
   // CATALOGUE records reach the page as the gateway's JSON catalogue (with the case texts)
 }
 
@@ -501,7 +501,7 @@ $('assess-reset').onclick = () => send({ op: 'assess', action: 'reset' });
 $('unlock').onclick = () => send({ op: 'auth', pass: $('pass').value });
 
 // ---- Tissue panel: materials per label and the solver's parameters (CmdMaterial) --------------
-// The MATERIAL record (type 8, docs/state-stream.md) carries what the running tissue was built
+// The MATERIAL record (type 7, docs/state-stream.md) carries what the running tissue was built
 // with; the sliders show it unless the user is holding one, and a release sends the label's E and
 // nu with the simulation parameters (the command carries both).
 const MAT_LABELS = ['skin', 'fat', 'muscle', 'vein', 'artery', 'nerve', 'thrombus']; // labels 1..7
