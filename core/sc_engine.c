@@ -2,6 +2,7 @@
  * sc_engine.h. */
 #include "sc_engine.h"
 
+#include <math.h>
 #include <string.h>
 
 #include "sc_assert.h"
@@ -485,6 +486,136 @@ static int apply_doppler(sc_engine *e, const sc_doppler_cmd *c)
 #endif
 }
 
+/* ---- CmdMaterial: the running case rebuilt with other materials ----------------------- */
+
+static int material_valid(const sc_engine *e, const sc_material_cmd *m)
+{
+    if (!isfinite(m->e_kpa) || !isfinite(m->poisson) || !isfinite(m->damping_s)) {
+        return SC_ERR_NOT_FINITE;
+    }
+    const uint32_t it_max = SC_PHYS_ITERATIONS_MAX < 63u ? SC_PHYS_ITERATIONS_MAX : 63u;
+    if (m->label < SC_MATERIAL_LABEL_MIN || m->label > SC_MATERIAL_LABEL_MAX ||
+        m->label >= e->slot.c.material_count || !(m->e_kpa >= 0.1f && m->e_kpa <= 6553.4f) ||
+        !(m->poisson >= 0.0f && m->poisson <= 0.49f) ||
+        !(m->damping_s >= 0.01f && m->damping_s <= 0.5f) || m->cg_iterations < 1u ||
+        m->cg_iterations > it_max || m->corotated > 1u) {
+        return SC_ERR_RANGE;
+    }
+    return SC_OK;
+}
+
+/* A rebuild of the running case with `next` (a switch to its own name; build_begin applies
+ * the overrides, swap_case takes them over). */
+static int material_rebuild(sc_engine *e, const sc_engine_material *next)
+{
+    if (!e->case_loaded || e->sw.phase != SC_SWITCH_IDLE) {
+        return SC_ERR_STATE;
+    }
+    const int rc = request_switch(e, e->case_name);
+    if (rc == SC_OK) {
+        e->mat_next = *next;
+        e->mat_rebuild = 1u;
+    }
+    return rc;
+}
+
+static int material_request(sc_engine *e, const sc_material_cmd *m)
+{
+    int rc = !e->case_loaded || e->sw.phase != SC_SWITCH_IDLE ? SC_ERR_STATE : SC_OK;
+    if (rc == SC_OK) {
+        rc = material_valid(e, m);
+    }
+    if (rc == SC_OK) {
+        sc_engine_material next = e->mat_run;
+        next.label_mask = (uint16_t)(next.label_mask | (1u << m->label));
+        next.e_pa[m->label] = m->e_kpa * 1000.0f;
+        next.poisson[m->label] = m->poisson;
+        next.sim_set = 1u;
+        next.damping_s = m->damping_s;
+        next.cg_iterations = m->cg_iterations;
+        next.corotated = m->corotated;
+        rc = material_rebuild(e, &next);
+    }
+    if (rc != SC_OK) {
+        e->counters.material_refused++;
+    }
+    sc_log(&e->hal->log, rc == SC_OK ? SC_LOG_INFO : SC_LOG_WARN, "material", rc,
+           (int64_t)m->label, (int64_t)(m->e_kpa * 10.0f));
+    return rc;
+}
+
+/* CmdReset (tissue) while overrides are in force: the case's own materials, rebuilt. */
+static void material_restore(sc_engine *e)
+{
+    if (e->mat_run.label_mask == 0u && e->mat_run.sim_set == 0u) {
+        return;
+    }
+    const sc_engine_material none = {0};
+    const int rc = material_rebuild(e, &none);
+    if (rc != SC_OK) {
+        e->counters.material_refused++;
+    }
+    sc_log(&e->hal->log, rc == SC_OK ? SC_LOG_INFO : SC_LOG_WARN, "material_restore", rc, 0, 0);
+}
+
+/* build_begin: the overrides of a material rebuild on the case's table and the tissue def. */
+static void material_apply_def(const sc_engine *e, sc_material_table *mat, sc_tissue_def *td)
+{
+    if (!e->mat_rebuild) {
+        return;
+    }
+    const sc_engine_material *o = &e->mat_next;
+    for (uint32_t l = 0; l < mat->count && l < 16u; l++) {
+        if (o->label_mask & (1u << l)) {
+            mat->row[l].e_pa = o->e_pa[l];
+            mat->row[l].poisson = o->poisson[l];
+        }
+    }
+    if (o->sim_set) {
+        td->fem.rayleigh_beta_s = o->damping_s;
+        td->fem.cg_iterations = o->cg_iterations;
+        td->fem.corotated = o->corotated;
+    }
+}
+
+/* swap_case, after the swap: the new tissue's overrides (none after a case switch), the
+ * MSDS springs' damping (Algorithm 1's gamma = 0.1 k unless overridden), the running name. */
+static void material_swapped(sc_engine *e, uint32_t slot)
+{
+    if (e->mat_rebuild) {
+        e->mat_run = e->mat_next;
+        e->counters.material_rebuilds++;
+        if (e->mat_run.sim_set) {
+            e->tissue[slot].msds.gamma_per_k_s = e->mat_run.damping_s;
+        }
+        sc_log(&e->hal->log, SC_LOG_INFO, "material_rebuilt", SC_OK,
+               (int64_t)e->mat_run.label_mask, (int64_t)e->mat_run.sim_set);
+    } else {
+        const sc_engine_material none = {0};
+        e->mat_run = none;
+        const size_t n = strlen(e->sw.name);
+        memcpy(e->case_name, e->sw.name, n + 1u);
+    }
+    e->mat_rebuild = 0u;
+}
+
+int sc_engine_set_material(sc_engine *e, const sc_material_cmd *m)
+{
+    if (e == NULL || m == NULL) {
+        return SC_ERR_INVALID_ARG;
+    }
+    const int rc = material_request(e, m);
+    if (rc != SC_OK) {
+        count_refusal(e, "command_refused", rc, (int64_t)SC_CMD_MATERIAL);
+    }
+    return rc;
+}
+
+const sc_engine_material *sc_engine_get_material(const sc_engine *e)
+{
+    return &e->mat_run;
+}
+
 static void apply_command(sc_engine *e, const sc_cmd *c)
 {
     int rc = SC_OK;
@@ -520,9 +651,13 @@ static void apply_command(sc_engine *e, const sc_cmd *c)
     case SC_CMD_DOPPLER:
         rc = apply_doppler(e, &c->doppler);
         break;
+    case SC_CMD_MATERIAL:
+        rc = material_request(e, &c->material);
+        break;
     case SC_CMD_RESET:
         if ((c->reset_target & SC_RESET_TISSUE) && e->case_loaded) {
             sc_tissue_reset(running_tissue(e));
+            material_restore(e);
         }
         if (c->reset_target & SC_RESET_FAULTS) {
             sc_health_clear(&e->health, SC_FAULT_PHYS_REPEATED);
@@ -566,6 +701,10 @@ static void switch_refused(sc_engine *e, int rc)
     e->counters.last_case_error = rc;
     e->slot.refused++;
     e->slot.last_error = rc;
+    if (e->mat_rebuild) {
+        e->counters.material_refused++;
+        e->mat_rebuild = 0u;
+    }
     sc_health_raise(&e->health, SC_FAULT_CONFIG);
     sc_log(&e->hal->log, SC_LOG_ERROR, "case_refused", rc, (int64_t)e->sw.case_id, 0);
 }
@@ -586,6 +725,7 @@ static int build_begin(sc_engine *e, uint32_t slot)
     }
     sc_tissue_def td = e->def.tissue;
     td.mesh = c->mesh;
+    material_apply_def(e, &mat, &td);
     /* the skin surface: over the top of the mesh box and a margin around it, so that its
      * deformation has no edge where the tissue mesh ends (paper section V) */
     for (uint32_t a = 0; a < 2u; a++) {
@@ -684,6 +824,7 @@ static int swap_case(sc_engine *e, uint32_t slot)
     e->case_loaded = 1;
     e->case_id = e->sw.case_id;
     e->counters.case_loads++;
+    material_swapped(e, slot);
     (void)sc_assess_begin_case(&e->assess, case_finding(&e->tissue[slot].mesh));
     sc_health_clear(&e->health, SC_FAULT_NO_CASE);
     sc_log(&e->hal->log, SC_LOG_INFO, "case_loaded", SC_OK, (int64_t)e->sw.c.case_id,
@@ -811,10 +952,12 @@ static void control_step(sc_engine *e)
 static int set_filters(sc_engine *e)
 {
     /* exactly the protocol's receive ids, so that foreign traffic (a flood at full bus load
-     * included) stays in the controller: commands 0x080..0x087, their cryptographic PDUs
-     * 0x088..0x08F, classic pose 0x100..0x102, FD pose 0x110 */
+     * included) stays in the controller: commands 0x080..0x087 and 0x090, their cryptographic
+     * PDUs 0x088..0x08F and 0x098, classic pose 0x100..0x102, FD pose 0x110 */
     const sc_can_filter f[] = {
         {.id = SC_CANID_CMD_CASE, .mask = 0x7F0u, .flags = 0}, /* 0x080..0x08F */
+        {.id = SC_CANID_CMD_MATERIAL, .mask = 0x7FFu, .flags = 0}, /* 0x090 CmdMaterial */
+        {.id = SC_CANID_AUTH_MATERIAL, .mask = 0x7FFu, .flags = 0}, /* 0x098 its MAC */
         {.id = SC_CANID_POSE_POS, .mask = 0x7FEu, .flags = 0},  /* 0x100..0x101 */
         {.id = SC_CANID_POSE_AUX, .mask = 0x7FFu, .flags = 0},  /* 0x102 */
         {.id = SC_CANID_POSE_FD, .mask = 0x7FFu, .flags = 0},
@@ -1027,6 +1170,18 @@ static void state_stream(sc_engine *e, uint64_t now)
     };
     for (uint32_t i = 0; i < 8u && i < SC_BSCAN_TGC_BANDS; i++) {
         in.tgc_db[i] = b->tgc_db[i];
+    }
+    in.material_rebuilds = e->counters.material_rebuilds;
+    in.material_refused = e->counters.material_refused;
+    if (e->case_loaded) {
+        const sc_tissue *rt = &e->tissue[e->active];
+        in.mat = &rt->mat;
+        in.mat_override_mask = e->mat_run.label_mask;
+        in.mat_sim_override = e->mat_run.sim_set;
+        in.cg_iterations = (uint8_t)(rt->fem.def.cg_iterations > 255u ? 255u
+                                                                       : rt->fem.def.cg_iterations);
+        in.corotated = rt->fem.def.corotated;
+        in.damping_s = rt->msds.gamma_per_k_s;
     }
     if (e->case_loaded && e->tissue_out.mesh != NULL && e->tissue_out.nodes != NULL) {
         in.c = &e->slot.c;

@@ -38,7 +38,9 @@
  *            every state_period_ms a few fixed records handed to the state device, never
  *            waiting (O(state_vert_records x 112) vertex interpolations).
  *   control  between this frame and the next, in the frame's slack: the queued commands
- *            (O(SC_CAN_CMD_QUEUE_MAX)), then at most one slice of a pending case switch:
+ *            (O(SC_CAN_CMD_QUEUE_MAX); a CmdMaterial starts a switch to the running case with
+ *            its overrides, sc_engine_set_material), then at most one slice of a pending case
+ *            switch:
  *              open      the storage mapping, the file's framing (O(sections));
  *              validate  at most case_check_slice_bytes of CRC / label pass (sc_case.h);
  *              build     the next case's tissue in the standby slot, one build phase per
@@ -177,6 +179,9 @@ typedef struct sc_engine_counters {
     uint64_t control_forced;        /* slices run after control_wait_frames without slack */
     uint64_t control_worst_ns[SC_ENGINE_SLICE_COUNT]; /* longest slice of each kind (HAL clock) */
     uint64_t case_check_bytes_worst; /* most case bytes validated in one frame */
+    uint64_t material_rebuilds;     /* CmdMaterial rebuilds swapped in (and their restores) */
+    uint64_t material_refused;      /* CmdMaterial refused: no case, busy, out of range (also
+                                     * in commands_refused) or its rebuild failed */
 } sc_engine_counters;
 
 typedef struct sc_engine_status {
@@ -247,6 +252,18 @@ typedef struct sc_case_switch {
     sc_case c;
 } sc_case_switch;
 
+/* CmdMaterial (sc_canproto.h): the overrides of the case's own materials and of the solver's
+ * parameters that a tissue was built with; all zero: the case's own (148 B). */
+typedef struct sc_engine_material {
+    uint16_t label_mask;         /* bit l: row l overridden */
+    uint8_t sim_set;             /* the solver parameters below are overridden */
+    uint8_t cg_iterations;       /* CG iterations per frame, 1..63 */
+    uint8_t corotated;           /* 0/1 */
+    float damping_s;             /* gamma / k = Rayleigh beta, s */
+    float e_pa[SC_MAX_LABELS];   /* Young's modulus of overridden rows, Pa */
+    float poisson[SC_MAX_LABELS];
+} sc_engine_material;
+
 typedef struct sc_engine {
     const sc_hal *hal;
     sc_engine_def def;
@@ -294,6 +311,11 @@ typedef struct sc_engine {
     sc_needle needle;       /* drawn in the B-scan, punctures */
     uint8_t needle_status_counter;
 #endif
+    /* CmdMaterial: a rebuild of the running case through the switch (the same slot) */
+    sc_engine_material mat_run;  /* of the running tissue */
+    sc_engine_material mat_next; /* of the rebuild being prepared */
+    uint8_t mat_rebuild;         /* 1: the switch in progress is a material rebuild/restore */
+    char case_name[SC_ENGINE_CASE_NAME_MAX]; /* the running case's storage name */
     sc_bscan bscan;
     sc_tissue tissue[SC_ENGINE_TISSUE_SLOTS]; /* the large ones last */
 } sc_engine;
@@ -323,6 +345,24 @@ int sc_engine_load_case(sc_engine *e, const char *name);
  * commands_refused, SC_FAULT_CONFIG raised): SC_ERR_INVALID_ARG, SC_ERR_RANGE (name too long),
  * SC_ERR_STATE (a switch is already running). */
 int sc_engine_select_case(sc_engine *e, const char *name);
+
+/* CmdMaterial: rebuild the running case's tissue with label m->label's Young's modulus and
+ * Poisson ratio and the solver's damping (gamma/k = Rayleigh beta), CG iterations and
+ * corotation (sc_material_cmd), on top of the overrides already in force. The rebuild is a
+ * switch to the running case (reopened, validated, built in the standby slot in slices
+ * between frames, swapped between two frames: off the frame path, no heap), its swap counted
+ * in material_rebuilds. A case switch, or CmdReset with SC_RESET_TISSUE while overrides are
+ * in force, restores the case's own materials (the latter by the same rebuild). Without a
+ * material command nothing changes. O(labels). Errors (refused, counted in commands_refused
+ * and material_refused): SC_ERR_INVALID_ARG (NULL), SC_ERR_STATE (no case runs, or a switch
+ * or rebuild is in progress), SC_ERR_NOT_FINITE, SC_ERR_RANGE (a label outside skin..thrombus
+ * or without a row in the case, E outside 0.1 kPa..6553.4 kPa, nu outside 0..0.49, damping
+ * outside 0.01..0.5 s, CG iterations outside 1..min(63, SC_PHYS_ITERATIONS_MAX), corotated
+ * above 1). */
+int sc_engine_set_material(sc_engine *e, const sc_material_cmd *m);
+
+/* The overrides the running tissue was built with (all zero: the case's own). O(1). */
+const sc_engine_material *sc_engine_get_material(const sc_engine *e);
 
 /* Set the platform hook (NULL: none). O(1). SC_ERR_INVALID_ARG for a NULL engine. */
 int sc_engine_set_hook(sc_engine *e, sc_engine_hook_fn fn, void *user);

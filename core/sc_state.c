@@ -291,6 +291,28 @@ static uint32_t emit_assessment(sc_state_tx *t, const sc_state_dev *dev, const s
     return finish(t, dev, &w, in->frame_no);
 }
 
+/* The MATERIAL record (docs/state-stream.md): what the running tissue was built with. */
+static uint32_t emit_material(sc_state_tx *t, const sc_state_dev *dev, const sc_state_in *in)
+{
+    const sc_material_table *m = in->mat;
+    const uint32_t count = m->count < SC_STATE_MATERIAL_ROWS ? m->count : SC_STATE_MATERIAL_ROWS;
+    wr w = begin(t, SC_STATE_MATERIAL);
+    put_u8(&w, (uint8_t)count);
+    put_u8(&w, in->mat_sim_override);
+    put_u8(&w, in->cg_iterations);
+    put_u8(&w, in->corotated);
+    put_f32(&w, in->damping_s);
+    put_u32(&w, in->mat_override_mask);
+    put_u32(&w, 0u);
+    put_u64(&w, in->material_rebuilds);
+    put_u64(&w, in->material_refused);
+    for (uint32_t l = 0; l < SC_STATE_MATERIAL_ROWS; l++) {
+        put_f32(&w, l < count ? m->row[l].e_pa : 0.0f);
+        put_f32(&w, l < count ? m->row[l].poisson : 0.0f);
+    }
+    return finish(t, dev, &w, in->frame_no);
+}
+
 uint32_t sc_state_emit(sc_state_tx *t, const sc_state_dev *dev, const sc_state_in *in)
 {
     if (t->period_ms == 0u || dev == NULL || dev->ops == NULL || in->now_ns < t->next_ns) {
@@ -319,6 +341,9 @@ uint32_t sc_state_emit(sc_state_tx *t, const sc_state_dev *dev, const sc_state_i
     }
     if (in->assess != NULL) {
         sent += emit_assessment(t, dev, in);
+    }
+    if (in->mat != NULL) {
+        sent += emit_material(t, dev, in);
     }
     t->periods++;
     return sent;

@@ -10,14 +10,15 @@
  * type. Types: FRAME (status, pose, statistics, imaging settings, compression measures),
  * SURF_INFO (the case's surfaces), VERTS (a run of deformed surface vertices), TRIS (a run of
  * triangles), CATALOGUE (one catalogue entry), ASSESSMENT (the exam's assessment record,
- * sc_assess_report in the layout of docs/assessment.md, one per period when the engine has one). A receiver ignores types and versions it does
+ * sc_assess_report in the layout of docs/assessment.md, one per period when the engine has one),
+ * MATERIAL (the running tissue's material rows and solver parameters, CmdMaterial). A receiver ignores types and versions it does
  * not know, and never needs every record: FRAME is complete in itself, surfaces are sent
  * round-robin (vertices every period, triangles and catalogue slowly), so a lost record is
  * replaced by the next round.
  *
  * Rate and cost: at most once per state_period_ms (engine def): one FRAME, one SURF_INFO, up
  * to vert_records VERTS (SC_STATE_VERTS_PER_RECORD vertices each: 4 node reads and a weighted
- * sum per vertex), one TRIS, one CATALOGUE, one ASSESSMENT. O(vert_records x SC_STATE_VERTS_PER_RECORD), never
+ * sum per vertex), one TRIS, one CATALOGUE, one ASSESSMENT, one MATERIAL. O(vert_records x SC_STATE_VERTS_PER_RECORD), never
  * allocates, never blocks (a record the device refuses is dropped and counted).
  * Memory: one record buffer of SC_STATE_RECORD_MAX bytes in the sc_state_tx.
  */
@@ -29,6 +30,7 @@
 #include "sc_assess.h"
 #include "sc_case.h"
 #include "sc_hal_state.h"
+#include "sc_material.h"
 #include "sc_mesh.h"
 #include "sc_pose.h"
 
@@ -50,7 +52,13 @@ typedef enum sc_state_type {
     SC_STATE_TRIS = 4,
     SC_STATE_CATALOGUE = 5,
     SC_STATE_ASSESSMENT = 6, /* the exam's assessment record (sc_assess.h) */
+    SC_STATE_MATERIAL = 7,   /* the running tissue's materials and solver parameters */
 } sc_state_type;
+
+/* MATERIAL payload: 32 bytes of head and SC_STATE_MATERIAL_ROWS rows of (E Pa, nu). */
+#define SC_STATE_MATERIAL_ROWS 16u
+#define SC_STATE_MATERIAL_SIZE (32u + 8u * SC_STATE_MATERIAL_ROWS)
+_Static_assert(SC_MAX_LABELS <= SC_STATE_MATERIAL_ROWS, "a MATERIAL record holds every label");
 
 #define SC_STATE_FRAME_SIZE 208u /* FRAME payload bytes (docs/state-stream.md) */
 
@@ -74,6 +82,13 @@ typedef struct sc_state_in {
     const sc_assess_report *assess; /* the exam's assessment; NULL: none */
     const char *const *catalogue; /* case_count names */
     uint32_t catalogue_count;
+    /* the running tissue's materials (NULL without a case: no MATERIAL record) */
+    const sc_material_table *mat;
+    uint32_t mat_override_mask; /* labels whose row a CmdMaterial set */
+    uint8_t mat_sim_override;   /* the solver parameters below were set by a CmdMaterial */
+    uint8_t cg_iterations, corotated;
+    float damping_s;            /* gamma / k (MSDS) = Rayleigh beta (FEM) of the running tissue */
+    uint64_t material_rebuilds, material_refused;
 } sc_state_in;
 
 typedef struct sc_state_tx {

@@ -4,7 +4,7 @@
 # program is a failure (CI installs them: tools/install-deps.sh base). About 20-40 s each.
 if(TARGET sc-gateway AND TARGET sc-hostsim AND TARGET sc-tracker-emu)
   find_program(SC_NODE node)
-  foreach(_scenario controls press sessions doppler)
+  foreach(_scenario controls press sessions doppler material)
     if(SC_NODE)
       add_test(NAME browser_console_${_scenario}
                COMMAND ${SC_NODE} ${CMAKE_CURRENT_SOURCE_DIR}/browser/console_test.mjs ${_scenario})

@@ -74,6 +74,15 @@ static const sc_can_sig sigs_cmd_doppler[] = {
     {"Steer", 40, 8, 1, 1.0f, 0.0f, -30.0f, 30.0f, "deg"},
     {"ColourGain", 48, 8, 1, 0.5f, 0.0f, -30.0f, 30.0f, "dB"},
 };
+static const sc_can_sig sigs_cmd_material[] = {
+    E2E_SIGS,
+    {"MaterialLabel", 16, 4, 0, 1.0f, 0.0f, 1.0f, 7.0f, ""},
+    {"CgIterations", 20, 6, 0, 1.0f, 0.0f, 1.0f, 63.0f, ""},
+    {"Corotated", 26, 1, 0, 1.0f, 0.0f, 0.0f, 1.0f, ""},
+    {"YoungsModulus", 32, 16, 0, 0.1f, 0.0f, 0.1f, 6553.4f, "kPa"},
+    {"PoissonRatio", 48, 8, 0, 0.002f, 0.0f, 0.0f, 0.49f, ""},
+    {"Damping", 56, 8, 0, 0.002f, 0.0f, 0.01f, 0.5f, "s"},
+};
 /* The cryptographic PDU (sc_secoc.h); the 40-bit MAC as two integer signals so that every
  * signal stays exact in float32 (MacA = MAC bytes 0..2, MacB = bytes 3..4, little-endian). */
 static const sc_can_sig sigs_auth[] = {
@@ -216,6 +225,8 @@ static const sc_can_msg_info msg_table[SC_MSG_COUNT] = {
     [SC_MSG_CMD_ASSESS] = MSG("CmdAssessment", SC_CANID_CMD_ASSESS, 8, 0, 0, 0, sigs_cmd_assess),
     [SC_MSG_CMD_VESSELS] = MSG("CmdVessels", SC_CANID_CMD_VESSELS, 8, 0, 0, 0, sigs_cmd_vessels),
     [SC_MSG_CMD_DOPPLER] = MSG("CmdDoppler", SC_CANID_CMD_DOPPLER, 8, 0, 0, 0, sigs_cmd_doppler),
+    [SC_MSG_CMD_MATERIAL] =
+        MSG("CmdMaterial", SC_CANID_CMD_MATERIAL, 8, 0, 0, 0, sigs_cmd_material),
     [SC_MSG_POSE_POS] = MSG("ProbePosePos", SC_CANID_POSE_POS, 8, 0, 10, 100, sigs_pose_pos),
     [SC_MSG_POSE_QUAT] = MSG("ProbePoseQuat", SC_CANID_POSE_QUAT, 8, 0, 10, 100, sigs_pose_quat),
     [SC_MSG_POSE_AUX] = MSG("ProbePoseAux", SC_CANID_POSE_AUX, 8, 0, 10, 100, sigs_pose_aux),
@@ -232,6 +243,7 @@ static const sc_can_msg_info msg_table[SC_MSG_COUNT] = {
     [SC_MSG_AUTH_ASSESS] = MSG_AUTH("CmdAuthAssessment", SC_CANID_AUTH_ASSESS),
     [SC_MSG_AUTH_VESSELS] = MSG_AUTH("CmdAuthVessels", SC_CANID_AUTH_VESSELS),
     [SC_MSG_AUTH_DOPPLER] = MSG_AUTH("CmdAuthDoppler", SC_CANID_AUTH_DOPPLER),
+    [SC_MSG_AUTH_MATERIAL] = MSG_AUTH("CmdAuthMaterial", SC_CANID_AUTH_MATERIAL),
     [SC_MSG_ASSESS_VESSELS] =
         MSG("AssessVessels", SC_CANID_ASSESS_VESSELS, 8, 0, 100, 0, sigs_assess_vessels),
     [SC_MSG_ASSESS_FORCE] =
@@ -253,6 +265,10 @@ _Static_assert(SC_CANID_AUTH_VESSELS == SC_CANID_CMD_VESSELS + SC_CANID_AUTH_OFF
 _Static_assert(SC_MSG_AUTH_VESSELS - SC_MSG_AUTH_CASE == SC_MSG_CMD_VESSELS - SC_MSG_CMD_CASE &&
                    SC_MSG_AUTH_DOPPLER - SC_MSG_AUTH_CASE == SC_MSG_CMD_DOPPLER - SC_MSG_CMD_CASE,
                "one cryptographic PDU per command (vessels, Doppler)");
+_Static_assert(SC_CANID_AUTH_MATERIAL == SC_CANID_CMD_MATERIAL + SC_CANID_AUTH_OFFSET &&
+                   SC_MSG_AUTH_MATERIAL - SC_MSG_AUTH_CASE ==
+                       SC_MSG_CMD_MATERIAL - SC_MSG_CMD_CASE,
+               "one cryptographic PDU per command (material)");
 _Static_assert(SC_CANID_AUTH_SYNC == SC_CANID_CMD_SYNC + SC_CANID_AUTH_OFFSET, "auth ids");
 _Static_assert(SC_MSG_AUTH_SYNC - SC_MSG_AUTH_CASE == SC_MSG_CMD_SYNC - SC_MSG_CMD_CASE,
                "one cryptographic PDU per command");
@@ -534,6 +550,7 @@ int sc_canproto_decode_pose_part(const sc_can_frame *f, sc_pose_msg *p)
     case SC_MSG_CMD_ASSESS:
     case SC_MSG_CMD_VESSELS:
     case SC_MSG_CMD_DOPPLER:
+    case SC_MSG_CMD_MATERIAL:
     case SC_MSG_STATUS:
     case SC_MSG_TIMING:
     case SC_MSG_DIAG:
@@ -546,6 +563,7 @@ int sc_canproto_decode_pose_part(const sc_can_frame *f, sc_pose_msg *p)
     case SC_MSG_AUTH_ASSESS:
     case SC_MSG_AUTH_VESSELS:
     case SC_MSG_AUTH_DOPPLER:
+    case SC_MSG_AUTH_MATERIAL:
     case SC_MSG_ASSESS_VESSELS:
     case SC_MSG_ASSESS_FORCE:
     case SC_MSG_ASSESS_SCORE:
@@ -580,6 +598,8 @@ sc_msg sc_canproto_cmd_msg(sc_cmd_kind k)
         return SC_MSG_CMD_VESSELS;
     case SC_CMD_DOPPLER:
         return SC_MSG_CMD_DOPPLER;
+    case SC_CMD_MATERIAL:
+        return SC_MSG_CMD_MATERIAL;
     }
     return SC_MSG_COUNT;
 }
@@ -590,6 +610,32 @@ static int assess_pair_ok(uint32_t action, uint32_t call)
     return (action == SC_ASSESS_ACTION_RESET && call == SC_ASSESS_CALL_NONE) ||
            (action == SC_ASSESS_ACTION_CALL &&
             (call == SC_ASSESS_CALL_NORMAL || call == SC_ASSESS_CALL_DVT));
+}
+
+/* CmdMaterial's fields: integers checked against their ranges, values put and range-checked
+ * as the decoder will (signals 2..7). */
+static int encode_material(sc_can_frame *f, sc_msg m, const sc_material_cmd *c)
+{
+    int rc = c->label >= SC_MATERIAL_LABEL_MIN && c->label <= SC_MATERIAL_LABEL_MAX &&
+                     c->cg_iterations >= 1u && c->cg_iterations <= 63u && c->corotated <= 1u
+                 ? 0
+                 : SC_ERR_CAN_SIGNAL;
+    put_u(f, m, 2u, c->label & 0xFu);
+    put_u(f, m, 3u, c->cg_iterations & 0x3Fu);
+    put_u(f, m, 4u, c->corotated & 1u);
+    if (rc == 0) {
+        rc = put_phys(f, m, 5u, c->e_kpa);
+    }
+    if (rc == 0) {
+        rc = put_phys(f, m, 6u, c->poisson);
+    }
+    if (rc == 0) {
+        rc = put_phys(f, m, 7u, c->damping_s);
+    }
+    for (unsigned i = 2u; i <= 7u && rc == 0; i++) {
+        rc = in_range(f, m, i) ? 0 : SC_ERR_CAN_SIGNAL;
+    }
+    return rc;
 }
 
 int sc_canproto_encode_cmd(const sc_cmd *c, uint8_t counter, sc_can_frame *out)
@@ -686,6 +732,11 @@ int sc_canproto_encode_cmd(const sc_cmd *c, uint8_t counter, sc_can_frame *out)
             rc = in_range(out, m, i) ? 0 : SC_ERR_CAN_SIGNAL;
         }
         break;
+    case SC_CMD_MATERIAL:
+        m = SC_MSG_CMD_MATERIAL;
+        frame_begin(out, m);
+        rc = encode_material(out, m, &c->material);
+        break;
     default:
         return SC_ERR_INVALID_ARG;
     }
@@ -759,6 +810,16 @@ int sc_canproto_decode_cmd(const sc_can_frame *f, sc_cmd *out)
         c.doppler.gain_db = get_phys(f, m, 5u);
         nsig = 4;
         break;
+    case SC_MSG_CMD_MATERIAL:
+        c.kind = SC_CMD_MATERIAL;
+        c.material.label = (uint8_t)get_u(f, m, 2u);
+        c.material.cg_iterations = (uint8_t)get_u(f, m, 3u);
+        c.material.corotated = (uint8_t)get_u(f, m, 4u);
+        c.material.e_kpa = get_phys(f, m, 5u);
+        c.material.poisson = get_phys(f, m, 6u);
+        c.material.damping_s = get_phys(f, m, 7u);
+        nsig = 6;
+        break;
     case SC_MSG_POSE_POS:
     case SC_MSG_POSE_QUAT:
     case SC_MSG_POSE_AUX:
@@ -775,6 +836,7 @@ int sc_canproto_decode_cmd(const sc_can_frame *f, sc_cmd *out)
     case SC_MSG_AUTH_ASSESS:
     case SC_MSG_AUTH_VESSELS:
     case SC_MSG_AUTH_DOPPLER:
+    case SC_MSG_AUTH_MATERIAL:
     case SC_MSG_ASSESS_VESSELS:
     case SC_MSG_ASSESS_FORCE:
     case SC_MSG_ASSESS_SCORE:
@@ -907,6 +969,7 @@ int sc_canproto_decode_status_part(const sc_can_frame *f, sc_status_msg *s)
     case SC_MSG_CMD_ASSESS:
     case SC_MSG_CMD_VESSELS:
     case SC_MSG_CMD_DOPPLER:
+    case SC_MSG_CMD_MATERIAL:
     case SC_MSG_POSE_POS:
     case SC_MSG_POSE_QUAT:
     case SC_MSG_POSE_AUX:
@@ -919,6 +982,7 @@ int sc_canproto_decode_status_part(const sc_can_frame *f, sc_status_msg *s)
     case SC_MSG_AUTH_ASSESS:
     case SC_MSG_AUTH_VESSELS:
     case SC_MSG_AUTH_DOPPLER:
+    case SC_MSG_AUTH_MATERIAL:
     case SC_MSG_ASSESS_VESSELS:
     case SC_MSG_ASSESS_FORCE:
     case SC_MSG_ASSESS_SCORE:

@@ -5,8 +5,9 @@
  * Messages (11-bit ids, Intel byte order, E2E header in bytes 0-1, see sc_e2e.h):
  *   0x080 CmdSelectCase  0x081 CmdSetMethod  0x082 CmdSetImaging  0x083 CmdReset
  *   0x084 CmdFreshnessSync  0x085 CmdVessels  0x086 CmdDoppler  0x087 CmdAssessment
- *                                                                                   (in, event)
- *   0x088..0x08F CmdAuth*: the cryptographic PDU of command id - 8 (sc_secoc.h) (in)
+ *   0x090 CmdMaterial (the second command block 0x090..0x097, auth 0x098..0x09F; 0x091..0x097
+ *         and 0x099..0x09F are unused and filtered out)                          (in, event)
+ *   0x088..0x08F, 0x098 CmdAuth*: the cryptographic PDU of command id - 8 (sc_secoc.h) (in)
  *   0x100 ProbePosePos   0x101 ProbePoseQuat 0x102 ProbePoseAux                    (in, 10 ms)
  *   0x110 ProbePoseFD    (in, 10 ms, CAN FD 20 bytes: the three above in one frame)
  *   0x200 EngineStatus   0x201 EngineTiming  0x202 TrackerDiag  0x203 AuthDiag    (out, 100 ms)
@@ -41,6 +42,7 @@ typedef enum sc_msg {
     SC_MSG_CMD_ASSESS, /* CmdAssessment 0x087: reset the assessment, the trainee's call */
     SC_MSG_CMD_VESSELS, /* CmdVessels 0x085: heart and breathing rates, Valsalva, pulsation */
     SC_MSG_CMD_DOPPLER, /* CmdDoppler 0x086: colour on/off, scale (PRF), steering, gain */
+    SC_MSG_CMD_MATERIAL, /* CmdMaterial 0x090: one label's E and nu, damping, CG iterations */
     SC_MSG_POSE_POS,
     SC_MSG_POSE_QUAT,
     SC_MSG_POSE_AUX,
@@ -57,6 +59,7 @@ typedef enum sc_msg {
     SC_MSG_AUTH_ASSESS,
     SC_MSG_AUTH_VESSELS,
     SC_MSG_AUTH_DOPPLER,
+    SC_MSG_AUTH_MATERIAL,
     SC_MSG_ASSESS_VESSELS, /* the assessment's status frames (out) */
     SC_MSG_ASSESS_FORCE,
     SC_MSG_ASSESS_SCORE,
@@ -68,11 +71,11 @@ typedef enum sc_msg {
     SC_MSG_COUNT
 } sc_msg;
 
-#define SC_CMD_MSGS 8u /* commands SC_MSG_CMD_CASE..SC_MSG_CMD_DOPPLER; SC_MSG_AUTH_* likewise */
+#define SC_CMD_MSGS 9u /* commands SC_MSG_CMD_CASE..SC_MSG_CMD_MATERIAL; SC_MSG_AUTH_* likewise */
 /* 1 for the secured commands (authentic PDUs), 1 for their cryptographic PDUs. */
-#define SC_MSG_IS_CMD(m)  ((unsigned)(m) <= (unsigned)SC_MSG_CMD_DOPPLER)
+#define SC_MSG_IS_CMD(m)  ((unsigned)(m) <= (unsigned)SC_MSG_CMD_MATERIAL)
 #define SC_MSG_IS_AUTH(m)                                                                          \
-    ((unsigned)(m) >= (unsigned)SC_MSG_AUTH_CASE && (unsigned)(m) <= (unsigned)SC_MSG_AUTH_DOPPLER)
+    ((unsigned)(m) >= (unsigned)SC_MSG_AUTH_CASE && (unsigned)(m) <= (unsigned)SC_MSG_AUTH_MATERIAL)
 #define SC_MSG_IS_NEEDLE_IN(m)                                                                   \
     ((unsigned)(m) >= (unsigned)SC_MSG_NEEDLE_POS && (unsigned)(m) <= (unsigned)SC_MSG_NEEDLE_AUX)
 
@@ -93,6 +96,8 @@ enum {
     SC_CANID_AUTH_VESSELS = 0x08D,
     SC_CANID_AUTH_DOPPLER = 0x08E,
     SC_CANID_AUTH_ASSESS = 0x08F,
+    SC_CANID_CMD_MATERIAL = 0x090, /* second command block 0x090..0x097, auth 0x098..0x09F */
+    SC_CANID_AUTH_MATERIAL = 0x098,
     SC_CANID_POSE_POS = 0x100,
     SC_CANID_POSE_QUAT = 0x101,
     SC_CANID_POSE_AUX = 0x102,
@@ -221,6 +226,7 @@ typedef enum sc_cmd_kind {
     SC_CMD_ASSESS = 6,         /* CmdAssessment: reset the assessment, or the trainee's call */
     SC_CMD_VESSELS = 7,        /* CmdVessels: the lumens' drive (heart, breathing, Valsalva) */
     SC_CMD_DOPPLER = 8,        /* CmdDoppler: colour Doppler on/off, scale, steering, gain */
+    SC_CMD_MATERIAL = 9,       /* CmdMaterial: a label's material, the solver's parameters */
 } sc_cmd_kind;
 
 enum { SC_METHOD_MSDS = 0, SC_METHOD_FEM = 1 };
@@ -259,6 +265,24 @@ typedef struct sc_doppler_cmd {
     float gain_db;
 } sc_doppler_cmd;
 
+/* CmdMaterial: the material of one tissue label (skin..thrombus; outside and bone are refused:
+ * bone's nodes are fixed) as Young's modulus 0.1..6553.4 kPa (0.1 kPa steps) and Poisson
+ * ratio 0..0.49 (0.002 steps), and the simulation parameters of the paper's FEM/MSDS dialogs
+ * that apply to both methods: the damping gamma/k = Rayleigh beta 0.01..0.5 s (0.002 s steps;
+ * Algorithm 1's 0.1 s), the CG iterations per frame 1..63 (FEM and the implicit MSDS; default
+ * SC_PHYS_CG_ITERATIONS_DEFAULT) and the corotated FEM on/off. The engine rebuilds the
+ * running case's tissue with them (sc_engine.h). */
+#define SC_MATERIAL_LABEL_MIN 1u /* SC_LABEL_SKIN */
+#define SC_MATERIAL_LABEL_MAX 7u /* SC_LABEL_THROMBUS */
+typedef struct sc_material_cmd {
+    uint8_t label;          /* SC_MATERIAL_LABEL_MIN..SC_MATERIAL_LABEL_MAX */
+    uint8_t cg_iterations;  /* 1..63 */
+    uint8_t corotated;      /* 0/1 */
+    float e_kpa;            /* 0.1..6553.4 */
+    float poisson;          /* 0..0.49 */
+    float damping_s;        /* gamma / k, 0.01..0.5 */
+} sc_material_cmd;
+
 typedef struct sc_cmd {
     sc_cmd_kind kind;
     uint8_t case_id;        /* SELECT_CASE: 0..254 */
@@ -268,6 +292,7 @@ typedef struct sc_cmd {
         sc_imaging_cmd imaging; /* SET_IMAGING */
         sc_vessels_cmd vessels; /* VESSELS */
         sc_doppler_cmd doppler; /* DOPPLER */
+        sc_material_cmd material; /* MATERIAL */
     };
     uint64_t fv_high;       /* SYNC_FRESHNESS: freshness value >> 16, 0..2^48-1 */
     uint8_t sender;         /* the authenticated sender (set by the receiver; sc_secoc.h) */

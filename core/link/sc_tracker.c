@@ -7,16 +7,17 @@
 
 #include <string.h>
 
-_Static_assert(SC_MSG_CMD_CASE == 0 && SC_MSG_POSE_FD == 11, "rx message indices 0..11");
+_Static_assert(SC_MSG_CMD_CASE == 0 && SC_MSG_POSE_FD == 12, "rx message indices 0..12");
 _Static_assert(SC_TRK_RX_MSGS == (unsigned)SC_MSG_POSE_FD + 1u, "rx state per message");
-_Static_assert(SC_CMD_MSGS == (unsigned)SC_MSG_CMD_DOPPLER + 1u, "commands first");
+_Static_assert(SC_CMD_MSGS == (unsigned)SC_MSG_CMD_MATERIAL + 1u, "commands first");
 /* 2,304 bytes on x86_64 with the default SC_CAN_CMD_QUEUE_MAX of 8 and five commands: 9 E2E
  * receivers of 64 B and their last payloads (180 B), 2 assembly slots of 56 B, the command
  * FIFO (48 B each), 5 pending commands (72 B each), the last accepted pairs and their times
  * (120 B), the SecOC receiver (256 B), counters (152 B). The sixth command (CmdAssessment)
  * adds a receiver, a payload, a pending command and a pair: 2,480 B in all; CmdVessels and
- * CmdDoppler 180 B each: 2,840 B (sc_cmd stays 48 B: the kinds' settings share a union). */
-_Static_assert(sizeof(sc_tracker) <= 2464u + 48u * SC_CAN_CMD_QUEUE_MAX, "tracker state grew");
+ * CmdDoppler 180 B each: 2,840 B (sc_cmd stays 48 B: the kinds' settings share a union);
+ * CmdMaterial (0x090) another 192 B: 3,032 B. */
+_Static_assert(sizeof(sc_tracker) <= 2648u + 48u * SC_CAN_CMD_QUEUE_MAX, "tracker state grew");
 
 sc_tracker_def sc_tracker_default_def(void)
 {
@@ -477,6 +478,7 @@ static sc_trk_outcome classify_and_handle(sc_tracker *t, const sc_can_frame *f, 
     case SC_MSG_CMD_ASSESS:
     case SC_MSG_CMD_VESSELS:
     case SC_MSG_CMD_DOPPLER:
+    case SC_MSG_CMD_MATERIAL:
         return on_command(t, f, m, ts_ns);
     case SC_MSG_POSE_POS:
     case SC_MSG_POSE_QUAT:
@@ -499,6 +501,7 @@ static sc_trk_outcome classify_and_handle(sc_tracker *t, const sc_can_frame *f, 
     case SC_MSG_AUTH_ASSESS:
     case SC_MSG_AUTH_VESSELS:
     case SC_MSG_AUTH_DOPPLER:
+    case SC_MSG_AUTH_MATERIAL:
     case SC_MSG_ASSESS_VESSELS:
     case SC_MSG_ASSESS_FORCE:
     case SC_MSG_ASSESS_SCORE:

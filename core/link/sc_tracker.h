@@ -130,7 +130,7 @@ typedef struct sc_trk_counters {
 } sc_trk_counters;
 
 #define SC_TRK_ASM_SLOTS 2u
-#define SC_TRK_RX_MSGS   12u /* the E2E-protected messages received: 8 commands, 4 pose */
+#define SC_TRK_RX_MSGS   13u /* the E2E-protected messages received: 9 commands, 4 pose */
 #define SC_TRK_FRAME_MAX 20u /* longest received payload (the FD pose) */
 /* SC_TRK_AUTH_PAIR_MS (config/sc_config.h): a command waits this long for its MAC */
 

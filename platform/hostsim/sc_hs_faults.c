@@ -193,7 +193,8 @@ static sc_fault fault_of(sc_hs_episode_kind k)
 
 /* foreign ids next to the protocol's (0x085..0x087 and 0x08D..0x08F are CmdVessels,
  * CmdDoppler, CmdAssessment and their MACs; 0x095..0x097 and 0x09D..0x09F differ from them in
- * one bit) */
+ * one bit and are unused ids of the second command block, whose CmdMaterial 0x090 and its MAC
+ * 0x098 the engine's filter passes exactly) */
 static const uint16_t k_flood_ids[] = {0x095, 0x096, 0x097, 0x09D, 0x09E, 0x09F,
                                        0x103, 0x104, 0x111, 0x555, 0x7FF};
 

@@ -16,6 +16,10 @@
 //             with colour off; the spectrum scrolls; after a depth change the overlay's depth
 //             readout and scale match the engine's imaging depth; a curvilinear probe is drawn
 //             as a fan from its probe-face radius
+//   material  the Tissue panel: fat made softer with its slider (applied on release) and the
+//             damping changed; the engine rebuilds the case and its MATERIAL record shows the new
+//             values on the page; a command during the rebuild refused by the engine (counted), a
+//             value outside the protocol refused by the gateway; "case materials" restores them
 // Exit 0 pass, 1 fail, 77 skipped (chromium genuinely unavailable).
 import { spawn, spawnSync } from 'node:child_process';
 import { existsSync, mkdirSync, readFileSync, writeFileSync } from 'node:fs';
@@ -306,6 +310,59 @@ if (scenario === 'sessions') {
   await page.locator('#geometry').selectOption('linear');
   emu.kill('SIGTERM');
   await stopped(emu);
+} else if (scenario === 'material') {
+  await waitFor(page, () => window.sc.material && window.sc.material.labels.fat, null, 'the Tissue panel shows the engine\'s materials');
+  const m0 = await page.evaluate(() => window.sc.material);
+  if (Math.abs(m0.labels.fat.eKpa - 3.5) > 0.01 || m0.mask !== 0) await fail(`the case's fat is not shown: ${JSON.stringify(m0.labels.fat)}, mask ${m0.mask}`);
+  ok(`engine's fat E ${m0.labels.fat.eKpa} kPa, nu ${m0.labels.fat.nu.toFixed(3)}, damping ${m0.dampingS.toFixed(3)} s, ${m0.cgIterations} CG iterations`);
+  // the fat slider to 0.7 kPa (log10 -0.15, on the slider's 0.01 grid), released: CmdMaterial,
+  // the rebuild, the record
+  const applied0 = await page.evaluate(() => window.sc.frame.commandsApplied);
+  await page.locator('[data-testid=mat-e-fat]').fill('-0.15');
+  await waitFor(page, (r0) => window.sc.material.rebuilds > r0 && Math.abs(window.sc.material.labels.fat.eKpa - 0.7) < 0.01 &&
+    window.sc.material.labels.fat.overridden === 1, m0.rebuilds, 'the engine rebuilt the case with fat at 0.7 kPa', 30000);
+  const shown = await page.locator('[data-testid=mat-e-fat-v]').innerText();
+  const status = await page.locator('[data-testid=tissue-status]').innerText();
+  if (!/^0\.70*$/.test(shown) || !/fat/.test(status)) await fail(`the panel shows "${shown}" kPa, "${status}"`);
+  if (!(await page.evaluate(() => window.sc.frame.commandsApplied) > applied0)) await fail('the engine did not count the command applied');
+  ok(`fat slider released at 0.7 kPa: engine rebuilt (${await page.evaluate(() => window.sc.material.rebuilds)} rebuilds); panel "${shown} kPa", "${status}"`);
+  // damping 0.2 s from its slider (sent with the last label moved, fat, as shown)
+  await page.locator('[data-testid=mat-damping]').fill('0.2');
+  await waitFor(page, () => Math.abs(window.sc.material.dampingS - 0.2) < 0.002 && window.sc.material.simOverride &&
+    Math.abs(window.sc.material.labels.fat.eKpa - 0.7) < 0.01, null, 'the engine runs with damping 0.2 s', 30000);
+  await page.locator('#tissue-panel').screenshot({ path: path.join(outDir, 'tissue-panel.png') });
+  ok(`damping slider: engine's damping ${await page.evaluate(() => window.sc.material.dampingS.toFixed(3))} s, fat still 0.7 kPa`);
+  // two commands back to back: the second arrives while the first one's rebuild runs (refused
+  // by the engine, counted); a Poisson ratio outside the protocol is refused by the gateway
+  const ref0 = await page.evaluate(() => window.sc.material.refused);
+  const e0 = await page.evaluate(() => window.sc.errors.length);
+  await page.evaluate(() => {
+    const m = { op: 'material', label: 'muscle', e_kpa: 30, nu: 0.45, damping_s: 0.2, cg_iterations: 10, corotated: 0 };
+    window.scSend(m); window.scSend({ ...m, label: 'nerve', e_kpa: 80 });
+    window.scSend({ ...m, nu: 0.6 });
+  });
+  await waitFor(page, (e0) => window.sc.errors.length > e0, e0, 'nu 0.6 refused by the gateway');
+  await waitFor(page, (ref0) => window.sc.material.refused > ref0 && Math.abs(window.sc.material.labels.muscle.eKpa - 30) < 0.05,
+    ref0, 'muscle applied, the command during its rebuild refused and counted', 30000);
+  const mm = await page.evaluate(() => window.sc.material);
+  if (mm.labels.nerve.overridden) await fail('the command sent during the rebuild was applied');
+  ok(`busy: muscle 30 kPa applied, the nerve command during its rebuild refused (${mm.refused} refused); gateway: ${await page.evaluate((e0) => window.sc.errors[e0].reason.slice(0, 60), e0)}`);
+  // a client without the pass phrase sees the materials but cannot change them
+  const viewer = await browser.newPage({ viewport: { width: 900, height: 600 } });
+  await viewer.goto(url);
+  await waitFor(viewer, () => window.sc?.material?.labels?.muscle && Math.abs(window.sc.material.labels.muscle.eKpa - 30) < 0.05,
+    null, 'a second client sees the engine\'s materials');
+  await viewer.locator('[data-testid=mat-e-skin]').fill('1');
+  await waitFor(viewer, () => window.sc.errors.some((e) => e.op === 'material' && /locked/.test(e.reason)), null,
+    'the locked client\'s material command refused');
+  await viewer.close();
+  ok('a client without the pass phrase: materials shown, its material command refused (controls locked)');
+  // "case materials": CmdReset tissue restores the case's own
+  await page.click('[data-testid=mat-restore]');
+  await waitFor(page, () => window.sc.material.mask === 0 && !window.sc.material.simOverride &&
+    Math.abs(window.sc.material.labels.fat.eKpa - 3.5) < 0.01 && Math.abs(window.sc.material.dampingS - 0.1) < 1e-4,
+  null, 'the case\'s own materials restored', 30000);
+  ok(`restored: fat ${await page.evaluate(() => window.sc.material.labels.fat.eKpa)} kPa, "${await page.locator('[data-testid=tissue-status]').innerText()}"`);
 } else if (scenario === 'press') {
   await waitFor(page, () => window.sc.surf && window.sc.surf.count >= 2, null, 'surfaces of the case');
   await sleep(2500); // every triangle and vertex round has arrived

@@ -27,6 +27,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         for (size_t f = 0; f < a.def.n_faults; f++) {
             SC_FUZZ_CHECK(a.def.faults[f].period >= 1u && isfinite(a.def.faults[f].start_s));
         }
+        /* every command it took is one the protocol's encoder sends (CmdMaterial included) */
+        SC_FUZZ_CHECK(a.n_cmds <= MAX_CMDS);
+        for (uint32_t k = 0; k < a.n_cmds; k++) {
+            sc_can_frame cf;
+            SC_FUZZ_CHECK(sc_canproto_encode_cmd(&a.cmds[k].cmd, 0, &cf) == 0);
+        }
         SC_FUZZ_CHECK(isfinite(a.def.rate_hz) && isfinite(a.def.duration_s) &&
                       isfinite(a.def.period_s) && isfinite(a.def.silence_ms));
         static sc_emu emu;
@@ -55,6 +61,8 @@ size_t sc_fuzz_seed(uint32_t i, uint8_t *buf, size_t cap)
         "--script|rock|--log|x.log|--log-iface|can1|--t0|1700000000|--angle-deg|15|--no-force",
         "--script|lift|--log|-|--fault|bad-crc:10:0.5|--fault|repeat|--fault|silence:50",
         "--csv|p.csv|--log|-|--silence-ms|300|--fault|counter-jump:7|--fault|implausible:3:1",
+        "--script|press|--log|-|--command|material=fat:0.7:0.45@1|--command|reset=tissue@3",
+        "--script|press|--log|-|--command|material=thrombus:40:0.45:0.2:20:1@2",
         "--help",
     };
     return sc_fuzz_argv_seed(lines, sizeof lines / sizeof lines[0], i, buf, cap);

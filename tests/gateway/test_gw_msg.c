@@ -58,6 +58,22 @@ static void each_protocol_command_parses(void **state)
     assert_float_equal(m.cmd.doppler.prf_hz, 2500.0f, 0.0f);
     assert_float_equal(m.cmd.doppler.steer_deg, -20.0f, 0.0f);
     assert_float_equal(m.cmd.doppler.gain_db, 4.5f, 0.0f);
+    assert_int_equal(parse("{\"op\":\"material\",\"label\":\"thrombus\",\"e_kpa\":12.5,"
+                           "\"nu\":0.4,\"damping_s\":0.2,\"cg_iterations\":20,\"corotated\":1}",
+                           &m, &why), 0);
+    assert_int_equal(m.op, GW_OP_COMMAND);
+    assert_int_equal(m.cmd.kind, SC_CMD_MATERIAL);
+    assert_int_equal(m.cmd.material.label, 7);
+    assert_float_equal(m.cmd.material.e_kpa, 12.5f, 0.0f);
+    assert_float_equal(m.cmd.material.poisson, 0.4f, 1e-6f);
+    assert_float_equal(m.cmd.material.damping_s, 0.2f, 1e-6f);
+    assert_int_equal(m.cmd.material.cg_iterations, 20);
+    assert_int_equal(m.cmd.material.corotated, 1);
+    assert_string_equal(m.name, "material");
+    assert_int_equal(parse("{\"op\":\"material\",\"label\":\"skin\",\"e_kpa\":100,"
+                           "\"nu\":0.45,\"damping_s\":0.1,\"cg_iterations\":10,\"corotated\":0}",
+                           &m, &why), 0);
+    assert_int_equal(m.cmd.material.label, 1);
 }
 
 static void bad_messages_are_refused_with_a_reason(void **state)
@@ -95,6 +111,19 @@ static void bad_messages_are_refused_with_a_reason(void **state)
         "{\"op\":\"doppler\",\"colour\":\"on\",\"prf_hz\":4000,\"steer_deg\":0,\"gain_db\":31}",
         "{\"op\":\"doppler\",\"colour\":\"yes\",\"prf_hz\":4000,\"steer_deg\":0,\"gain_db\":0}",
         "{\"op\":\"doppler\",\"colour\":\"on\",\"prf_hz\":4000,\"steer_deg\":0,\"gain_db\":0,\"x\":1}",
+        /* material: E, nu, damping, iterations outside the DBC; bone, unknown label, a number
+         * for the label, corotated 2, fractional iterations, a field missing */
+        "{\"op\":\"material\",\"label\":\"fat\",\"e_kpa\":0,\"nu\":0.45,\"damping_s\":0.1,\"cg_iterations\":10,\"corotated\":0}",
+        "{\"op\":\"material\",\"label\":\"fat\",\"e_kpa\":7000,\"nu\":0.45,\"damping_s\":0.1,\"cg_iterations\":10,\"corotated\":0}",
+        "{\"op\":\"material\",\"label\":\"fat\",\"e_kpa\":3.5,\"nu\":0.5,\"damping_s\":0.1,\"cg_iterations\":10,\"corotated\":0}",
+        "{\"op\":\"material\",\"label\":\"fat\",\"e_kpa\":3.5,\"nu\":0.45,\"damping_s\":0.9,\"cg_iterations\":10,\"corotated\":0}",
+        "{\"op\":\"material\",\"label\":\"fat\",\"e_kpa\":3.5,\"nu\":0.45,\"damping_s\":0.1,\"cg_iterations\":64,\"corotated\":0}",
+        "{\"op\":\"material\",\"label\":\"fat\",\"e_kpa\":3.5,\"nu\":0.45,\"damping_s\":0.1,\"cg_iterations\":2.5,\"corotated\":0}",
+        "{\"op\":\"material\",\"label\":\"bone\",\"e_kpa\":3.5,\"nu\":0.45,\"damping_s\":0.1,\"cg_iterations\":10,\"corotated\":0}",
+        "{\"op\":\"material\",\"label\":\"liver\",\"e_kpa\":3.5,\"nu\":0.45,\"damping_s\":0.1,\"cg_iterations\":10,\"corotated\":0}",
+        "{\"op\":\"material\",\"label\":2,\"e_kpa\":3.5,\"nu\":0.45,\"damping_s\":0.1,\"cg_iterations\":10,\"corotated\":0}",
+        "{\"op\":\"material\",\"label\":\"fat\",\"e_kpa\":3.5,\"nu\":0.45,\"damping_s\":0.1,\"cg_iterations\":10,\"corotated\":2}",
+        "{\"op\":\"material\",\"label\":\"fat\",\"e_kpa\":3.5,\"nu\":0.45,\"damping_s\":0.1,\"cg_iterations\":10}",
         "{\"op\":\"auth\",\"pass\":\"\\u0041\"}",          /* unsupported escape */
         "{\"op\":{\"nested\":1}}",
     };

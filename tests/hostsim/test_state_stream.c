@@ -23,7 +23,8 @@ static size_t g_size;
 
 /* ---- what the stream delivered ----------------------------------------------------------- */
 static struct {
-    uint32_t frames, surf_infos, verts, tris, catalogue, assessments, other;
+    uint32_t frames, surf_infos, verts, tris, catalogue, assessments, materials, other;
+    uint32_t mat_rows; /* of the last MATERIAL record */
     uint32_t assess_frames, assess_score_max; /* of the last ASSESSMENT record */
     uint32_t last_seq;
     int have_seq;
@@ -74,6 +75,10 @@ static int sink(void *ctx, const uint8_t *rec, uint16_t len)
         got.assessments++;
         got.assess_frames = rd32(p + 4);
         got.assess_score_max = p[98];
+        break;
+    case SC_STATE_MATERIAL: /* docs/state-stream.md: row count at 0 */
+        got.materials++;
+        got.mat_rows = p[0];
         break;
     default: got.other++; break;
     }
@@ -202,6 +207,8 @@ static void stream_carries_the_engine_and_the_skin_sinks_under_the_press(void **
     assert_int_equal(got.assessments, got.frames); /* the exam's record every period */
     assert_true(got.assess_frames >= 55u && got.assess_frames <= 60u);
     assert_int_equal(got.assess_score_max, sc_engine_assessment(&rig.engine)->score_max);
+    assert_int_equal(got.materials, got.frames); /* the running materials every period */
+    assert_int_equal(got.mat_rows, rig.engine.slot.c.material_count);
     assert_int_equal(got.other, 0u);
     assert_string_equal(got.name, "block");
     float rest_max = -1e9f;

@@ -196,7 +196,7 @@ static void commands_outside_their_ranges_are_refused_both_ways(void **state)
     c.imaging.depth_mm = 50.0f;
     c.imaging.gain_db = NAN;
     assert_int_equal(sc_canproto_encode_cmd(&c, 0, &f), SC_ERR_NOT_FINITE);
-    c = (sc_cmd){.kind = (sc_cmd_kind)9};
+    c = (sc_cmd){.kind = (sc_cmd_kind)10}; /* 9 is CmdMaterial */
     assert_int_equal(sc_canproto_encode_cmd(&c, 0, &f), SC_ERR_INVALID_ARG);
 
     /* raw frames from a foreign sender with out-of-range signals */
@@ -632,6 +632,122 @@ static void doppler_command_round_trips_and_out_of_range_is_refused(void **state
     assert_int_equal(sc_canproto_cmd_msg(SC_CMD_DOPPLER), SC_MSG_CMD_DOPPLER);
 }
 
+/* ---- CmdMaterial (0x090, MAC 0x098) ------------------------------------------------------ */
+
+static sc_material_cmd material_ok(void)
+{
+    return (sc_material_cmd){.label = 2u, .cg_iterations = 10u, .corotated = 0u,
+                             .e_kpa = 3.5f, .poisson = 0.45f, .damping_s = 0.1f};
+}
+
+static void material_command_round_trips_within_half_a_step(void **state)
+{
+    (void)state;
+    const sc_material_cmd ok[] = {
+        {1u, 1u, 0u, 0.1f, 0.0f, 0.01f},      /* every lower bound */
+        {7u, 63u, 1u, 6553.4f, 0.49f, 0.5f},  /* every upper bound */
+        {2u, 10u, 0u, 3.5f, 0.45f, 0.1f},     /* the default fat and Algorithm 1's damping */
+        {4u, 20u, 1u, 0.15f, 0.3f, 0.25f},    /* vein filler */
+        {3u, 33u, 0u, 1234.5f, 0.333f, 0.037f},
+    };
+    for (size_t i = 0; i < sizeof ok / sizeof ok[0]; i++) {
+        sc_cmd c = {.kind = SC_CMD_MATERIAL};
+        c.material = ok[i];
+        sc_can_frame f;
+        assert_int_equal(sc_canproto_encode_cmd(&c, (uint8_t)i, &f), 0);
+        assert_int_equal(f.id, 0x090);
+        assert_int_equal(f.len, 8);
+        assert_true(e2e_ok(&f));
+        sc_cmd d;
+        assert_int_equal(sc_canproto_decode_cmd(&f, &d), 0);
+        assert_int_equal(d.kind, SC_CMD_MATERIAL);
+        assert_int_equal(d.material.label, ok[i].label);
+        assert_int_equal(d.material.cg_iterations, ok[i].cg_iterations);
+        assert_int_equal(d.material.corotated, ok[i].corotated);
+        /* half a step: 0.05 kPa, 0.001, 0.001 s */
+        assert_true(fabsf(d.material.e_kpa - ok[i].e_kpa) <= 0.05f + 1e-3f);
+        assert_true(fabsf(d.material.poisson - ok[i].poisson) <= 0.001f + 1e-6f);
+        assert_true(fabsf(d.material.damping_s - ok[i].damping_s) <= 0.001f + 1e-6f);
+        sc_can_frame g;
+        assert_int_equal(sc_canproto_encode_cmd(&d, (uint8_t)i, &g), 0);
+        assert_memory_equal(f.data, g.data, 8);
+    }
+    sc_can_frame pdu = {.id = 0x098, .len = 8};
+    sc_msg m;
+    assert_int_equal(sc_canproto_classify(&pdu, &m), 0);
+    assert_int_equal(m, SC_MSG_AUTH_MATERIAL);
+    assert_true(SC_MSG_IS_AUTH(m));
+    assert_true(SC_MSG_IS_CMD(SC_MSG_CMD_MATERIAL));
+    assert_int_equal(sc_canproto_cmd_msg(SC_CMD_MATERIAL), SC_MSG_CMD_MATERIAL);
+    assert_int_equal(sc_canproto_info(SC_MSG_AUTH_MATERIAL)->can_id,
+                     sc_canproto_info(SC_MSG_CMD_MATERIAL)->can_id + SC_CANID_AUTH_OFFSET);
+    /* the rest of the second block is not the protocol's (the flood test's ids among them) */
+    for (uint32_t id = 0x091; id <= 0x09F; id++) {
+        if (id == 0x098) {
+            continue;
+        }
+        sc_can_frame x = {.id = id, .len = 8};
+        assert_int_equal(sc_canproto_classify(&x, &m), SC_ERR_CAN_ID);
+    }
+}
+
+static void material_command_out_of_range_is_refused_both_ways(void **state)
+{
+    (void)state;
+    /* encoder: each field out of range alone */
+    sc_material_cmd bad[12];
+    for (size_t i = 0; i < 12u; i++) {
+        bad[i] = material_ok();
+    }
+    bad[0].label = 0u;       /* outside */
+    bad[1].label = 8u;       /* bone */
+    bad[2].cg_iterations = 0u;
+    bad[3].cg_iterations = 64u;
+    bad[4].corotated = 2u;
+    bad[5].e_kpa = 0.04f;    /* rounds to raw 0 */
+    bad[6].e_kpa = 6553.6f;  /* above the range */
+    bad[7].e_kpa = -1.0f;
+    bad[8].poisson = 0.5f;
+    bad[9].damping_s = 0.0f;
+    bad[10].damping_s = 0.52f;
+    bad[11].e_kpa = NAN;
+    for (size_t i = 0; i < 12u; i++) {
+        sc_cmd c = {.kind = SC_CMD_MATERIAL};
+        c.material = bad[i];
+        sc_can_frame f;
+        const int rc = sc_canproto_encode_cmd(&c, 0, &f);
+        assert_int_equal(rc, i == 11u ? SC_ERR_NOT_FINITE : SC_ERR_CAN_SIGNAL);
+    }
+    /* decoder: a valid frame with one raw field out of range, from a foreign sender */
+    const sc_can_msg_info *mi = sc_canproto_info(SC_MSG_CMD_MATERIAL);
+    struct {
+        unsigned sig;
+        int64_t raw;
+    } raw_bad[] = {{2, 0},   {2, 8},   {2, 15},  {3, 0},   {5, 0},
+                   {6, 246}, {6, 255}, {7, 0},   {7, 4},   {7, 251}};
+    for (size_t i = 0; i < sizeof raw_bad / sizeof raw_bad[0]; i++) {
+        sc_cmd c = {.kind = SC_CMD_MATERIAL};
+        c.material = material_ok();
+        sc_can_frame f;
+        assert_int_equal(sc_canproto_encode_cmd(&c, 0, &f), 0);
+        sc_canproto_put_raw(f.data, &mi->sigs[raw_bad[i].sig], raw_bad[i].raw);
+        assert_int_equal(sc_e2e_protect_with(0x090, 0, f.data, f.len), 0);
+        sc_cmd d;
+        assert_int_equal(sc_canproto_decode_cmd(&f, &d), SC_ERR_CAN_SIGNAL);
+    }
+    /* wrong length, FD flag */
+    sc_cmd c = {.kind = SC_CMD_MATERIAL};
+    c.material = material_ok();
+    sc_can_frame f;
+    assert_int_equal(sc_canproto_encode_cmd(&c, 0, &f), 0);
+    f.len = 7;
+    sc_cmd d;
+    assert_int_equal(sc_canproto_decode_cmd(&f, &d), SC_ERR_CAN_DLC);
+    f.len = 8;
+    f.flags = SC_CAN_FLAG_FD;
+    assert_int_equal(sc_canproto_decode_cmd(&f, &d), SC_ERR_CAN_DLC);
+}
+
 static void assessment_frames_decode_as_the_dbc_says(void **state)
 {
     (void)state;
@@ -743,6 +859,8 @@ int main(void)
         cmocka_unit_test(dbc_file_defines_exactly_the_codec_tables),
         cmocka_unit_test(vessels_command_round_trips_and_out_of_range_is_refused),
         cmocka_unit_test(doppler_command_round_trips_and_out_of_range_is_refused),
+        cmocka_unit_test(material_command_round_trips_within_half_a_step),
+        cmocka_unit_test(material_command_out_of_range_is_refused_both_ways),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

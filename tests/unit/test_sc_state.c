@@ -138,6 +138,51 @@ static void assessment_record_has_the_documented_layout(void **state)
     assert_int_equal(p[98], 8u);
 }
 
+/* The MATERIAL record: the running tissue's rows, the solver parameters, the counters. */
+static void material_record_has_the_documented_layout(void **state)
+{
+    (void)state;
+    memset(&g_sink, 0, sizeof g_sink);
+    sc_state_tx_init(&g_tx, 33u, 4u);
+    const sc_state_dev dev = {&k_ops, &g_sink};
+    sc_material_table mt;
+    sc_material_table_default(&mt);
+    mt.row[2].e_pa = 700.0f;
+    mt.row[2].poisson = 0.4f;
+    sc_state_in in = base_in(1000000000u);
+    in.mat = &mt;
+    in.mat_override_mask = 1u << 2;
+    in.mat_sim_override = 1u;
+    in.cg_iterations = 20u;
+    in.corotated = 1u;
+    in.damping_s = 0.2f;
+    in.material_rebuilds = 3u;
+    in.material_refused = 5u;
+    assert_int_equal(sc_state_emit(&g_tx, &dev, &in), 2u); /* FRAME, MATERIAL */
+    const uint8_t *rec = g_sink.rec[1];
+    assert_int_equal(g_sink.len[1], SC_STATE_HEADER_SIZE + SC_STATE_MATERIAL_SIZE);
+    assert_int_equal(SC_STATE_MATERIAL_SIZE, 160u);
+    assert_int_equal(sc_state_check(rec, g_sink.len[1], NULL, NULL), SC_STATE_MATERIAL);
+    const uint8_t *p = rec + SC_STATE_HEADER_SIZE;
+    assert_int_equal(p[0], mt.count);
+    assert_int_equal(p[1], 1u);
+    assert_int_equal(p[2], 20u);
+    assert_int_equal(p[3], 1u);
+    assert_true(rdf(p + 4) > 0.1999f && rdf(p + 4) < 0.2001f);
+    assert_int_equal(rd32(p + 8), 4u);
+    assert_int_equal(rd32(p + 16), 3u);
+    assert_int_equal(rd32(p + 24), 5u);
+    assert_float_equal(rdf(p + 32 + 8 * 2), 700.0f, 0.0f);
+    assert_float_equal(rdf(p + 32 + 8 * 2 + 4), 0.4f, 0.0f);
+    assert_float_equal(rdf(p + 32 + 8 * 3), 15.0e3f, 0.0f); /* muscle: the table's */
+    assert_float_equal(rdf(p + 32 + 8 * mt.count), 0.0f, 0.0f); /* rows past the count: 0 */
+    /* without a case (no table) there is no MATERIAL record */
+    memset(&g_sink, 0, sizeof g_sink);
+    sc_state_tx_init(&g_tx, 33u, 4u);
+    in.mat = NULL;
+    assert_int_equal(sc_state_emit(&g_tx, &dev, &in), 1u);
+}
+
 static void period_limits_the_rate_and_sequence_counts_up(void **state)
 {
     (void)state;
@@ -278,6 +323,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(frame_record_has_header_size_and_fields),
         cmocka_unit_test(assessment_record_has_the_documented_layout),
+        cmocka_unit_test(material_record_has_the_documented_layout),
         cmocka_unit_test(period_limits_the_rate_and_sequence_counts_up),
         cmocka_unit_test(refused_records_are_counted_and_leave_a_sequence_gap),
         cmocka_unit_test(period_zero_or_no_device_sends_nothing),

@@ -209,6 +209,42 @@ int gw_msg_bundle_name_ok(const char *name)
     return 1;
 }
 
+/* CmdMaterial: a label by name (config/sc_labels.h, skin..thrombus), its E and nu, and the
+ * solver's damping, CG iterations and corotation; the ranges are the encoder's. */
+static int parse_material(const member *m, int n, gw_msg *r)
+{
+    static const char *const k[] = {"op",        "label",         "e_kpa",     "nu",
+                                    "damping_s", "cg_iterations", "corotated", NULL};
+    static const char *const labels[] = {"skin", "fat", "muscle", "vein", "artery", "nerve",
+                                         "thrombus"};
+    const member *l = find(m, n, "label", 1), *e = find(m, n, "e_kpa", 0),
+                 *nu = find(m, n, "nu", 0), *d = find(m, n, "damping_s", 0),
+                 *it = find(m, n, "cg_iterations", 0), *co = find(m, n, "corotated", 0);
+    if (!only(m, n, k) || !l || !e || !nu || !d || !it || !co || !is_bit(co->num) ||
+        floor(it->num) < it->num || !(it->num >= 1.0 && it->num <= 63.0)) {
+        return -1;
+    }
+    uint8_t label = 0;
+    for (unsigned i = 0; i < sizeof labels / sizeof labels[0]; i++) {
+        if (strcmp(l->str, labels[i]) == 0) {
+            label = (uint8_t)(SC_MATERIAL_LABEL_MIN + i);
+        }
+    }
+    if (label == 0u) {
+        return -1;
+    }
+    r->op = GW_OP_COMMAND;
+    r->name = "material";
+    r->cmd.kind = SC_CMD_MATERIAL;
+    r->cmd.material.label = label;
+    r->cmd.material.e_kpa = (float)e->num;
+    r->cmd.material.poisson = (float)nu->num;
+    r->cmd.material.damping_s = (float)d->num;
+    r->cmd.material.cg_iterations = (uint8_t)it->num;
+    r->cmd.material.corotated = co->num > 0.5 ? 1u : 0u;
+    return 0;
+}
+
 int gw_msg_parse(const char *text, size_t len, gw_msg *out, const char **why)
 {
     static const char *dummy;
@@ -384,9 +420,16 @@ int gw_msg_parse(const char *text, size_t len, gw_msg *out, const char **why)
         r.cmd.doppler.prf_hz = (float)prf->num;
         r.cmd.doppler.steer_deg = (float)st->num;
         r.cmd.doppler.gain_db = (float)g->num;
+    } else if (strcmp(op->str, "material") == 0) {
+        if (parse_material(m, n, &r) != 0) {
+            return fail(why, "material wants label (\"skin\"|\"fat\"|\"muscle\"|\"vein\"|"
+                             "\"artery\"|\"nerve\"|\"thrombus\"), e_kpa (0.1..6553.4), nu "
+                             "(0..0.49), damping_s (0.01..0.5), cg_iterations (1..63), corotated "
+                             "(0|1)");
+        }
     } else {
         return fail(why, "unknown op (auth, ping, case, method, imaging, reset, assess, sessions, "
-                         "replay, vessels, doppler)");
+                         "replay, vessels, doppler, material)");
     }
     if (r.op == GW_OP_COMMAND) {
         sc_can_frame f;

@@ -11,6 +11,9 @@
  *   {"op":"imaging","depth_mm":D,"gain_db":G,"dyn_range_db":R,"tgc_db_per_cm":T,
  *    "geometry":"linear"|"curvilinear"}                CmdSetImaging (every field required)
  *   {"op":"reset","target":"tissue"|"faults"|"all"}    CmdReset
+ *   {"op":"material","label":"fat","e_kpa":E,"nu":NU,"damping_s":D,"cg_iterations":N,
+ *    "corotated":0|1}                                  CmdMaterial (every field required; label
+ *                                                      skin|fat|muscle|vein|artery|nerve|thrombus)
  *   {"op":"sessions"}                                  list the recorded sessions (--sessions DIR)
  *   {"op":"replay","name":"FILE.scb"}                  replay one of them into the console
  *

@@ -20,6 +20,8 @@
  *   case=N  method=msds|fem  reset=tissue|faults|all
  *   imaging=DEPTH_MM:GAIN_DB:DYN_RANGE_DB:TGC_DB_PER_CM:linear|curvilinear
  *   vessels=HR_BPM:RR_PER_MIN:VALSALVA(0|1):PULSE(0|1)   doppler=on|off:PRF_HZ:STEER_DEG:GAIN_DB
+ *   material=LABEL:E_KPA:NU[:DAMPING_S:CG_ITERATIONS:COROTATED(0|1)]  (CmdMaterial; LABEL skin,
+ *     fat, muscle, vein, artery, nerve, thrombus; without the last three: 0.1 s, 10, 0)
  * Summary (samples, frames, injected faults) on stderr; exit 0, 2 on a usage error, 1 on an
  * I/O error. */
 #include <errno.h>
@@ -66,7 +68,11 @@ static void usage(void)
             "          vessels=HR_BPM:RR_PER_MIN:VALSALVA(0|1):PULSE(0|1) (heart rate 30..200,\n"
             "            respiration 0 or 4..40, Valsalva held, arterial pulse on)\n"
             "          doppler=on|off:PRF_HZ:STEER_DEG:GAIN_DB (colour Doppler, scale 100..20000,\n"
-            "            steering -30..30, gain -30..30)\n");
+            "            steering -30..30, gain -30..30)\n"
+            "          material=LABEL:E_KPA:NU[:DAMPING_S:CG_ITERATIONS:COROTATED] (a tissue's\n"
+            "            material, LABEL skin|fat|muscle|vein|artery|nerve|thrombus, E 0.1..6553.4\n"
+            "            kPa, nu 0..0.49; damping 0.01..0.5 s (0.1), CG iterations 1..63 (10),\n"
+            "            corotated 0|1 (0); the engine rebuilds the running case with it)\n");
 }
 
 /* A whole, finite number (NaN and infinities compare false with every range below). */
@@ -115,6 +121,36 @@ static int parse_fault(char *arg, sc_emu_fault *f)
     if (start && parse_double(start, &f->start_s) != 0) {
         return -1;
     }
+    return 0;
+}
+
+/* material=LABEL:E_KPA:NU[:DAMPING_S:CG_ITERATIONS:COROTATED] into c; -1 when malformed (the
+ * ranges are the encoder's). */
+static int parse_material(const char *val, sc_cmd *c)
+{
+    static const char *const labels[] = {"skin", "fat", "muscle", "vein", "artery", "nerve",
+                                         "thrombus"};
+    char name[16];
+    char tail;
+    unsigned it = 10u, co = 0u;
+    sc_material_cmd m = {.damping_s = 0.1f};
+    const int n = sscanf(val, "%15[a-z]:%f:%f:%f:%u:%u%c", name, &m.e_kpa, &m.poisson,
+                         &m.damping_s, &it, &co, &tail);
+    if ((n != 3 && n != 6) || it > 63u || co > 1u) {
+        return -1;
+    }
+    for (unsigned i = 0; i < sizeof labels / sizeof labels[0]; i++) {
+        if (strcmp(name, labels[i]) == 0) {
+            m.label = (uint8_t)(SC_MATERIAL_LABEL_MIN + i);
+        }
+    }
+    if (m.label == 0u) {
+        return -1;
+    }
+    m.cg_iterations = (uint8_t)it;
+    m.corotated = (uint8_t)co;
+    c->kind = SC_CMD_MATERIAL;
+    c->material = m;
     return 0;
 }
 
@@ -204,6 +240,10 @@ static int parse_command(const char *arg, timed_cmd *out)
         if (strcmp(onoff, "on") == 0) {
             c.doppler.on = 1u;
         } else if (strcmp(onoff, "off") != 0) {
+            return -1;
+        }
+    } else if (strcmp(buf, "material") == 0) {
+        if (parse_material(val, &c) != 0) {
             return -1;
         }
     } else if (strcmp(buf, "imaging") == 0) {

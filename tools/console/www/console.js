@@ -13,7 +13,7 @@ const $ = (id) => document.getElementById(id);
 // ---- state shared with the tests (window.sc) ------------------------------------------------
 const sc = {
   frame: null, surf: null, catalogue: [], replies: [], errors: [], bscanFrames: 0, sessions: [], replay: null, replays: [],
-  records: 0, gaps: 0, lastSeq: -1, frozen: false, assessment: null,
+  records: 0, gaps: 0, lastSeq: -1, frozen: false, assessment: null, material: null,
 };
 window.sc = sc;
 
@@ -372,6 +372,7 @@ function onRecord(buf) {
   else if (type === 3) onVerts(dv, p);
   else if (type === 4) onTris(dv, p);
   else if (type === 6) onAssessment(dv, p);
+  else if (type === 7) onMaterial(dv, p);
   // CATALOGUE records reach the page as the gateway's JSON catalogue (with the case texts)
 }
 
@@ -516,12 +517,94 @@ for (const b of document.querySelectorAll('[data-call]')) b.onclick = () => send
 $('assess-reset').onclick = () => send({ op: 'assess', action: 'reset' });
 $('unlock').onclick = () => send({ op: 'auth', pass: $('pass').value });
 
-// material sliders: shown, disabled (no material command in the CAN protocol)
-for (const [name, e] of [['fat', 5], ['muscle', 12], ['vein wall', 8], ['artery wall', 60], ['thrombus', 30]]) {
-  const l = document.createElement('label');
-  l.textContent = `${name} E (kPa) `;
-  const i = document.createElement('input');
-  Object.assign(i, { type: 'range', min: 1, max: 200, value: e, disabled: true, title: 'no material command in config/sonocomp.dbc' });
-  l.append(i);
-  $('materials').append(l);
+// ---- Tissue panel: materials per label and the solver's parameters (CmdMaterial) --------------
+// The MATERIAL record (type 7, docs/state-stream.md) carries what the running tissue was built
+// with; the sliders show it unless the user is holding one, and a release sends the label's E and
+// nu with the simulation parameters (the command carries both).
+const MAT_LABELS = ['skin', 'fat', 'muscle', 'vein', 'artery', 'nerve', 'thrombus']; // labels 1..7
+const matRows = {};
+let matHeld = null, matPendingUntil = 0;
+const ekpa = (slider) => Math.round(10 ** +slider.value * 10) / 10; // log10 kPa slider
+for (const [i, name] of MAT_LABELS.entries()) {
+  const row = document.createElement('div');
+  row.className = 'matrow';
+  const le = document.createElement('label'), ln = document.createElement('label');
+  const ov = document.createElement('output'), nv = document.createElement('output');
+  const e = document.createElement('input'), nu = document.createElement('input');
+  Object.assign(e, { type: 'range', min: -1, max: 3.8, step: 0.01, value: 1 });
+  Object.assign(nu, { type: 'range', min: 0, max: 0.49, step: 0.002, value: 0.45 });
+  e.dataset.testid = `mat-e-${name}`; nu.dataset.testid = `mat-nu-${name}`;
+  ov.dataset.testid = `mat-e-${name}-v`; nv.dataset.testid = `mat-nu-${name}-v`;
+  le.append(`${name} E `, ov, ' kPa', e);
+  ln.append('ν ', nv, nu);
+  row.append(le, ln);
+  $('materials').append(row);
+  matRows[name] = { label: i + 1, e, nu, ov, nv };
+  for (const inp of [e, nu]) {
+    inp.addEventListener('pointerdown', () => { matHeld = name; });
+    inp.addEventListener('input', () => { matHeld = name; ov.textContent = ekpa(e); nv.textContent = (+nu.value).toFixed(3); });
+    inp.addEventListener('change', () => sendMaterial(name)); // on release
+  }
+}
+function simParams() {
+  return { damping_s: +(+$('mat-damping').value).toFixed(3), cg_iterations: +$('mat-cg').value,
+           corotated: $('mat-corotated').checked ? 1 : 0 };
+}
+function sendMaterial(name) {
+  const r = matRows[name];
+  matHeld = null;
+  matPendingUntil = performance.now() + 3000; // until the rebuilt tissue's record shows it
+  send({ op: 'material', label: name, e_kpa: ekpa(r.e), nu: +(+r.nu.value).toFixed(3), ...simParams() });
+}
+// the simulation parameters travel with a label: the last one moved, else fat (its values as shown)
+let matLast = 'fat';
+for (const id of ['mat-damping', 'mat-cg', 'mat-corotated']) {
+  const el = $(id);
+  el.addEventListener('pointerdown', () => { matHeld = id; });
+  el.addEventListener('input', () => {
+    matHeld = id;
+    $('mat-damping-v').textContent = (+$('mat-damping').value).toFixed(3);
+    $('mat-cg-v').textContent = $('mat-cg').value;
+  });
+  el.addEventListener('change', () => sendMaterial(matLast));
+}
+for (const name of MAT_LABELS) matRows[name].e.addEventListener('change', () => { matLast = name; });
+
+function onMaterial(dv, p) {
+  if (dv.byteLength < p + 160) return;
+  const n = dv.getUint8(p), rows = {};
+  for (let l = 0; l < n && l < 16; l++) rows[l] = { e: dv.getFloat32(p + 32 + 8 * l, true), nu: dv.getFloat32(p + 36 + 8 * l, true) };
+  const m = {
+    count: n, simOverride: dv.getUint8(p + 1) === 1, cgIterations: dv.getUint8(p + 2), corotated: dv.getUint8(p + 3),
+    dampingS: dv.getFloat32(p + 4, true), mask: dv.getUint32(p + 8, true),
+    rebuilds: Number(dv.getBigUint64(p + 16, true)), refused: Number(dv.getBigUint64(p + 24, true)),
+    rows, labels: {},
+  };
+  for (const name of MAT_LABELS) {
+    const r = rows[matRows[name].label];
+    if (r) m.labels[name] = { eKpa: r.e / 1000, nu: r.nu, overridden: (m.mask >> matRows[name].label) & 1 };
+  }
+  const changed = !sc.material || sc.material.rebuilds !== m.rebuilds;
+  sc.material = m;
+  if (changed) matPendingUntil = 0; // the rebuilt tissue: show what it holds
+  const over = MAT_LABELS.filter((name) => m.labels[name]?.overridden);
+  const busy = sc.frame && sc.frame.switching;
+  $('tissue-status').textContent = `${over.length ? 'set: ' + over.join(', ') : "the case's own materials"}` +
+    `${m.simOverride ? '; simulation parameters set' : ''}; ${m.rebuilds} rebuilds, ${m.refused} refused${busy ? '; rebuilding…' : ''}`;
+  if (performance.now() < matPendingUntil) return;
+  for (const name of MAT_LABELS) {
+    const r = matRows[name], v = m.labels[name];
+    if (!v || matHeld === name) continue;
+    r.e.value = Math.log10(Math.max(v.eKpa, 0.1)).toFixed(2);
+    r.nu.value = v.nu;
+    r.ov.textContent = v.eKpa >= 100 ? v.eKpa.toFixed(0) : v.eKpa.toPrecision(3);
+    r.nv.textContent = v.nu.toFixed(3);
+    r.e.title = r.nu.title = v.overridden ? 'set by CmdMaterial' : "the case's value";
+    r.e.parentElement.parentElement.classList.toggle('overridden', !!v.overridden);
+  }
+  if (!String(matHeld).startsWith('mat-')) {
+    $('mat-damping').value = m.dampingS; $('mat-damping-v').textContent = m.dampingS.toFixed(3);
+    $('mat-cg').value = m.cgIterations; $('mat-cg-v').textContent = m.cgIterations;
+    $('mat-corotated').checked = m.corotated === 1;
+  }
 }
