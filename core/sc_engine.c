@@ -257,8 +257,10 @@ static void stage_imaging(sc_engine *e, const sc_probe_in *probe, const sc_tissu
             e->counters.imaging_errors++;
         }
 #if SC_ENABLE_NEEDLE
+        e->needle_entry = 0u;
         if (sc_needle_frame_end(&e->needle, &e->slot.c.volume)) {
             const sc_needle_status *ns = sc_needle_status_get(&e->needle);
+            e->needle_entry = ns->last_puncture;
             sc_log(&e->hal->log, ns->last_puncture == SC_LABEL_ARTERY ? SC_LOG_WARN : SC_LOG_INFO,
                    "needle_puncture", SC_OK, (int64_t)ns->last_puncture,
                    (int64_t)(ns->vein_punctures + ns->artery_punctures));
@@ -295,6 +297,11 @@ static void assess_frame(sc_engine *e, const sc_tissue_out *tissue, const sc_ima
         }
         in.force_n = sc_tissue_probe_force_n(running_tissue(e), NULL);
     }
+#if SC_ENABLE_NEEDLE
+    /* the needle's lumen entry of this frame (an arterial puncture is a fault of the exam) */
+    in.puncture = e->case_loaded ? e->needle_entry : 0u;
+    e->needle_entry = 0u;
+#endif
     sc_assess_update(&e->assess, &in);
 }
 

@@ -293,6 +293,8 @@ typedef struct sc_engine {
     sc_needle_rx needle_rx; /* the tracked needle's CAN receiver */
     sc_needle needle;       /* drawn in the B-scan, punctures */
     uint8_t needle_status_counter;
+    uint8_t needle_entry; /* label of the lumen the tip entered this frame (0 none): the
+                           * assessment's puncture input */
 #endif
     sc_bscan bscan;
     sc_tissue tissue[SC_ENGINE_TISSUE_SLOTS]; /* the large ones last */
