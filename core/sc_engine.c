@@ -445,16 +445,21 @@ static int request_switch(sc_engine *e, const char *name)
     return SC_OK;
 }
 
-/* CmdVessels: the lumens' drive of the running tissue, kept for the cases loaded later.
+/* CmdVessels: the lumens' drive of the running tissue, kept for the cases loaded later that
+ * carry no drive of their own (a case's DRIV section replaces it at the swap).
  * Pulsation off removes the arterial pressure pulse (the heart's clock runs on, so the
- * Doppler's flow keeps its rhythm); the pulse pressure otherwise is config/sc_materials.h's. */
+ * Doppler's flow keeps its rhythm); on, the pulse pressure is the running case's (its DRIV),
+ * else config/sc_materials.h's. */
 static int apply_vessels(sc_engine *e, const sc_vessels_cmd *v)
 {
 #if SC_PHYS_LUMEN
     sc_lumen_drive d = e->vessel_drive_set ? e->vessel_drive : sc_lumen_drive_default();
+    const float pulse_on = e->case_loaded && e->slot.c.drive.present && e->slot.c.drive.d.pulse_pa > 0.0f
+                               ? e->slot.c.drive.d.pulse_pa
+                               : sc_lumen_drive_default().pulse_pa;
     d.heart_rate_bpm = v->heart_rate_bpm;
     d.resp_rate_bpm = v->resp_rate_bpm;
-    d.pulse_pa = v->pulse ? sc_lumen_drive_default().pulse_pa : 0.0f;
+    d.pulse_pa = v->pulse ? pulse_on : 0.0f;
     d.valsalva = v->valsalva ? 1u : 0u;
     int rc = sc_lumen_drive_validate(&d);
     if (rc == SC_OK && e->case_loaded) {
@@ -648,7 +653,15 @@ static int swap_case(sc_engine *e, uint32_t slot)
         /* the pulsation's clock runs at the frame rate */
         rc = sc_tissue_set_frame_s(&e->tissue[slot], 1.0f / (float)e->def.sched.rate_hz);
     }
-    if (rc == SC_OK && e->vessel_drive_set) {
+    if (rc == SC_OK && e->sw.c.drive.present) {
+        /* the case's own drive (its DRIV section: heart rate, pulse, waveform, breathing);
+         * a later CmdVessels overrides it, and a case without one keeps that command's */
+        rc = sc_tissue_set_drive(&e->tissue[slot], &e->sw.c.drive.d);
+        if (rc == SC_OK) {
+            e->vessel_drive = e->sw.c.drive.d;
+            e->vessel_drive_set = 1u;
+        }
+    } else if (rc == SC_OK && e->vessel_drive_set) {
         /* CmdVessels' setting outlives the case */
         rc = sc_tissue_set_drive(&e->tissue[slot], &e->vessel_drive);
     }
