@@ -454,8 +454,9 @@ static int apply_vessels(sc_engine *e, const sc_vessels_cmd *v)
 {
 #if SC_PHYS_LUMEN
     sc_lumen_drive d = e->vessel_drive_set ? e->vessel_drive : sc_lumen_drive_default();
-    const float pulse_on = e->case_loaded && e->slot.c.drive.present && e->slot.c.drive.d.pulse_pa > 0.0f
-                               ? e->slot.c.drive.d.pulse_pa
+    const sc_case_drive *cd = e->case_loaded ? &e->slot.c.drive : NULL;
+    const float pulse_on = cd != NULL && cd->present && cd->d.pulse_pa > 0.0f
+                               ? cd->d.pulse_pa
                                : sc_lumen_drive_default().pulse_pa;
     d.heart_rate_bpm = v->heart_rate_bpm;
     d.resp_rate_bpm = v->resp_rate_bpm;

@@ -25,7 +25,10 @@ build() { # name, extra C flags
         cmake --preset cortex-m7 -B "$dir" -DSC_LIBCCD_SOURCE_DIR="$CCD" \
             -DCMAKE_C_FLAGS="$base $2" > /dev/null
     fi
-    cmake --build "$dir" -j2 > "$dir.log" 2>&1 || { echo "build of $1 failed: $dir.log" >&2; exit 1; }
+    if ! cmake --build "$dir" -j2 > "$dir.log" 2>&1; then
+        echo "build of $1 failed: $dir.log" >&2
+        exit 1
+    fi
     arm-none-eabi-size -A "$dir/$ELF" | awk -v n="$1" '
         $1 == ".text" || $1 ~ /^\.rodata/ || $1 == ".isr_vector" || $1 == ".ARM.exidx" { t += $2 }
         $1 == ".data" { d += $2 } $1 == ".bss" { b += $2 }
@@ -58,7 +61,9 @@ NAMES="sc_engine sc_tissue sc_lumen sc_lumen_drive sc_doppler sc_needle sc_needl
     echo '};'
 } > "$SRC"
 INC=""
-for d in core core/base core/link core/physics core/imaging core/case hal config; do INC="$INC -I$d"; done
+for d in core core/base core/link core/physics core/imaging core/case hal config; do
+    INC="$INC -I$d"
+done
 OBJ=$(mktemp --suffix=.o)
 BIN=$(mktemp)
 # shellcheck disable=SC2086

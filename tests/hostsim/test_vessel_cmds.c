@@ -5,8 +5,9 @@
  * while the probe rests on the neck-ijv phantom (the `cases` target), MSDS. Checked:
  *   - loaded, the case's own drive (its DRIV section: neck-ijv 60 / min, 12 breaths / min)
  *     runs: the artery's image area oscillates at 1.0 Hz (issue 18 item 1, "in the case");
- *   - a CmdVessels with heart rate 108 / min (breathing off) overrides it and makes the artery's image area
- *     oscillate at 1.8 Hz (largest DFT bin of 4 s at 60 Hz), one with 72 / min at 1.2 Hz;
+ *   - a CmdVessels with heart rate 108 / min (breathing off) overrides it and makes the
+ *     artery's image area oscillate at 1.8 Hz (largest DFT bin of 4 s at 60 Hz), one with
+ *     72 / min at 1.2 Hz;
  *   - a CmdVessels with Valsalva held distends the vein (image area up >= 5%), released it
  *     comes back within 2%;
  *   - (probe rolled 20 degrees so that the beam has a component along the flow) a CmdDoppler

@@ -236,7 +236,7 @@ static void puncture(uint8_t label)
 }
 
 /* issue 18 item 3: an arterial puncture is a fault of the exam; a vein puncture is not */
-static void an_arterial_puncture_fails_its_criterion_and_a_vein_puncture_does_not(void **state)
+static void arterial_puncture_fails_its_criterion_vein_puncture_does_not(void **state)
 {
     (void)state;
     assert_int_equal(sc_assess_begin_case(&a, SC_ASSESS_CALL_NORMAL), SC_OK);
@@ -281,7 +281,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup(defaults_are_valid_and_bad_definitions_are_refused, setup),
-        cmocka_unit_test_setup(an_arterial_puncture_fails_its_criterion_and_a_vein_puncture_does_not,
+        cmocka_unit_test_setup(arterial_puncture_fails_its_criterion_vein_puncture_does_not,
                                setup),
         cmocka_unit_test_setup(an_empty_exam_scores_nothing_and_says_not_available, setup),
         cmocka_unit_test_setup(the_deepest_compression_and_its_force_are_kept, setup),
