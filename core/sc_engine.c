@@ -661,6 +661,8 @@ static int swap_case(sc_engine *e, uint32_t slot)
         if (rc == SC_OK) {
             e->vessel_drive = e->sw.c.drive.d;
             e->vessel_drive_set = 1u;
+            sc_log(&e->hal->log, SC_LOG_INFO, "case_drive", SC_OK,
+                   (int64_t)e->sw.c.drive.d.heart_rate_bpm, (int64_t)e->sw.c.drive.d.resp_rate_bpm);
         }
     } else if (rc == SC_OK && e->vessel_drive_set) {
         /* CmdVessels' setting outlives the case */
