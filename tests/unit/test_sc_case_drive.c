@@ -2,7 +2,8 @@
  * vessel drive: the encoder and parser round trip; every rule refused by name
  * (SC_ERR_CASE_DRIVE: size, version, reserved word, waveform, non-finite and out-of-range
  * values; a second DRIV: SC_ERR_CASE_SECTION); the loader, whole and sliced, agreeing; a case
- * without DRIV loads with none;
+ * without DRIV loads with none; a case switch to a bad DRIV refused and counted by the slot, the
+ * running case kept;
  * the phantoms' DRIV from sc-casebuild: a plausible, different heart rate per case. */
 #include "sc_test.h"
 
@@ -14,6 +15,7 @@
 #include "sc_case.h"
 #include "sc_case_drive.h"
 #include "sc_err.h"
+#include "sc_hs_storage.h"
 #include "sc_labels.h"
 #include "sc_test_case.h"
 
@@ -190,6 +192,37 @@ static void loader_whole_and_sliced_agree(void **state)
     free(tc.bytes);
 }
 
+static sc_hs_storage g_storage;
+
+static void a_switch_to_a_bad_drive_is_refused_counted_and_the_running_case_stays(void **state)
+{
+    (void)state;
+    sc_test_case tc;
+    assert_int_equal(sc_test_case_make(&tc, 5, 5, 5, SC_LABEL_VEIN, "drive"), SC_OK);
+    size_t n_good, n_bad;
+    uint8_t *good = with_drive(&tc, 1, 0, &n_good);
+    uint8_t *bad = with_drive(&tc, 1, 1, &n_bad);
+    sc_hs_storage_init(&g_storage);
+    assert_int_equal(sc_hs_storage_add(&g_storage, "good", good, n_good), SC_OK);
+    assert_int_equal(sc_hs_storage_add(&g_storage, "bad", bad, n_bad), SC_OK);
+    const sc_storage_dev dev = sc_hs_storage_dev(&g_storage);
+    sc_case_slot slot;
+    sc_case_slot_init(&slot);
+    assert_int_equal(sc_case_slot_switch(&slot, &dev, "good"), SC_OK);
+    assert_int_equal(slot.c.drive.present, 1u);
+    const uint32_t id = slot.c.case_id;
+    assert_int_equal(sc_case_slot_switch(&slot, &dev, "bad"), SC_ERR_CASE_DRIVE);
+    assert_int_equal(slot.refused, 1u);
+    assert_int_equal(slot.last_error, SC_ERR_CASE_DRIVE);
+    assert_int_equal(slot.loaded, 1);
+    assert_int_equal(slot.c.case_id, id); /* the running case stays */
+    assert_float_equal(slot.c.drive.d.heart_rate_bpm, 84.0f, 0.0f);
+    sc_case_slot_close(&slot);
+    free(good);
+    free(bad);
+    free(tc.bytes);
+}
+
 static void phantoms_carry_a_different_plausible_drive_each(void **state)
 {
     (void)state;
@@ -229,6 +262,7 @@ int main(void)
         cmocka_unit_test(encoder_and_parser_round_trip),
         cmocka_unit_test(parser_refuses_every_rule),
         cmocka_unit_test(loader_whole_and_sliced_agree),
+        cmocka_unit_test(a_switch_to_a_bad_drive_is_refused_counted_and_the_running_case_stays),
         cmocka_unit_test(phantoms_carry_a_different_plausible_drive_each),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
