@@ -258,8 +258,10 @@ static void stage_imaging(sc_engine *e, const sc_probe_in *probe, const sc_tissu
             e->counters.imaging_errors++;
         }
 #if SC_ENABLE_NEEDLE
+        e->needle_entry = 0u;
         if (sc_needle_frame_end(&e->needle, &e->slot.c.volume)) {
             const sc_needle_status *ns = sc_needle_status_get(&e->needle);
+            e->needle_entry = ns->last_puncture;
             sc_log(&e->hal->log, ns->last_puncture == SC_LABEL_ARTERY ? SC_LOG_WARN : SC_LOG_INFO,
                    "needle_puncture", SC_OK, (int64_t)ns->last_puncture,
                    (int64_t)(ns->vein_punctures + ns->artery_punctures));
@@ -296,6 +298,11 @@ static void assess_frame(sc_engine *e, const sc_tissue_out *tissue, const sc_ima
         }
         in.force_n = sc_tissue_probe_force_n(running_tissue(e), NULL);
     }
+#if SC_ENABLE_NEEDLE
+    /* the needle's lumen entry of this frame (an arterial puncture is a fault of the exam) */
+    in.puncture = e->case_loaded ? e->needle_entry : 0u;
+    e->needle_entry = 0u;
+#endif
     sc_assess_update(&e->assess, &in);
 }
 
@@ -439,16 +446,22 @@ static int request_switch(sc_engine *e, const char *name)
     return SC_OK;
 }
 
-/* CmdVessels: the lumens' drive of the running tissue, kept for the cases loaded later.
+/* CmdVessels: the lumens' drive of the running tissue, kept for the cases loaded later that
+ * carry no drive of their own (a case's DRIV section replaces it at the swap).
  * Pulsation off removes the arterial pressure pulse (the heart's clock runs on, so the
- * Doppler's flow keeps its rhythm); the pulse pressure otherwise is config/sc_materials.h's. */
+ * Doppler's flow keeps its rhythm); on, the pulse pressure is the running case's (its DRIV),
+ * else config/sc_materials.h's. */
 static int apply_vessels(sc_engine *e, const sc_vessels_cmd *v)
 {
 #if SC_PHYS_LUMEN
     sc_lumen_drive d = e->vessel_drive_set ? e->vessel_drive : sc_lumen_drive_default();
+    const sc_case_drive *cd = e->case_loaded ? &e->slot.c.drive : NULL;
+    const float pulse_on = cd != NULL && cd->present && cd->d.pulse_pa > 0.0f
+                               ? cd->d.pulse_pa
+                               : sc_lumen_drive_default().pulse_pa;
     d.heart_rate_bpm = v->heart_rate_bpm;
     d.resp_rate_bpm = v->resp_rate_bpm;
-    d.pulse_pa = v->pulse ? sc_lumen_drive_default().pulse_pa : 0.0f;
+    d.pulse_pa = v->pulse ? pulse_on : 0.0f;
     d.valsalva = v->valsalva ? 1u : 0u;
     int rc = sc_lumen_drive_validate(&d);
     if (rc == SC_OK && e->case_loaded) {
@@ -781,7 +794,17 @@ static int swap_case(sc_engine *e, uint32_t slot)
         /* the pulsation's clock runs at the frame rate */
         rc = sc_tissue_set_frame_s(&e->tissue[slot], 1.0f / (float)e->def.sched.rate_hz);
     }
-    if (rc == SC_OK && e->vessel_drive_set) {
+    if (rc == SC_OK && e->sw.c.drive.present) {
+        /* the case's own drive (its DRIV section: heart rate, pulse, waveform, breathing);
+         * a later CmdVessels overrides it, and a case without one keeps that command's */
+        rc = sc_tissue_set_drive(&e->tissue[slot], &e->sw.c.drive.d);
+        if (rc == SC_OK) {
+            e->vessel_drive = e->sw.c.drive.d;
+            e->vessel_drive_set = 1u;
+            sc_log(&e->hal->log, SC_LOG_INFO, "case_drive", SC_OK,
+                   (int64_t)e->sw.c.drive.d.heart_rate_bpm, (int64_t)e->sw.c.drive.d.resp_rate_bpm);
+        }
+    } else if (rc == SC_OK && e->vessel_drive_set) {
         /* CmdVessels' setting outlives the case */
         rc = sc_tissue_set_drive(&e->tissue[slot], &e->vessel_drive);
     }

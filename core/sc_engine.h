@@ -310,6 +310,8 @@ typedef struct sc_engine {
     sc_needle_rx needle_rx; /* the tracked needle's CAN receiver */
     sc_needle needle;       /* drawn in the B-scan, punctures */
     uint8_t needle_status_counter;
+    uint8_t needle_entry; /* label of the lumen the tip entered this frame (0 none): the
+                           * assessment's puncture input */
 #endif
     /* CmdMaterial: a rebuild of the running case through the switch (the same slot) */
     sc_engine_material mat_run;  /* of the running tissue */

@@ -280,14 +280,17 @@ static uint32_t emit_assessment(sc_state_tx *t, const sc_state_dev *dev, const s
     put_u8(&w, r->call);
     put_u8(&w, r->finding);
     put_u8(&w, r->criteria_met);
-    for (uint32_t c = 0; c < SC_ASSESS_CRITERIA; c++) {
+    for (uint32_t c = 0; c < SC_ASSESS_CRITERIA_R0; c++) {
         put_u8(&w, r->points[c]);
     }
     put_u8(&w, r->score);
     put_u8(&w, r->score_max);
-    for (uint32_t k = 0; k < 5u; k++) {
-        put_u8(&w, 0u);
-    }
+    /* revision 1: the needle's punctures and criterion 5 in bytes 99..102 */
+    put_u8(&w, r->artery_punctures);
+    put_u8(&w, r->vein_punctures);
+    put_u8(&w, r->puncture_points);
+    put_u8(&w, r->revision);
+    put_u8(&w, 0u);
     return finish(t, dev, &w, in->frame_no);
 }
 

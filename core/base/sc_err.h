@@ -44,6 +44,7 @@
     X(SC_ERR_CASE_RESERVED, -45, "case reserved field or padding not zero")                   \
     X(SC_ERR_CASE_SIZE, -46, "case section size disagrees with its contents")                 \
     X(SC_ERR_CASE_DEPTH, -47, "case usable imaging depth not finite or out of range")         \
+    X(SC_ERR_CASE_DRIVE, -58, "case DRIV section (vessel drive) invalid")                     \
     X(SC_ERR_CASE_SURFACE, -59, "case SURF section (console surfaces) invalid")                \
     /* CAN protocol and E2E: -64 .. -95 */                                                     \
     X(SC_ERR_CAN_ID, -64, "CAN identifier not in the protocol")                               \

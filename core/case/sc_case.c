@@ -664,6 +664,10 @@ int sc_case_load(const uint8_t *bytes, size_t size, sc_case *out)
     if (src != SC_OK) {
         return src;
     }
+    const int drc = sc_case_drive_find(bytes, size, &c.drive);
+    if (drc != SC_OK) {
+        return drc;
+    }
     *out = c;
     return SC_OK;
 }
@@ -762,6 +766,10 @@ int sc_case_check_finish(const sc_case_check *k, sc_case *out)
     const int src = sc_case_surf_find(k->bytes, k->size, &c.mesh, &c.surf);
     if (src != SC_OK) {
         return src;
+    }
+    const int drc = sc_case_drive_find(k->bytes, k->size, &c.drive);
+    if (drc != SC_OK) {
+        return drc;
     }
     *out = c;
     return SC_OK;

@@ -30,6 +30,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "sc_case_drive.h"
 #include "sc_case_surf.h"
 #include "sc_config.h"
 #include "sc_hal_storage.h"
@@ -128,6 +129,7 @@ typedef struct sc_case {
                        * own CRC fields; they hold the payload CRCs): identifies
                        * the case content */
     sc_case_surf surf; /* optional SURF section (console surfaces); surf.count 0: none */
+    sc_case_drive drive; /* optional DRIV section (the vessel drive); drive.present 0: none */
 } sc_case;
 
 /* What the writer encodes. volume.voxels and volume.labels must both be non-NULL. */
@@ -169,7 +171,7 @@ int sc_case_write(const sc_case_def *def, uint8_t *buf, size_t cap, size_t *out_
  * SC_ERR_CASE_VERSION, SC_ERR_CASE_SECTION (missing, duplicated, unknown-size header),
  * SC_ERR_CASE_RESERVED, SC_ERR_CASE_SIZE, SC_ERR_CASE_TEXT, SC_ERR_CASE_DIMS,
  * SC_ERR_CASE_SPACING, SC_ERR_CASE_TRANSFORM, SC_ERR_CASE_MATERIAL, SC_ERR_CASE_LABEL,
- * SC_ERR_CASE_MESH_NODES, SC_ERR_CASE_MESH_BOX. */
+ * SC_ERR_CASE_MESH_NODES, SC_ERR_CASE_MESH_BOX, SC_ERR_CASE_SURFACE, SC_ERR_CASE_DRIVE. */
 int sc_case_load(const uint8_t *bytes, size_t size, sc_case *out);
 
 /* ---- the same validation in bounded slices (a case switch while another case runs) --------

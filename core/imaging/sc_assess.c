@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "sc_err.h"
+#include "sc_labels.h"
 
 sc_assess_def sc_assess_default_def(void)
 {
@@ -14,7 +15,7 @@ sc_assess_def sc_assess_default_def(void)
         .firm_force_n = 8.0f, /* neck-ijv: the vein coapts by 12 N (tests/hostsim/test_assess) */
         .force_max_n = 60.0f,
         .min_view_frames = 6u,
-        .points = {1u, 2u, 1u, 1u, 3u},
+        .points = {1u, 2u, 1u, 1u, 3u, 2u},
     };
 }
 
@@ -46,6 +47,7 @@ static void clear_record(sc_assess_report *r)
     const uint8_t finding = r->finding;
     memset(r, 0, sizeof(*r));
     r->version = SC_ASSESS_REPORT_VERSION;
+    r->revision = SC_ASSESS_REPORT_REVISION;
     r->resets = resets;
     r->finding = finding;
     r->call = SC_ASSESS_CALL_NONE;
@@ -113,6 +115,14 @@ void sc_assess_update(sc_assess *a, const sc_assess_in *in)
     sc_assess_report *r = &a->r;
     const uint32_t frame = r->frames;
     r->frames++;
+    if (in->puncture == (uint8_t)SC_LABEL_ARTERY && r->artery_punctures < 255u) {
+        r->artery_punctures++;
+    } else if (in->puncture == (uint8_t)SC_LABEL_VEIN && r->vein_punctures < 255u) {
+        r->vein_punctures++;
+    }
+    if (in->puncture != 0u) {
+        sc_assess_score(&a->def, r);
+    }
     if (!in->contact) {
         return;
     }
@@ -158,10 +168,15 @@ void sc_assess_score(const sc_assess_def *def, sc_assess_report *r)
     met[SC_ASSESS_CRIT_FORCE_SAFE] = (uint8_t)(imaged && r->peak_force_n <= def->force_max_n);
     met[SC_ASSESS_CRIT_CALL_CORRECT] =
         (uint8_t)(r->call != SC_ASSESS_CALL_NONE && r->call == r->finding);
+    met[SC_ASSESS_CRIT_NO_ARTERY_PUNCTURE] = (uint8_t)(imaged && r->artery_punctures == 0u);
     uint32_t score = 0, max = 0;
     uint8_t bits = 0;
     for (uint32_t c = 0; c < SC_ASSESS_CRITERIA; c++) {
-        r->points[c] = def->points[c];
+        if (c < SC_ASSESS_CRITERIA_R0) {
+            r->points[c] = def->points[c];
+        } else {
+            r->puncture_points = def->points[c];
+        }
         max += def->points[c];
         if (met[c]) {
             bits = (uint8_t)(bits | (1u << c));
@@ -171,6 +186,14 @@ void sc_assess_score(const sc_assess_def *def, sc_assess_report *r)
     r->criteria_met = bits;
     r->score = (uint8_t)score; /* <= 255: checked by sc_assess_def_validate */
     r->score_max = (uint8_t)max;
+}
+
+uint8_t sc_assess_report_points(const sc_assess_report *r, uint32_t c)
+{
+    if (c < SC_ASSESS_CRITERIA_R0) {
+        return r->points[c];
+    }
+    return c == (uint32_t)SC_ASSESS_CRIT_NO_ARTERY_PUNCTURE ? r->puncture_points : 0u;
 }
 
 const sc_assess_report *sc_assess_get(const sc_assess *a)
@@ -193,6 +216,8 @@ void sc_assess_to_msg(const sc_assess_report *r, sc_assess_msg *out)
     out->criteria_met = r->criteria_met;
     out->score = r->score;
     out->score_max = r->score_max;
+    out->artery_punctured = r->artery_punctures != 0u ? 1u : 0u;
+    out->vein_punctured = r->vein_punctures != 0u ? 1u : 0u;
 }
 
 const char *sc_assess_criterion_name(sc_assess_criterion c)
@@ -208,6 +233,8 @@ const char *sc_assess_criterion_name(sc_assess_criterion c)
         return "force_safe";
     case SC_ASSESS_CRIT_CALL_CORRECT:
         return "call_correct";
+    case SC_ASSESS_CRIT_NO_ARTERY_PUNCTURE:
+        return "no_artery_puncture";
     case SC_ASSESS_CRITERIA:
         break;
     }

@@ -8,7 +8,8 @@
  * the force on the probe at that frame (sc_tissue_probe_force_n), whether it coapted (ratio <=
  * coapt_ratio); over the exam the peak force and whether the artery was compressed below
  * artery_min_ratio; the trainee's call (normal / DVT, a CAN command) against the case's finding
- * (DVT when the case's mesh holds thrombus). A score sums the points of the criteria met
+ * (DVT when the case's mesh holds thrombus); the tracked needle's lumen entries (an arterial
+ * puncture is a fault). A score sums the points of the criteria met
  * (sc_assess_criterion, each met or not, with its points in the report).
  *
  * The record (sc_assess_report, version SC_ASSESS_REPORT_VERSION) is plain data: the engine's
@@ -28,6 +29,10 @@
 #include "sc_canproto.h"
 
 #define SC_ASSESS_REPORT_VERSION 1u
+/* Compatible revision of the version-1 layout: 0 the first (five criteria), 1 adds the needle's
+ * punctures and criterion 5 in bytes formerly reserved (docs/assessment.md). */
+#define SC_ASSESS_REPORT_REVISION 1u
+#define SC_ASSESS_CRITERIA_R0     5u /* criteria whose points sit in points[] */
 
 /* The vessels assessed (index of the report's vessel[] and of the CAN signals). */
 typedef enum sc_assess_vessel {
@@ -49,6 +54,9 @@ typedef enum sc_assess_criterion {
     SC_ASSESS_CRIT_FORCE_SAFE,      /* a vein was imaged and the peak force stayed <=
                                      * force_max_n (met when the force is not available) */
     SC_ASSESS_CRIT_CALL_CORRECT,    /* the trainee's call equals the case's finding */
+    SC_ASSESS_CRIT_NO_ARTERY_PUNCTURE, /* a vein was imaged and the needle's tip never entered
+                                        * the artery's lumen (an arterial puncture is a fault
+                                        * of the exam, issue 18) */
     SC_ASSESS_CRITERIA
 } sc_assess_criterion;
 
@@ -66,6 +74,10 @@ typedef struct sc_assess_in {
     uint8_t contact;                   /* the probe touches the tissue */
     float area_ratio[SC_ASSESS_VESSELS]; /* < 0 (or non-finite): not in view */
     float force_n;                     /* < 0 (or non-finite): not available */
+    uint8_t puncture;                  /* the needle's tip entered a lumen this frame: its label
+                                        * (SC_LABEL_VEIN, SC_LABEL_ARTERY); 0 none. The needle
+                                        * reports each entry once (sc_needle.h); counted with
+                                        * or without probe contact */
 } sc_assess_in;
 
 typedef struct sc_assess_vessel_rec {
@@ -92,12 +104,18 @@ typedef struct sc_assess_report {
     uint8_t call;              /* SC_ASSESS_CALL_*: the trainee's call (NONE: not yet) */
     uint8_t finding;           /* SC_ASSESS_CALL_NORMAL or _DVT: the case's truth */
     uint8_t criteria_met;      /* bit per sc_assess_criterion */
-    uint8_t points[SC_ASSESS_CRITERIA]; /* points of each criterion (from the def) */
+    uint8_t points[SC_ASSESS_CRITERIA_R0]; /* points of criteria 0..4 (from the def) */
     uint8_t score;             /* sum of the points of the met criteria */
     uint8_t score_max;         /* sum of all points */
-    uint8_t reserved[5];       /* 0 */
+    /* revision 1 of the layout (bytes 99..102 were reserved zero in revision 0: a reader of
+     * revision 0 ignores them and still reads a consistent score / score_max) */
+    uint8_t artery_punctures;  /* needle entries into the artery's lumen, saturating at 255 */
+    uint8_t vein_punctures;    /* needle entries into a vein's lumen, saturating at 255 */
+    uint8_t puncture_points;   /* points of criterion 5 (no_artery_puncture) */
+    uint8_t revision;          /* SC_ASSESS_REPORT_REVISION */
+    uint8_t reserved;          /* 0 */
 } sc_assess_report;
-_Static_assert(SC_ASSESS_CRITERIA == 5u, "five criteria: the record's layout");
+_Static_assert(SC_ASSESS_CRITERIA == 6u, "six criteria: the record's layout");
 _Static_assert(sizeof(sc_assess_report) == 104u, "assessment record layout (docs/assessment.md)");
 
 typedef struct sc_assess {
@@ -106,7 +124,8 @@ typedef struct sc_assess {
 } sc_assess;
 
 /* coapt 0.05, artery 0.75, firm press 8 N, unsafe above 60 N, 6 frames (0.1 s) in view;
- * points: imaged 1, compressed 2, artery spared 1, force safe 1, call correct 3 (8 in all). */
+ * points: imaged 1, compressed 2, artery spared 1, force safe 1, call correct 3, no arterial
+ * puncture 2 (10 in all). */
 sc_assess_def sc_assess_default_def(void);
 /* SC_ERR_INVALID_ARG (NULL), SC_ERR_NOT_FINITE, SC_ERR_RANGE (ratios outside (0, 1], forces
  * <= 0 or firm above max, more than 255 points in all). O(1). */
@@ -127,6 +146,9 @@ void sc_assess_update(sc_assess *a, const sc_assess_in *in);
 /* The criteria and score of a record under def (pure: writes criteria_met, points, score,
  * score_max of *r). O(SC_ASSESS_CRITERIA). */
 void sc_assess_score(const sc_assess_def *def, sc_assess_report *r);
+/* Points of criterion c in a scored record (points[] or puncture_points); 0 for an unknown c.
+ * O(1). */
+uint8_t sc_assess_report_points(const sc_assess_report *r, uint32_t c);
 /* The record (scored). O(1). */
 const sc_assess_report *sc_assess_get(const sc_assess *a);
 /* The CAN status message of a record. O(1). */

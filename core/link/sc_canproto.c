@@ -179,6 +179,8 @@ static const sc_can_sig sigs_assess_score[] = {
     {"CriteriaMet", 40, 8, 0, 1.0f, 0.0f, 0.0f, 255.0f, ""},
     {"Score", 48, 8, 0, 1.0f, 0.0f, 0.0f, 255.0f, ""},
     {"ScoreMax", 56, 8, 0, 1.0f, 0.0f, 0.0f, 255.0f, ""},
+    {"ArteryPunctured", 12, 1, 0, 1.0f, 0.0f, 0.0f, 1.0f, ""},
+    {"VeinPunctured", 13, 1, 0, 1.0f, 0.0f, 0.0f, 1.0f, ""},
 };
 static const sc_can_sig sigs_needle_pos[] = {
     E2E_SIGS,
@@ -1038,6 +1040,8 @@ int sc_canproto_encode_assess(const sc_assess_msg *a, sc_e2e_tx tx[SC_ASSESS_FRA
     put_u(&out[2], m, 9u, a->criteria_met);
     put_u(&out[2], m, 10u, a->score);
     put_u(&out[2], m, 11u, a->score_max);
+    put_u(&out[2], m, 12u, a->artery_punctured ? 1u : 0u);
+    put_u(&out[2], m, 13u, a->vein_punctured ? 1u : 0u);
     for (unsigned i = 0; i < SC_ASSESS_FRAMES; i++) {
         rc = sc_e2e_protect(&tx[i], out[i].data, out[i].len);
         if (rc != 0) {
@@ -1077,6 +1081,8 @@ int sc_canproto_decode_assess_part(const sc_can_frame *f, sc_assess_msg *a)
         a->criteria_met = (uint8_t)get_u(f, m, 9u);
         a->score = (uint8_t)get_u(f, m, 10u);
         a->score_max = (uint8_t)get_u(f, m, 11u);
+        a->artery_punctured = (uint8_t)get_u(f, m, 12u);
+        a->vein_punctured = (uint8_t)get_u(f, m, 13u);
         return 0;
     }
     return SC_ERR_CAN_ID;

@@ -79,7 +79,7 @@ typedef enum sc_msg {
 #define SC_MSG_IS_NEEDLE_IN(m)                                                                   \
     ((unsigned)(m) >= (unsigned)SC_MSG_NEEDLE_POS && (unsigned)(m) <= (unsigned)SC_MSG_NEEDLE_AUX)
 
-#define SC_CANPROTO_MAX_SIGS 12u /* AssessScore */
+#define SC_CANPROTO_MAX_SIGS 14u /* AssessScore */
 
 enum {
     SC_CANID_CMD_CASE = 0x080,
@@ -364,6 +364,8 @@ typedef struct sc_assess_msg {
     uint8_t criteria_met;               /* bit per criterion (sc_assess_criterion) */
     uint8_t score;                      /* points of the met criteria */
     uint8_t score_max;                  /* points of every criterion */
+    uint8_t artery_punctured;           /* the needle entered the artery since the reset */
+    uint8_t vein_punctured;             /* the needle entered a vein since the reset */
 } sc_assess_msg;
 
 /* Encodes AssessVessels, AssessForce, AssessScore into out[0..2], each protected with the

@@ -28,6 +28,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     SC_FUZZ_CHECK(c.mesh.nx <= SC_MAX_MESH_NX && c.mesh.ny <= SC_MAX_MESH_NY &&
                   c.mesh.nz <= SC_MAX_MESH_NZ);
     SC_FUZZ_CHECK(strlen(c.name) < SC_CASE_NAME_LEN);
+    /* an accepted DRIV is a drive the lumens take as it is */
+    SC_FUZZ_CHECK(c.drive.present <= 1u);
+    SC_FUZZ_CHECK(!c.drive.present ||
+                  (sc_lumen_drive_validate(&c.drive.d) == SC_OK && c.drive.d.valsalva == 0u));
     return 0;
 }
 

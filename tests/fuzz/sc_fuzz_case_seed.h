@@ -10,7 +10,8 @@
 #include "sc_labels.h"
 
 /* Seed i (0..3): a valid case of a 6^3 (i = 3: 3 x 5 x 2) volume, 4 or 2 labels, varied mesh,
- * spacing, origin and materials (all load: tools/fuzz-seeds.sh writes them as the corpus). */
+ * spacing, origin and materials (all load: tools/fuzz-seeds.sh writes them as the corpus);
+ * seeds 1 and 3 carry the optional DRIV section (the patient's vessel drive). */
 static size_t sc_fuzz_case_seed(uint32_t i, uint8_t *buf, size_t cap)
 {
     if (i > 3u) {
@@ -44,6 +45,16 @@ static size_t sc_fuzz_case_seed(uint32_t i, uint8_t *buf, size_t cap)
     size_t out = 0;
     if (sc_case_write(&def, buf, cap, &out) != SC_OK) {
         return 0;
+    }
+    if (i & 1u) {
+        sc_lumen_drive d = sc_lumen_drive_default();
+        d.heart_rate_bpm = i == 1u ? 90.0f : 0.0f;
+        d.wave = (uint8_t)(i == 3u ? SC_LUMEN_WAVE_SINE : SC_LUMEN_WAVE_ARTERIAL);
+        uint8_t p[SC_CASE_DRIVE_SIZE];
+        if (sc_case_drive_encode(&d, p) != SC_OK ||
+            sc_case_append_section(buf, cap, &out, SC_CASE_TAG_DRIV_U32, p, sizeof p) != SC_OK) {
+            return 0;
+        }
     }
     return out;
 }

@@ -1,7 +1,10 @@
 /* test_needle_engine.c: the tracked needle through the whole engine on the host simulator: the
  * tracker emulator's needle frames on the simulated bus, the engine's receiver, the needle in
  * the image, and the puncture reports that leave on CAN (NeedleStatus, 0x220): a vein entered
- * twice is reported twice, each entry once, and no artery. Deterministic (virtual clock). */
+ * twice is reported twice, each entry once, and no artery. The assessment (issue 18 item 3):
+ * a needle into the artery is a fault of the exam, counted once, in the record and on CAN
+ * (AssessScore's ArteryPunctured, criterion 5 not met); into the vein, none. Deterministic
+ * (virtual clock). */
 #include "sc_test.h"
 
 #include <math.h>
@@ -36,6 +39,8 @@ static int group_teardown(void **state)
 typedef struct needle_seen {
     uint32_t status_frames;
     sc_needle_status_msg last;
+    uint32_t score_frames; /* AssessScore frames read back */
+    sc_assess_msg assess;  /* their last content */
     uint32_t max_drawn;
     uint32_t max_tip_contacts; /* tissue nodes the tip pushed */
     float max_moved_mm;        /* largest node displacement seen (the probe only hovers) */
@@ -93,6 +98,9 @@ static void run(uint32_t n, needle_seen *seen)
                 assert_int_equal(sc_canproto_decode_needle_status(&r, &seen->last), SC_OK);
                 assert_int_equal(sc_e2e_crc(SC_CANID_NEEDLE_STATUS, r.data, r.len), r.data[0]);
                 seen->status_frames++;
+            } else if (r.id == SC_CANID_ASSESS_SCORE) {
+                assert_int_equal(sc_canproto_decode_assess_part(&r, &seen->assess), SC_OK);
+                seen->score_frames++;
             }
         }
     }
@@ -171,12 +179,84 @@ static void a_needle_into_the_vein_is_reported_once_per_entry_on_can(void **stat
     assert_int_equal(seen.last.vein_punctures, 2u);
     assert_int_equal(seen.last.artery_punctures, 0u);
     assert_int_equal(sc_engine_get_needle_status(&rig.engine)->vein_punctures, 2u);
+    /* the assessment: two vein entries, no fault */
+    const sc_assess_report *ar = sc_engine_assessment(&rig.engine);
+    print_message("assessment: vein %u artery %u punctures, criteria 0x%02x, score %u/%u\n",
+                  ar->vein_punctures, ar->artery_punctures, ar->criteria_met, ar->score,
+                  ar->score_max);
+    assert_int_equal(ar->vein_punctures, 2u);
+    assert_int_equal(ar->artery_punctures, 0u);
+    assert_true(ar->criteria_met & (1u << SC_ASSESS_CRIT_VEIN_IMAGED));
+    assert_true(ar->criteria_met & (1u << SC_ASSESS_CRIT_NO_ARTERY_PUNCTURE));
+    assert_true(seen.score_frames > 0u);
+    assert_int_equal(seen.assess.artery_punctured, 0u);
+    assert_int_equal(seen.assess.vein_punctured, 1u);
+    assert_int_equal(seen.assess.criteria_met, ar->criteria_met);
+}
+
+/* The same needle path mirrored onto the artery: one arterial puncture, the exam's fault. */
+static void a_needle_into_the_artery_is_a_fault_of_the_exam_once(void **state)
+{
+    (void)state;
+    sc_engine_def def = sc_test_engine_def();
+    def.tissue.collider = sc_test_scene_collider(&block.scene);
+    def.case_names[0] = "block";
+    def.case_count = 1;
+    assert_int_equal(sc_hs_rig_init(&rig, &def, 7, 0), SC_OK);
+    assert_int_equal(sc_hs_storage_add(&rig.storage, "block", block.bytes, block.size), SC_OK);
+    assert_int_equal(sc_engine_load_case(&rig.engine, "block"), SC_OK);
+    sc_emu_def pd = sc_emu_default_def();
+    pd.script = SC_EMU_PRESS;
+    memcpy(pd.point_mm, block.centre_tracker_mm, sizeof pd.point_mm);
+    pd.hover_mm = 2.0f;
+    pd.depth_mm = 1.0f;
+    pd.duration_s = 10.0;
+    assert_int_equal(sc_emu_init(&emu, &pd), SC_OK);
+    /* from 8 mm beyond the artery (away from the vein) toward its axis, 14 mm deep at most */
+    sc_emu_needle_def nd = sc_emu_needle_default_def();
+    nd.entry_mm[0] = block.scene.p.artery_x_mm + 8.0f;
+    nd.entry_mm[1] = block.vein_tracker_mm[1];
+    nd.entry_mm[2] = 0.0f;
+    nd.dir[0] = -8.0f;
+    nd.dir[1] = 0.0f;
+    nd.dir[2] = -10.0f;
+    nd.speed_mm_s = 10.0f;
+    nd.max_depth_mm = 14.0f;
+    nd.hold_s = 1.0;
+    assert_int_equal(sc_emu_needle_init(&needle, &nd), SC_OK);
+    t0 = rig.clock.now_ns;
+    probe_next = needle_next = 0u;
+    needle_seen seen = {0};
+    run(180, &seen); /* 3 s: in and held in the artery */
+    const sc_assess_report *ar = sc_engine_assessment(&rig.engine);
+    print_message("artery: needle status vein %u artery %u last %u; assessment artery %u vein %u, "
+                  "criteria 0x%02x, score %u/%u\n",
+                  seen.last.vein_punctures, seen.last.artery_punctures, seen.last.last_puncture,
+                  ar->artery_punctures, ar->vein_punctures, ar->criteria_met, ar->score,
+                  ar->score_max);
+    assert_int_equal(seen.last.artery_punctures, 1u);
+    assert_int_equal(seen.last.vein_punctures, 0u);
+    assert_int_equal(ar->artery_punctures, 1u); /* once, although the tip stays in */
+    assert_int_equal(ar->vein_punctures, 0u);
+    assert_false(ar->criteria_met & (1u << SC_ASSESS_CRIT_NO_ARTERY_PUNCTURE));
+    assert_true(ar->score + ar->puncture_points <= ar->score_max);
+    assert_true(seen.score_frames > 0u);
+    assert_int_equal(seen.assess.artery_punctured, 1u);
+    assert_int_equal(seen.assess.criteria_met, ar->criteria_met);
+    assert_int_equal(seen.assess.score, ar->score);
+    /* the assessment's reset forgets the fault; the needle's own counters stay */
+    sc_assess_reset(&rig.engine.assess);
+    assert_int_equal(sc_engine_assessment(&rig.engine)->artery_punctures, 0u);
+    run(30, &seen); /* held in the lumen: no new entry, no new fault */
+    assert_int_equal(sc_engine_assessment(&rig.engine)->artery_punctures, 0u);
+    assert_int_equal(sc_engine_get_needle_status(&rig.engine)->artery_punctures, 1u);
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(a_needle_into_the_vein_is_reported_once_per_entry_on_can),
+        cmocka_unit_test(a_needle_into_the_artery_is_a_fault_of_the_exam_once),
     };
     return cmocka_run_group_tests(tests, group_setup, group_teardown);
 }

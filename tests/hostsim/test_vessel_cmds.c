@@ -3,8 +3,11 @@
  * command (CmdVessels 0x085, CmdDoppler 0x086), end to end: the commands are signed
  * (sc_cmdsign, with their MACs at 0x08D / 0x08E) and sent through the host simulator's bus
  * while the probe rests on the neck-ijv phantom (the `cases` target), MSDS. Checked:
- *   - a CmdVessels with heart rate 108 / min (breathing off) makes the artery's image area
- *     oscillate at 1.8 Hz (largest DFT bin of 4 s at 60 Hz), one with 72 / min at 1.2 Hz;
+ *   - loaded, the case's own drive (its DRIV section: neck-ijv 60 / min, 12 breaths / min)
+ *     runs: the artery's image area oscillates at 1.0 Hz (issue 18 item 1, "in the case");
+ *   - a CmdVessels with heart rate 108 / min (breathing off) overrides it and makes the
+ *     artery's image area oscillate at 1.8 Hz (largest DFT bin of 4 s at 60 Hz), one with
+ *     72 / min at 1.2 Hz;
  *   - a CmdVessels with Valsalva held distends the vein (image area up >= 5%), released it
  *     comes back within 2%;
  *   - (probe rolled 20 degrees so that the beam has a component along the flow) a CmdDoppler
@@ -13,7 +16,8 @@
  *   - bad values reach the engine and are refused and counted (commands_refused): breathing
  *     2 / min (the lumen law takes 0 or 4..60) and a scale of 200 Hz under the 100 Hz wall
  *     filter (it must be <= PRF / 4); the previous settings stay;
- *   - the vessels' setting survives a case switch (the new tissue gets the commanded drive).
+ *   - a case switch applies the new case's drive (its DRIV replaces the commanded one), and
+ *     CmdVessels' "pulse on" takes the running case's pulse pressure.
  */
 #include "sc_test.h"
 
@@ -136,6 +140,21 @@ static void heart_rate_command_sets_the_arterys_pulse(void **state)
     const uint32_t hz = rig.engine.def.sched.rate_hz;
     const uint32_t n = 4u * hz;
     assert_true(n <= MAX_SAMPLES);
+    /* the case's drive first: neck-ijv's DRIV says 60 / min */
+    {
+        const sc_case_drive *cd = &rig.engine.slot.c.drive;
+        const sc_lumen_drive *dr = &sc_test_press_tissue(&rig)->lumen.drive;
+        assert_int_equal(cd->present, 1u);
+        assert_float_equal(cd->d.heart_rate_bpm, 60.0f, 0.0f);
+        assert_float_equal(dr->heart_rate_bpm, cd->d.heart_rate_bpm, 0.0f);
+        assert_float_equal(dr->resp_rate_bpm, cd->d.resp_rate_bpm, 0.0f);
+        record(hz, SC_LABEL_ARTERY, NULL); /* settle */
+        record(n, SC_LABEL_ARTERY, series);
+        const double f = sc_test_peak_hz(series, n, 1.0 / hz);
+        print_message("case drive %.0f / min: artery image area peak at %.3f Hz (set %.3f Hz)\n",
+                      (double)cd->d.heart_rate_bpm, f, (double)cd->d.heart_rate_bpm / 60.0);
+        assert_true(fabs(f - (double)cd->d.heart_rate_bpm / 60.0) <= 0.125 + 1e-9);
+    }
     const float bpm[2] = {108.0f, 72.0f};
     for (int i = 0; i < 2; i++) {
         assert_int_equal(send_vessels(bpm[i], 0.0f, 0u, 1u), 1);
@@ -229,11 +248,18 @@ static void bad_values_are_refused_and_counted(void **state)
     assert_true(rig.engine.counters.commands_refused == refused + 2u);
     print_message("refused and counted: breathing 2 / min, PRF 200 Hz (commands_refused %llu)\n",
                   (unsigned long long)rig.engine.counters.commands_refused);
-    /* the setting survives a case switch: the new tissue gets the commanded drive */
-    assert_int_equal(sc_engine_load_case(&rig.engine, "neck-ijv.scase"), SC_OK);
+    /* a case switch applies the new case's drive (femoral's DRIV: 78 / min, 16 breaths, 6 kPa),
+     * replacing the commanded one; a command then overrides it again */
+    assert_int_equal(sc_engine_load_case(&rig.engine, "femoral.scase"), SC_OK);
     const sc_lumen_drive *dr = &sc_test_press_tissue(&rig)->lumen.drive;
+    assert_float_equal(dr->heart_rate_bpm, 78.0f, 0.0f);
+    assert_float_equal(dr->resp_rate_bpm, 16.0f, 0.0f);
+    assert_float_equal(dr->pulse_pa, 6.0e3f, 0.0f);
+    assert_int_equal(send_vessels(90.0f, 12.0f, 0u, 1u), 1);
+    dr = &sc_test_press_tissue(&rig)->lumen.drive;
     assert_float_equal(dr->heart_rate_bpm, 90.0f, 0.0f);
     assert_float_equal(dr->resp_rate_bpm, 12.0f, 0.0f);
+    assert_float_equal(dr->pulse_pa, 6.0e3f, 0.0f); /* "pulse on": the case's pulse pressure */
 }
 
 int main(void)

@@ -7,6 +7,7 @@
 
 #include "sc_assess.h"
 #include "sc_err.h"
+#include "sc_labels.h"
 
 static sc_assess a;
 
@@ -47,7 +48,7 @@ static void defaults_are_valid_and_bad_definitions_are_refused(void **state)
     d.force_max_n = d.firm_force_n * 0.5f;
     assert_int_equal(sc_assess_def_validate(&d), SC_ERR_RANGE);
     d = sc_assess_default_def();
-    memset(d.points, 200, sizeof d.points); /* 1000 points do not fit the score */
+    memset(d.points, 200, sizeof d.points); /* 1200 points do not fit the score */
     assert_int_equal(sc_assess_def_validate(&d), SC_ERR_RANGE);
     sc_assess x;
     assert_int_equal(sc_assess_init(&x, &d), SC_ERR_RANGE);
@@ -59,7 +60,8 @@ static void an_empty_exam_scores_nothing_and_says_not_available(void **state)
     const sc_assess_report *r = sc_assess_get(&a);
     assert_int_equal(r->version, SC_ASSESS_REPORT_VERSION);
     assert_int_equal(r->score, 0);
-    assert_int_equal(r->score_max, 8);
+    assert_int_equal(r->score_max, 10);
+    assert_int_equal(r->revision, SC_ASSESS_REPORT_REVISION);
     assert_int_equal(r->criteria_met, 0);
     for (int v = 0; v < (int)SC_ASSESS_VESSELS; v++) {
         assert_true(r->vessel[v].min_ratio < 0.0f);
@@ -107,7 +109,8 @@ static void the_vein_imaged_criterion_needs_min_view_frames(void **state)
     assert_false(met(SC_ASSESS_CRIT_VEIN_IMAGED));
     frame(1u, 0.9f, 1.0f, -1.0f, 1.0f);
     assert_true(met(SC_ASSESS_CRIT_VEIN_IMAGED));
-    assert_int_equal(sc_assess_get(&a)->score, 1 + 1 + 1); /* imaged, artery spared, force */
+    /* imaged, artery spared, force safe, no arterial puncture */
+    assert_int_equal(sc_assess_get(&a)->score, 1 + 1 + 1 + 2);
 }
 
 static void coaptation_meets_the_compression_criterion(void **state)
@@ -198,12 +201,14 @@ static void a_full_normal_exam_scores_every_point_and_reset_clears_it(void **sta
     }
     assert_int_equal(sc_assess_set_call(&a, SC_ASSESS_CALL_NORMAL), SC_OK);
     const sc_assess_report *r = sc_assess_get(&a);
-    assert_int_equal(r->criteria_met, 0x1F);
+    assert_int_equal(r->criteria_met, 0x3F);
     assert_int_equal(r->score, r->score_max);
     uint32_t sum = 0;
     for (int c = 0; c < (int)SC_ASSESS_CRITERIA; c++) {
-        sum += r->points[c];
+        sum += sc_assess_report_points(r, (uint32_t)c);
     }
+    assert_int_equal(sc_assess_report_points(r, SC_ASSESS_CRIT_NO_ARTERY_PUNCTURE), 2);
+    assert_int_equal(sc_assess_report_points(r, 99u), 0);
     assert_int_equal(sum, r->score_max);
     /* the CAN message carries the same */
     sc_assess_msg m;
@@ -223,10 +228,61 @@ static void a_full_normal_exam_scores_every_point_and_reset_clears_it(void **sta
     assert_string_equal(sc_assess_criterion_name(SC_ASSESS_CRITERIA), "?");
 }
 
+static void puncture(uint8_t label)
+{
+    const sc_assess_in in = {.contact = 0u, .area_ratio = {-1.0f, -1.0f, -1.0f},
+                             .force_n = -1.0f, .puncture = label};
+    sc_assess_update(&a, &in);
+}
+
+/* issue 18 item 3: an arterial puncture is a fault of the exam; a vein puncture is not */
+static void arterial_puncture_fails_its_criterion_vein_puncture_does_not(void **state)
+{
+    (void)state;
+    assert_int_equal(sc_assess_begin_case(&a, SC_ASSESS_CALL_NORMAL), SC_OK);
+    for (int i = 0; i < 10; i++) {
+        frame(1u, 0.9f, 0.95f, -1.0f, 2.0f);
+    }
+    const sc_assess_report *r = sc_assess_get(&a);
+    assert_true(met(SC_ASSESS_CRIT_NO_ARTERY_PUNCTURE)); /* imaged, no puncture */
+    const uint8_t before = r->score;
+    puncture((uint8_t)SC_LABEL_VEIN);
+    assert_int_equal(r->vein_punctures, 1);
+    assert_int_equal(r->artery_punctures, 0);
+    assert_true(met(SC_ASSESS_CRIT_NO_ARTERY_PUNCTURE));
+    assert_int_equal(r->score, before);
+    puncture((uint8_t)SC_LABEL_ARTERY);
+    assert_int_equal(r->artery_punctures, 1);
+    assert_false(met(SC_ASSESS_CRIT_NO_ARTERY_PUNCTURE));
+    assert_int_equal(r->score, before - 2);
+    /* another label or none is not a puncture; the count saturates */
+    puncture((uint8_t)SC_LABEL_MUSCLE);
+    puncture(0u);
+    assert_int_equal(r->artery_punctures, 1);
+    assert_int_equal(r->vein_punctures, 1);
+    for (int i = 0; i < 300; i++) {
+        puncture((uint8_t)SC_LABEL_ARTERY);
+    }
+    assert_int_equal(r->artery_punctures, 255);
+    sc_assess_msg m;
+    sc_assess_to_msg(r, &m);
+    assert_int_equal(m.artery_punctured, 1);
+    assert_int_equal(m.vein_punctured, 1);
+    assert_int_equal(m.criteria_met & (1u << SC_ASSESS_CRIT_NO_ARTERY_PUNCTURE), 0);
+    /* the reset forgets the punctures */
+    sc_assess_reset(&a);
+    assert_int_equal(r->artery_punctures, 0);
+    assert_int_equal(r->vein_punctures, 0);
+    assert_string_equal(sc_assess_criterion_name(SC_ASSESS_CRIT_NO_ARTERY_PUNCTURE),
+                        "no_artery_puncture");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup(defaults_are_valid_and_bad_definitions_are_refused, setup),
+        cmocka_unit_test_setup(arterial_puncture_fails_its_criterion_vein_puncture_does_not,
+                               setup),
         cmocka_unit_test_setup(an_empty_exam_scores_nothing_and_says_not_available, setup),
         cmocka_unit_test_setup(the_deepest_compression_and_its_force_are_kept, setup),
         cmocka_unit_test_setup(the_vein_imaged_criterion_needs_min_view_frames, setup),

@@ -116,7 +116,11 @@ static void assessment_record_has_the_documented_layout(void **state)
     r.criteria_met = 0x0Fu;
     r.points[4] = 3u;
     r.score = 5u;
-    r.score_max = 8u;
+    r.score_max = 10u;
+    r.artery_punctures = 2u;
+    r.vein_punctures = 1u;
+    r.puncture_points = 2u;
+    r.revision = SC_ASSESS_REPORT_REVISION;
     sc_state_in in = base_in(1000000000u);
     in.assess = &r;
     assert_int_equal(sc_state_emit(&g_tx, &dev, &in), 2u); /* FRAME, ASSESSMENT */
@@ -135,7 +139,13 @@ static void assessment_record_has_the_documented_layout(void **state)
     assert_int_equal(p[91], 0x0Fu);
     assert_int_equal(p[96], 3u);
     assert_int_equal(p[97], 5u);
-    assert_int_equal(p[98], 8u);
+    assert_int_equal(p[98], 10u);
+    /* revision 1: the needle's punctures in formerly reserved bytes */
+    assert_int_equal(p[99], 2u);
+    assert_int_equal(p[100], 1u);
+    assert_int_equal(p[101], 2u);
+    assert_int_equal(p[102], SC_ASSESS_REPORT_REVISION);
+    assert_int_equal(p[103], 0u);
 }
 
 /* The MATERIAL record: the running tissue's rows, the solver parameters, the counters. */

@@ -79,7 +79,8 @@ static int usage(void)
     return 2;
 }
 
-static int write_case_file(const sc_case_def *def, const char *path)
+/* drive: the case's DRIV section (the patient's vessel drive), NULL for none */
+static int write_case_file(const sc_case_def *def, const sc_lumen_drive *drive, const char *path)
 {
     size_t need = sc_case_encoded_size(def);
     if (need == 0u) {
@@ -103,16 +104,25 @@ static int write_case_file(const sc_case_def *def, const char *path)
         uint8_t *surf = NULL;
         size_t surf_n = 0;
         rc = sc_casesurf_build(def, &surf, &surf_n);
-        uint8_t *grown = rc == SC_OK ? realloc(buf, need + surf_n + 2u * SC_CASE_ALIGN) : NULL;
+        uint8_t *grown = rc == SC_OK ? realloc(buf, need + surf_n + 4u * SC_CASE_ALIGN) : NULL;
         if (rc == SC_OK && grown == NULL) {
             rc = SC_ERR_NO_SPACE;
         }
         if (rc == SC_OK) {
             buf = grown;
-            rc = sc_case_append_section(buf, need + surf_n + 2u * SC_CASE_ALIGN, &n,
+            rc = sc_case_append_section(buf, need + surf_n + 4u * SC_CASE_ALIGN, &n,
                                         SC_CASE_TAG_SURF_U32, surf, surf_n);
         }
         free(surf);
+        if (rc == SC_OK && drive != NULL) {
+            /* the patient's drive (DRIV), into the spare room of the buffer above */
+            uint8_t dp[SC_CASE_DRIVE_SIZE];
+            rc = sc_case_drive_encode(drive, dp);
+            if (rc == SC_OK) {
+                rc = sc_case_append_section(buf, need + surf_n + 4u * SC_CASE_ALIGN, &n,
+                                            SC_CASE_TAG_DRIV_U32, dp, sizeof dp);
+            }
+        }
         if (rc == SC_OK) {
             sc_case c;
             rc = sc_case_load(buf, n, &c);
@@ -216,6 +226,16 @@ static int cmd_info(int argc, char **argv)
     print_xform("image -> probe", &c.image_to_probe);
     print_xform("tracker -> patient", &c.tracker_to_patient);
     print_xform("tracker -> volume", &c.tracker_to_volume);
+    if (c.drive.present) {
+        const sc_lumen_drive *d = &c.drive.d;
+        printf("vessel drive           heart %.0f / min, pulse %.1f kPa, %s waveform, breathing "
+               "%.0f / min, venous swing %.2f kPa, Valsalva %.1f kPa\n",
+               (double)d->heart_rate_bpm, (double)d->pulse_pa * 1e-3,
+               d->wave == (uint8_t)SC_LUMEN_WAVE_SINE ? "sine" : "arterial",
+               (double)d->resp_rate_bpm, (double)d->resp_pa * 1e-3, (double)d->valsalva_pa * 1e-3);
+    } else {
+        printf("vessel drive           none (the engine's)\n");
+    }
     uint64_t hist[SC_MAX_LABELS];
     sc_case_label_histogram(&c, hist);
     uint64_t ihist[256] = {0};
@@ -402,7 +422,11 @@ static int cmd_phantom(int argc, char **argv)
         p.def.mesh.ny = mesh_nodes[1];
         p.def.mesh.nz = mesh_nodes[2];
     }
-    rc = write_case_file(&p.def, out);
+    sc_lumen_drive drive;
+    rc = sc_phantom_drive(pd.kind, &drive);
+    if (rc == SC_OK) {
+        rc = write_case_file(&p.def, &drive, out);
+    }
     sc_phantom_free(&p);
     return rc;
 }
@@ -559,7 +583,7 @@ static int cmd_import(int argc, char **argv)
         return 1;
     }
     print_import(out, &r);
-    rc = write_case_file(&r.def, out);
+    rc = write_case_file(&r.def, NULL, out);
     sc_import_result_free(&r);
     return rc;
 }
@@ -685,7 +709,7 @@ static int cmd_reconstruct(int argc, char **argv)
         return 1;
     }
     print_import(out, &r);
-    rc = write_case_file(&r.def, out);
+    rc = write_case_file(&r.def, NULL, out);
     sc_import_result_free(&r);
     return rc;
 }

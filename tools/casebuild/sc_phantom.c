@@ -573,3 +573,34 @@ int sc_phantom_generate(const sc_phantom_def *pd, sc_phantom *out)
     d->tracker_to_patient.r[8] = -1.0f;
     return SC_OK;
 }
+
+int sc_phantom_drive(sc_phantom_kind kind, sc_lumen_drive *out)
+{
+    if (out == NULL || (unsigned)kind >= (unsigned)SC_PHANTOM_KIND_COUNT) {
+        return SC_ERR_INVALID_ARG;
+    }
+    sc_lumen_drive d = sc_lumen_drive_default(); /* 72 / min, 40 mmHg, arterial, 15 / min */
+    switch (kind) {
+    case SC_PHANTOM_NECK_IJV: /* a resting adult: 60 / min, 40 mmHg, 12 breaths / min */
+        d.heart_rate_bpm = 60.0f;
+        d.resp_rate_bpm = 12.0f;
+        break;
+    case SC_PHANTOM_FEMORAL: /* 78 / min, 45 mmHg (6.0 kPa), 16 breaths / min, smaller venous
+                              * swing far from the thorax */
+        d.heart_rate_bpm = 78.0f;
+        d.pulse_pa = 6.0e3f;
+        d.resp_rate_bpm = 16.0f;
+        d.resp_pa = 0.3e3f;
+        break;
+    case SC_PHANTOM_FEMORAL_DVT: /* tachycardic (96 / min), 35 mmHg, 20 breaths / min */
+        d.heart_rate_bpm = 96.0f;
+        d.pulse_pa = 4.7e3f;
+        d.resp_rate_bpm = 20.0f;
+        d.resp_pa = 0.3e3f;
+        break;
+    case SC_PHANTOM_KIND_COUNT:
+        return SC_ERR_INVALID_ARG;
+    }
+    *out = d;
+    return SC_OK;
+}

@@ -62,6 +62,11 @@ sc_phantom_def sc_phantom_default_def(void);
 /* Kind from its case name ("neck-ijv", "femoral", "femoral-dvt"); -1 when unknown. */
 int sc_phantom_kind_from_name(const char *name);
 const char *sc_phantom_kind_name(sc_phantom_kind kind);
+/* The phantom's patient drive (its DRIV section, sc_case_drive.h): a plausible, different
+ * heart rate per case (neck-ijv 60 / min, femoral 78 / min, femoral-dvt 96 / min: the DVT
+ * patient is tachycardic), pulse pressure, arterial waveform, breathing and venous swing.
+ * SC_ERR_INVALID_ARG for an unknown kind or NULL. */
+int sc_phantom_drive(sc_phantom_kind kind, sc_lumen_drive *out);
 
 /* Generate a phantom. O(voxels). Allocates the voxel and label arrays (free with
  * sc_phantom_free). Errors: SC_ERR_INVALID_ARG (kind, spacing), SC_ERR_NO_SPACE (malloc). */
