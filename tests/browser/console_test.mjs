@@ -396,6 +396,8 @@ if (scenario === 'sessions') {
   const a = await page.evaluate(() => window.sc.assessment);
   if (!((a.met >> 4) & 1)) await fail(`the correct call "normal" on a normal case did not score (criteria 0x${a.met.toString(16)})`);
   if (!(a.vessels[0].inView > 0 && a.vessels[0].min < 0.3)) await fail(`the assessment missed the press: vein ${JSON.stringify(a.vessels[0])}`);
+  if (a.revision !== 1 || a.points.length !== 6 || a.arteryPunctures !== 0)
+    await fail(`the page did not read the record's revision 1 (criterion 5, punctures): ${JSON.stringify(a)}`);
   ok(`assessment: score ${a.score}/${a.scoreMax}, vein min ratio ${a.vessels[0].min.toFixed(3)}, call ${a.call} scored`);
   await page.evaluate(() => window.scNormalView());
 } else {

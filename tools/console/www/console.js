@@ -331,7 +331,8 @@ function onTris(dv, p) {
 }
 
 // ASSESSMENT: the engine's exam record (docs/assessment.md, 104 bytes little-endian)
-const CRITERIA = ['vein imaged', 'compressed', 'artery spared', 'force safe', 'call correct'];
+const CRITERIA = ['vein imaged', 'compressed', 'artery spared', 'force safe', 'call correct',
+                  'no arterial puncture'];
 const CALLS = ['none', 'normal', 'DVT'];
 function onAssessment(dv, p) {
   if (dv.byteLength < p + 104 || dv.getUint32(p, true) !== 1) return;
@@ -346,11 +347,17 @@ function onAssessment(dv, p) {
     finding: CALLS[dv.getUint8(p + 90)] ?? '?', met: dv.getUint8(p + 91),
     points: [0, 1, 2, 3, 4].map((i) => dv.getUint8(p + 92 + i)),
     score: dv.getUint8(p + 97), scoreMax: dv.getUint8(p + 98),
+    // revision 1 (byte 102): the needle's punctures and criterion 5 in bytes 99..101
+    revision: dv.getUint8(p + 102), arteryPunctures: dv.getUint8(p + 99),
+    veinPunctures: dv.getUint8(p + 100),
   };
+  if (a.revision >= 1) a.points.push(dv.getUint8(p + 101));
   sc.assessment = a;
   $('assessment').hidden = false;
   const lines = [`score ${a.score}/${a.scoreMax}`];
-  CRITERIA.forEach((c, i) => lines.push(`${(a.met >> i) & 1 ? '\u2713' : '\u2717'} ${c} (${a.points[i]})`));
+  a.points.forEach((pts, i) => lines.push(`${(a.met >> i) & 1 ? '\u2713' : '\u2717'} ${CRITERIA[i]} (${pts})`));
+  if (a.revision >= 1 && a.arteryPunctures + a.veinPunctures > 0)
+    lines.push(`needle: ${a.veinPunctures} vein, ${a.arteryPunctures} arterial puncture(s)`);
   for (const v of ves) {
     if (v.inView > 0) lines.push(`${v.name}: min ratio ${v.min.toFixed(3)}${v.coapted ? ' (coapted)' : ''}` +
                                  (v.force >= 0 ? ` at ${v.force.toFixed(1)} N` : ''));
