@@ -273,9 +273,19 @@ int bench_contact_walker(const char *cases_dir, const char *case_name, int frame
     for (size_t i = 0; i < nb; i++) {
         h = (h ^ g_keep[i]) * 16777619u;
     }
+    /* and of the label areas (the compression measure): their float bits */
+    uint32_t ha = 2166136261u;
+    for (uint32_t i = 0; i < SC_LABEL_COUNT; i++) {
+        uint32_t w[2];
+        memcpy(&w[0], &e->bscan.status.area_now_mm2[i], 4);
+        memcpy(&w[1], &e->bscan.status.area_rest_mm2[i], 4);
+        for (uint32_t q = 0; q < 2u; q++) {
+            ha = (ha ^ w[q]) * 16777619u;
+        }
+    }
     printf("contact-walker: %s, %d walker frames at the deepest point (mapper %u, acoustics %u), "
-           "fold relocations %u per frame, image hash %08x\n",
+           "fold relocations %u per frame, image hash %08x, areas hash %08x\n",
            case_name, frames, e->bscan.def.mapper, e->bscan.def.acoustics,
-           (e->bscan.status.walk_relocations - rel0) / (uint32_t)(frames > 0 ? frames : 1), h);
+           (e->bscan.status.walk_relocations - rel0) / (uint32_t)(frames > 0 ? frames : 1), h, ha);
     return 0;
 }
