@@ -154,6 +154,35 @@ int sc_bscan_init(sc_bscan *b, const sc_bscan_def *def)
     return sc_bscan_set_def(b, def);
 }
 
+/* 1 when the mesh has sc_mesh_build's layout: nx * ny * nz nodes numbered i + nx (j + ny k),
+ * nx at most 64 (a row of nodes fits a 64-bit mask), tets 5 c .. 5 c + 4 of cell
+ * c = i + (nx - 1) (j + (ny - 1) k) with their vertices among the cell's corners. */
+static uint32_t mesh_is_grid(const sc_mesh *m)
+{
+    const uint32_t nx = m->nx, ny = m->ny, nz = m->nz;
+    if (nx < 2u || ny < 2u || nz < 2u || nx > 64u || nx > SC_MAX_MESH_NX ||
+        ny > SC_MAX_MESH_NY || nz > SC_MAX_MESH_NZ || m->node_count != nx * ny * nz ||
+        m->tet_count != 5u * (nx - 1u) * (ny - 1u) * (nz - 1u)) {
+        return 0u;
+    }
+    for (uint32_t t = 0; t < m->tet_count; t++) {
+        const uint32_t c = t / 5u;
+        const uint32_t ci = c % (nx - 1u), cj = (c / (nx - 1u)) % (ny - 1u),
+                       ck = c / ((nx - 1u) * (ny - 1u));
+        for (uint32_t v = 0; v < 4u; v++) {
+            const uint32_t n = m->tet[t][v];
+            if (n >= m->node_count) {
+                return 0u;
+            }
+            const uint32_t i = n % nx, j = (n / nx) % ny, k = n / (nx * ny);
+            if (i - ci > 1u || j - cj > 1u || k - ck > 1u) { /* unsigned: also below */
+                return 0u;
+            }
+        }
+    }
+    return 1u;
+}
+
 int sc_bscan_attach_mesh(sc_bscan *b, const sc_mesh *mesh)
 {
     if (b == NULL || mesh == NULL || mesh->tet_count > SC_MAX_TETS) {
@@ -176,6 +205,7 @@ int sc_bscan_attach_mesh(sc_bscan *b, const sc_mesh *mesh)
     }
     b->hull_count = n;
     b->mesh_tets = mesh->tet_count;
+    b->mesh_grid = mesh_is_grid(mesh);
     return SC_OK;
 }
 
@@ -248,24 +278,43 @@ static inline void emit_run(sc_bscan *b, uint32_t k0, uint32_t k1, const float a
 /* Barycentric coordinates of a tet in the image frame as affine functions of the point:
  * lambda_i(p) = alpha[i] + g[i] . p. Returns 1 for a positively oriented tet, -1 for an
  * inverted one (still a valid point location), 0 for a degenerate (flat) one. */
-static int tet_affine(const sc_bscan *b, const uint32_t tv[4], float alpha[4], float g[4][3])
+/* The edges from vertex 0, the rows of the adjugate of [e1 e2 e3] ((e2 x e3, e3 x e1, e1 x e2))
+ * and the determinant: tet_affine's first part, also the region bins' orientation test. */
+static inline float tet_edges_det(const sc_bscan *b, const uint32_t tv[4], float e[3][3],
+                                  float r[3][3])
 {
     const float x0 = b->qx[tv[0]], y0 = b->qy[tv[0]], z0 = b->qz[tv[0]];
-    float e[3][3];
     for (uint32_t i = 0; i < 3u; i++) {
         e[i][0] = b->qx[tv[i + 1u]] - x0;
         e[i][1] = b->qy[tv[i + 1u]] - y0;
         e[i][2] = b->qz[tv[i + 1u]] - z0;
     }
-    /* rows of the inverse of [e1 e2 e3]: (e2 x e3, e3 x e1, e1 x e2) / det */
-    float r[3][3];
     for (uint32_t i = 0; i < 3u; i++) {
         const float *a = e[(i + 1u) % 3u], *c = e[(i + 2u) % 3u];
         r[i][0] = a[1] * c[2] - a[2] * c[1];
         r[i][1] = a[2] * c[0] - a[0] * c[2];
         r[i][2] = a[0] * c[1] - a[1] * c[0];
     }
-    const float det = e[0][0] * r[0][0] + e[0][1] * r[0][1] + e[0][2] * r[0][2];
+    return e[0][0] * r[0][0] + e[0][1] * r[0][1] + e[0][2] * r[0][2];
+}
+
+/* The orientation tet_affine returns, without the maps. */
+static int tet_orient(const sc_bscan *b, const uint32_t tv[4])
+{
+    float e[3][3], r[3][3];
+    const float det = tet_edges_det(b, tv, e, r);
+    if (!(fabsf(det) > 1e-12f)) {
+        return 0;
+    }
+    return det > 0.0f ? 1 : -1;
+}
+
+static int tet_affine(const sc_bscan *b, const uint32_t tv[4], float alpha[4], float g[4][3])
+{
+    const float x0 = b->qx[tv[0]], y0 = b->qy[tv[0]], z0 = b->qz[tv[0]];
+    /* rows of the inverse of [e1 e2 e3]: (e2 x e3, e3 x e1, e1 x e2) / det */
+    float e[3][3], r[3][3];
+    const float det = tet_edges_det(b, tv, e, r);
     if (!(fabsf(det) > 1e-12f)) {
         return 0;
     }
@@ -468,8 +517,8 @@ static const sc_bscan_tcache *tet_cached(sc_bscan *b, const sc_mesh *m, uint32_t
 }
 
 static int build_regions(sc_bscan *b, const sc_mesh *m);
-static void map_line_regions(sc_bscan *b, uint32_t l, const frame_ctx *c);
-static int32_t locate_deepest(const sc_bscan *b, uint32_t r, float x, float z);
+static void map_line_regions(sc_bscan *b, const sc_mesh *m, uint32_t l, const frame_ctx *c);
+static int32_t locate_deepest(sc_bscan *b, const sc_mesh *m, uint32_t r, float x, float z);
 static void fill_run(sc_bscan *b, const frame_ctx *c, uint32_t ta, uint32_t a, uint32_t z);
 static uint32_t region_of_line(uint32_t l, uint32_t lines, uint32_t regions);
 
@@ -493,7 +542,7 @@ static int relocate(sc_bscan *b, const sc_mesh *m, const frame_ctx *c, uint32_t 
     const uint32_t r = region_of_line(c->line, b->def.scan.lines_n, b->def.regions_n);
     for (uint32_t kk = ks < *k ? *k : ks; kk < c->n; kk++) {
         const int32_t pi =
-            locate_deepest(b, r, c->ox + (float)kk * c->dx, c->oz + (float)kk * c->dz);
+            locate_deepest(b, m, r, c->ox + (float)kk * c->dx, c->oz + (float)kk * c->dz);
         if (pi < 0) {
             *s_out = (float)kk;
             return 0;
@@ -655,7 +704,7 @@ static void map_line_walk(sc_bscan *b, const sc_mesh *m, uint32_t l, uint32_t *a
         }
         if (b->regions_state == 1u) {
             b->run_count = 0u;
-            map_line_regions(b, l, c);
+            map_line_regions(b, m, l, c);
             b->status.line_fallbacks++;
         } else {
             b->status.region_overflows++;
@@ -670,66 +719,162 @@ static uint32_t region_of_line(uint32_t l, uint32_t lines, uint32_t regions)
     return (l * regions) / lines;
 }
 
+/* sc_bscan_ptet.tet: the maps (lam, rest) not computed yet */
+#define SC_PTET_PENDING 0x80000000u
+_Static_assert(SC_MAX_TETS < SC_PTET_PENDING, "tet indices leave the pending bit free");
+
+/* The maps of a plane tet, computed on its first point test: most plane tets are never tested
+ * (the walker relocates on a few lines); the same function of the same inputs as when they
+ * were computed for every plane tet, so the same values. */
+static void ptet_ready(sc_bscan *b, const sc_mesh *m, sc_bscan_ptet *p)
+{
+    if ((p->tet & SC_PTET_PENDING) == 0u) {
+        return;
+    }
+    const uint32_t t = p->tet & ~SC_PTET_PENDING;
+    const uint32_t *tv = m->tet[t];
+    float al[4], g[4][3];
+    (void)tet_affine(b, tv, al, g); /* not flat: add_plane_tet checked */
+    for (uint32_t i = 0; i < 4u; i++) {
+        p->lam[i][0] = al[i];
+        p->lam[i][1] = g[i][0];
+        p->lam[i][2] = g[i][2];
+    }
+    for (uint32_t j = 0; j < 3u; j++) {
+        p->rest[0][j] = 0.0f;
+        p->rest[1][j] = 0.0f;
+        p->rest[2][j] = 0.0f;
+        for (uint32_t i = 0; i < 4u; i++) {
+            p->rest[0][j] += p->lam[i][j] * m->rest_x[tv[i]];
+            p->rest[1][j] += p->lam[i][j] * m->rest_y[tv[i]];
+            p->rest[2][j] += p->lam[i][j] * m->rest_z[tv[i]];
+        }
+    }
+    p->tet = t;
+}
+
+/* fminf and fmaxf without the libm call (the portable x86-64 build does not inline them):
+ * a NaN argument gives the other one, as theirs; among equal values (+0, -0) either, which
+ * the comparisons these boxes serve do not tell apart. */
+static inline float min_f(float a, float b)
+{
+    return (b < a || isnan(a)) ? b : a;
+}
+static inline float max_f(float a, float b)
+{
+    return (b > a || isnan(a)) ? b : a;
+}
+
+/* Index of the lowest set bit of x != 0. */
+static inline uint32_t sc_ctz64(uint64_t x)
+{
+#if defined(__GNUC__)
+    return (uint32_t)__builtin_ctzll(x);
+#else
+    uint32_t n = 0;
+    while ((x & 1u) == 0u) {
+        x >>= 1;
+        n++;
+    }
+    return n;
+#endif
+}
+
+/* Tet t into the plane tets when the plane cuts it (not flat, in front of some line): 0 when
+ * the plane tets are over their limit. */
+static int add_plane_tet(sc_bscan *b, const sc_mesh *m, uint32_t t, uint32_t *np_io)
+{
+    const uint32_t np = *np_io;
+    const uint32_t *tv = m->tet[t];
+    uint32_t pos = 0;
+    for (uint32_t v = 0; v < 4u; v++) {
+        pos += (uint32_t)(b->qy[tv[v]] > 0.0f);
+    }
+    if (pos == 0u || pos == 4u) {
+        /* all on one side; a tet with a face in the plane (three y = 0, one < 0) counts
+         * through its neighbour on the other side */
+        return 1;
+    }
+    const int orient = tet_orient(b, tv);
+    if (orient == 0) {
+        return 1;
+    }
+    float xmin = b->qx[tv[0]], xmax = xmin, zmin = b->qz[tv[0]], zmax = zmin;
+    for (uint32_t v = 1; v < 4u; v++) {
+        xmin = min_f(xmin, b->qx[tv[v]]);
+        xmax = max_f(xmax, b->qx[tv[v]]);
+        zmin = min_f(zmin, b->qz[tv[v]]);
+        zmax = max_f(zmax, b->qz[tv[v]]);
+    }
+    int32_t lo, hi;
+    if (!sc_scan_geom_line_range(&b->geom, xmin, xmax, zmin, zmax, &lo, &hi)) {
+        return 1;
+    }
+    if (np >= SC_BSCAN_MAX_PLANE_TETS) {
+        return 0;
+    }
+    sc_bscan_ptet *p = &b->ptets[np];
+    p->tet = t | SC_PTET_PENDING; /* the maps when a point is first tested (ptet_ready) */
+    p->orient = orient;
+    p->xmin = xmin;
+    p->xmax = xmax;
+    p->zmin = zmin;
+    p->zmax = zmax;
+    b->ptet_lo[np] = lo;
+    b->ptet_hi[np] = hi;
+    *np_io = np + 1u;
+    return 1;
+}
+
 /* Returns 0 when the path's limits are exceeded (the caller then walks this frame). */
 static int build_regions(sc_bscan *b, const sc_mesh *m)
 {
     const uint32_t lines = b->def.scan.lines_n, regions = b->def.regions_n;
     uint32_t np = 0;
-    for (uint32_t t = 0; t < m->tet_count; t++) {
-        const uint32_t *tv = m->tet[t];
-        uint32_t pos = 0;
-        for (uint32_t v = 0; v < 4u; v++) {
-            pos += (uint32_t)(b->qy[tv[v]] > 0.0f);
-        }
-        if (pos == 0u || pos == 4u) {
-            /* all on one side; a tet with a face in the plane (three y = 0, one < 0) counts
-             * through its neighbour on the other side */
-            continue;
-        }
-        float al[4], g[4][3];
-        const int orient = tet_affine(b, tv, al, g);
-        if (orient == 0) {
-            continue;
-        }
-        float xmin = b->qx[tv[0]], xmax = xmin, zmin = b->qz[tv[0]], zmax = zmin;
-        for (uint32_t v = 1; v < 4u; v++) {
-            xmin = fminf(xmin, b->qx[tv[v]]);
-            xmax = fmaxf(xmax, b->qx[tv[v]]);
-            zmin = fminf(zmin, b->qz[tv[v]]);
-            zmax = fmaxf(zmax, b->qz[tv[v]]);
-        }
-        int32_t lo, hi;
-        if (!sc_scan_geom_line_range(&b->geom, xmin, xmax, zmin, zmax, &lo, &hi)) {
-            continue;
-        }
-        if (np >= SC_BSCAN_MAX_PLANE_TETS) {
-            return 0;
-        }
-        sc_bscan_ptet *p = &b->ptets[np];
-        for (uint32_t i = 0; i < 4u; i++) {
-            p->lam[i][0] = al[i];
-            p->lam[i][1] = g[i][0];
-            p->lam[i][2] = g[i][2];
-        }
-        for (uint32_t j = 0; j < 3u; j++) {
-            p->rest[0][j] = 0.0f;
-            p->rest[1][j] = 0.0f;
-            p->rest[2][j] = 0.0f;
-            for (uint32_t i = 0; i < 4u; i++) {
-                p->rest[0][j] += p->lam[i][j] * m->rest_x[tv[i]];
-                p->rest[1][j] += p->lam[i][j] * m->rest_y[tv[i]];
-                p->rest[2][j] += p->lam[i][j] * m->rest_z[tv[i]];
+    if (b->mesh_grid) {
+        /* the cells with corners on both sides of the plane, found from 64-bit masks of the
+         * node rows (bit i: y > 0), two layers of rows at a time: O(nodes) plus the cut cells'
+         * tets instead of a pass over every tet; the same tets in the same (ascending) order,
+         * as a tet cut by the plane has its corners among its cell's */
+        const uint32_t nx = m->nx, ny = m->ny, nz = m->nz;
+        uint64_t rows[2][SC_MAX_MESH_NY];
+        const uint64_t cells_x = ((uint64_t)1 << (nx - 1u)) - 1u; /* nx <= 64 */
+        for (uint32_t k = 0; k < nz; k++) {
+            uint64_t *cur = rows[k & 1u];
+            for (uint32_t j = 0; j < ny; j++) {
+                const float *qy = &b->qy[nx * (j + ny * k)];
+                uint64_t mk = 0;
+                for (uint32_t i = 0; i < nx; i++) {
+                    mk |= (uint64_t)(qy[i] > 0.0f) << i;
+                }
+                cur[j] = mk;
+            }
+            if (k == 0u) {
+                continue;
+            }
+            const uint64_t *prev = rows[(k - 1u) & 1u];
+            for (uint32_t j = 0; j + 1u < ny; j++) {
+                const uint64_t any = prev[j] | prev[j + 1u] | cur[j] | cur[j + 1u];
+                const uint64_t all = prev[j] & prev[j + 1u] & cur[j] & cur[j + 1u];
+                uint64_t cut = (any | (any >> 1)) & ~(all & (all >> 1)) & cells_x;
+                const uint32_t c0 = (nx - 1u) * (j + (ny - 1u) * (k - 1u));
+                while (cut != 0u) {
+                    const uint32_t i = sc_ctz64(cut);
+                    cut &= cut - 1u;
+                    for (uint32_t t = 5u * (c0 + i); t < 5u * (c0 + i) + 5u; t++) {
+                        if (!add_plane_tet(b, m, t, &np)) {
+                            return 0;
+                        }
+                    }
+                }
             }
         }
-        p->tet = t;
-        p->orient = orient;
-        p->xmin = xmin;
-        p->xmax = xmax;
-        p->zmin = zmin;
-        p->zmax = zmax;
-        b->ptet_lo[np] = lo;
-        b->ptet_hi[np] = hi;
-        np++;
+    } else {
+        for (uint32_t t = 0; t < m->tet_count; t++) {
+            if (!add_plane_tet(b, m, t, &np)) {
+                return 0;
+            }
+        }
     }
     b->ptet_count = np;
     for (uint32_t r = 0; r <= regions; r++) {
@@ -762,10 +907,10 @@ static int build_regions(sc_bscan *b, const sc_mesh *m)
         for (uint32_t r = r0; r <= r1; r++) {
             b->region_refs[b->region_start[r]++] = i;
             float *bx = b->region_box[r];
-            bx[0] = fminf(bx[0], b->ptets[i].xmin);
-            bx[1] = fmaxf(bx[1], b->ptets[i].xmax);
-            bx[2] = fminf(bx[2], b->ptets[i].zmin);
-            bx[3] = fmaxf(bx[3], b->ptets[i].zmax);
+            bx[0] = min_f(bx[0], b->ptets[i].xmin);
+            bx[1] = max_f(bx[1], b->ptets[i].xmax);
+            bx[2] = min_f(bx[2], b->ptets[i].zmin);
+            bx[3] = max_f(bx[3], b->ptets[i].zmax);
         }
     }
     for (uint32_t r = regions; r > 0u; r--) {
@@ -777,7 +922,7 @@ static int build_regions(sc_bscan *b, const sc_mesh *m)
 
 /* The first tet of region r holding (x, z), a positively oriented one before an inverted one
  * (a fold's turned layer counts only where nothing else covers the point). */
-static int32_t locate_region(const sc_bscan *b, uint32_t r, float x, float z)
+static int32_t locate_region(sc_bscan *b, const sc_mesh *m, uint32_t r, float x, float z)
 {
     const float *bx = b->region_box[r];
     if (x < bx[0] || x > bx[1] || z < bx[2] || z > bx[3]) {
@@ -786,10 +931,11 @@ static int32_t locate_region(const sc_bscan *b, uint32_t r, float x, float z)
     int32_t inverted = -1;
     for (uint32_t i = b->region_start[r]; i < b->region_start[r + 1u]; i++) {
         const uint32_t pi = b->region_refs[i];
-        const sc_bscan_ptet *p = &b->ptets[pi];
+        sc_bscan_ptet *p = &b->ptets[pi];
         if (x < p->xmin || x > p->xmax || z < p->zmin || z > p->zmax) {
             continue;
         }
+        ptet_ready(b, m, p);
         int in = 1;
         for (uint32_t v = 0; v < 4u && in; v++) {
             in = p->lam[v][0] + p->lam[v][1] * x + p->lam[v][2] * z >= -SC_BSCAN_LAMBDA_EPS;
@@ -809,7 +955,7 @@ static int32_t locate_region(const sc_bscan *b, uint32_t r, float x, float z)
 /* The tet of region r that holds (x, z) deepest (largest smallest barycentric coordinate), a
  * positively oriented one before an inverted one: the oracle's rule, for the walker's
  * relocation inside folds. */
-static int32_t locate_deepest(const sc_bscan *b, uint32_t r, float x, float z)
+static int32_t locate_deepest(sc_bscan *b, const sc_mesh *m, uint32_t r, float x, float z)
 {
     const float *bx = b->region_box[r];
     if (x < bx[0] || x > bx[1] || z < bx[2] || z > bx[3]) {
@@ -820,10 +966,11 @@ static int32_t locate_deepest(const sc_bscan *b, uint32_t r, float x, float z)
     float best_min = -SC_BSCAN_LAMBDA_EPS;
     for (uint32_t i = b->region_start[r]; i < b->region_start[r + 1u]; i++) {
         const uint32_t pi = b->region_refs[i];
-        const sc_bscan_ptet *p = &b->ptets[pi];
+        sc_bscan_ptet *p = &b->ptets[pi];
         if (x < p->xmin || x > p->xmax || z < p->zmin || z > p->zmax) {
             continue;
         }
+        ptet_ready(b, m, p);
         float lmin = p->lam[0][0] + p->lam[0][1] * x + p->lam[0][2] * z;
         for (uint32_t v = 1; v < 4u; v++) {
             const float l = p->lam[v][0] + p->lam[v][1] * x + p->lam[v][2] * z;
@@ -864,7 +1011,7 @@ static void fill_run(sc_bscan *b, const frame_ctx *c, uint32_t ta, uint32_t a, u
     emit_run(b, a, z + 1u, v0, vd);
 }
 
-static void map_line_regions(sc_bscan *b, uint32_t l, const frame_ctx *c)
+static void map_line_regions(sc_bscan *b, const sc_mesh *m, uint32_t l, const frame_ctx *c)
 {
     const uint32_t r = region_of_line(l, b->def.scan.lines_n, b->def.regions_n);
     const float *bx = b->region_box[r];
@@ -876,8 +1023,8 @@ static void map_line_regions(sc_bscan *b, uint32_t l, const frame_ctx *c)
     const uint32_t last = c->n - 1u;
     st[sp].a = 0u;
     st[sp].z = last;
-    st[sp].ta = locate_region(b, r, c->ox, c->oz);
-    st[sp].tz = locate_region(b, r, c->ox + (float)last * c->dx, c->oz + (float)last * c->dz);
+    st[sp].ta = locate_region(b, m, r, c->ox, c->oz);
+    st[sp].tz = locate_region(b, m, r, c->ox + (float)last * c->dx, c->oz + (float)last * c->dz);
     sp++;
     while (sp > 0u) {
         sp--;
@@ -907,10 +1054,10 @@ static void map_line_regions(sc_bscan *b, uint32_t l, const frame_ctx *c)
             }
         }
         const uint32_t mid = a + (z - a + 1u) / 2u;
-        const int32_t tm1 = locate_region(b, r, c->ox + (float)(mid - 1u) * c->dx,
+        const int32_t tm1 = locate_region(b, m, r, c->ox + (float)(mid - 1u) * c->dx,
                                           c->oz + (float)(mid - 1u) * c->dz);
         const int32_t tm =
-            locate_region(b, r, c->ox + (float)mid * c->dx, c->oz + (float)mid * c->dz);
+            locate_region(b, m, r, c->ox + (float)mid * c->dx, c->oz + (float)mid * c->dz);
         SC_ASSERT(sp + 2u <= SC_COUNT_OF(st));
         st[sp].a = mid;
         st[sp].z = z;
@@ -1356,6 +1503,22 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
             const int64_t DX = to_fx32(c->fd[0]), DY = to_fx32(c->fd[1]), DZ = to_fx32(c->fd[2]);
             const int64_t lx = (int64_t)v->dim[0] - 1, ly = (int64_t)v->dim[1] - 1,
                           lz = (int64_t)v->dim[2] - 1;
+            const int64_t m1 = (int64_t)(k1 - 1u - k0);
+            const int64_t xe = X + m1 * DX, ye = Y + m1 * DY, ze = Z + m1 * DZ;
+            if (X >= 0 && xe >= 0 && Y >= 0 && ye >= 0 && Z >= 0 && ze >= 0 &&
+                (X >> 32) <= lx && (xe >> 32) <= lx && (Y >> 32) <= ly && (ye >> 32) <= ly &&
+                (Z >> 32) <= lz && (ze >> 32) <= lz) {
+                /* both ends clear of the clamps, so every position between them is (they are
+                 * linear in kk): the loop below without them, the same labels */
+                for (uint32_t kk = k0; kk < k1; kk++) {
+                    b->line_label[kk] = vc->lab[(size_t)(X >> 32) + vc->stride[1] * (size_t)(Y >> 32) +
+                                                vc->stride[2] * (size_t)(Z >> 32)];
+                    X += DX;
+                    Y += DY;
+                    Z += DZ;
+                }
+                continue;
+            }
             for (uint32_t kk = k0; kk < k1; kk++) {
                 int64_t ix = X < 0 ? 0 : X >> 32, iy = Y < 0 ? 0 : Y >> 32,
                         iz = Z < 0 ? 0 : Z >> 32;
@@ -1591,7 +1754,7 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
                 map_line_walk(b, mesh, l, &active_n, &c);
                 break;
             case SC_BSCAN_MAP_REGIONS:
-                map_line_regions(b, l, &c);
+                map_line_regions(b, mesh, l, &c);
                 break;
             case SC_BSCAN_MAP_ORACLE:
                 map_line_oracle(b, mesh, nodes, l, &c);

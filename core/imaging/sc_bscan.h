@@ -206,6 +206,8 @@ typedef struct sc_bscan {
     /* mesh boundary, from sc_bscan_attach_mesh */
     uint32_t hull_count;
     uint32_t mesh_tets;
+    uint32_t mesh_grid; /* 1: sc_mesh_build's cell layout (tets 5c..5c+4 of cell c, corners of
+                           c): the region bins find the plane's tets cell row by cell row */
     sc_bscan_hull_face hull[SC_BSCAN_MAX_HULL_FACES];
     /* per frame: nodes in the image frame (x, y = distance to the plane, z), SoA */
     SC_ALIGN_HOT float qx[SC_MAX_NODES];

@@ -335,6 +335,73 @@ static void lines_through_inverted_tets_are_walked_by_locating_across_the_fold(v
     }
 }
 
+/* The region bins find the plane's tets cell row by cell row on sc_mesh_build's layout
+ * (mesh_grid): the same tets in the same order as the pass over every tet, so the same bytes,
+ * plane tets and relocations, through a fold (walker) and on the region path; a mesh not in
+ * that layout is recognised and takes the pass over every tet. */
+static sc_mesh g_mesh_swapped;
+
+static void render_grid(const sc_bscan_def *def, const sc_xform *probe, uint32_t grid,
+                        uint8_t *out)
+{
+    assert_int_equal(sc_bscan_init(&g_b, def), SC_OK);
+    assert_int_equal(sc_bscan_attach_mesh(&g_b, &g_mesh), SC_OK);
+    assert_int_equal(g_b.mesh_grid, 1);
+    g_b.mesh_grid = grid;
+    sc_hs_display_init(&g_disp);
+    const sc_display_dev dev = sc_hs_display_dev(&g_disp);
+    assert_int_equal(sc_bscan_frame(&g_b, &g_mesh, &g_nodes, &g_vol.v, probe, 1, &dev, 7u), SC_OK);
+    assert_int_equal(g_disp.frames_complete, 1);
+    memcpy(out, g_disp.last, (size_t)def->scan.lines_n * def->scan.samples_n);
+}
+
+static void plane_tets_from_cell_rows_equal_the_pass_over_every_tet(void **state)
+{
+    (void)state;
+    build_mesh(16, 8, 8);
+    deform(SCN_DEFORM_DENT, 4.0f, 0);
+    uint32_t best = 0;
+    float bd = 1e9f;
+    for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+        const float dx = g_mesh.rest_x[i] - 20.0f, dy = g_mesh.rest_y[i] - 10.0f,
+                    dz = g_mesh.rest_z[i] - 8.0f;
+        const float d2 = dx * dx + dy * dy + dz * dz;
+        if (d2 < bd) {
+            bd = d2;
+            best = i;
+        }
+    }
+    g_nodes.z[best] -= 1.6f * g_mesh.cell_mm[2]; /* a fold: the walker relocates */
+    const sc_xform probe = scn_probe(20.0f, g_mesh.rest_y[best], 4.0f, 0.0f);
+    for (uint32_t mp = SC_BSCAN_MAP_WALK; mp <= SC_BSCAN_MAP_REGIONS; mp++) {
+        sc_bscan_def d = small_def(mp, 64, 160);
+        const uint32_t n = d.scan.lines_n * d.scan.samples_n;
+        render_grid(&d, &probe, 1u, g_a);
+        const sc_bscan_status st = g_b.status;
+        render_grid(&d, &probe, 0u, g_o);
+        assert_memory_equal(g_a, g_o, n);
+        assert_int_equal(st.plane_tets, g_b.status.plane_tets);
+        assert_int_equal(st.walk_relocations, g_b.status.walk_relocations);
+        assert_memory_equal(st.area_now_mm2, g_b.status.area_now_mm2, sizeof st.area_now_mm2);
+        if (mp == SC_BSCAN_MAP_WALK) {
+            assert_true(st.walk_relocations > 0u);
+        } else {
+            assert_true(st.plane_tets > 0u);
+        }
+    }
+    /* two tets of different cells swapped: not the layout, recognised */
+    memcpy(&g_mesh_swapped, &g_mesh, sizeof g_mesh);
+    const uint32_t last = g_mesh.tet_count - 1u;
+    for (uint32_t v = 0; v < 4u; v++) {
+        g_mesh_swapped.tet[0][v] = g_mesh.tet[last][v];
+        g_mesh_swapped.tet[last][v] = g_mesh.tet[0][v];
+    }
+    assert_int_equal(sc_bscan_attach_mesh(&g_b, &g_mesh_swapped), SC_OK);
+    assert_int_equal(g_b.mesh_grid, 0);
+    assert_int_equal(sc_bscan_attach_mesh(&g_b, &g_mesh), SC_OK);
+    assert_int_equal(g_b.mesh_grid, 1);
+}
+
 /* ---- dark images ------------------------------------------------------------------------- */
 
 static void probe_in_air_gives_dark_image(void **state)
@@ -675,6 +742,7 @@ int main(void)
         cmocka_unit_test(curvilinear_fast_paths_match_oracle_on_deformed_small_mesh),
         cmocka_unit_test(fast_paths_match_oracle_on_deformed_full_mesh),
         cmocka_unit_test(lines_through_inverted_tets_are_walked_by_locating_across_the_fold),
+        cmocka_unit_test(plane_tets_from_cell_rows_equal_the_pass_over_every_tet),
         cmocka_unit_test(probe_in_air_gives_dark_image),
         cmocka_unit_test(gain_tgc_and_dynamic_range_follow_the_display_formula),
         cmocka_unit_test(lines_stream_in_order_between_begin_and_end_with_frame_number),

@@ -320,6 +320,11 @@ int main(int argc, char **argv)
                      : -1;
         return bench_contact_run(cases, name, method, n > 0 ? n : 40);
     }
+    if (argc > 1 && strcmp(argv[1], "contact-walker") == 0) {
+        const int n = argc > 4 ? atoi(argv[4]) : 10;
+        return bench_contact_walker(argc > 2 ? argv[2] : SC_DEFAULT_CASES_DIR,
+                                    argc > 3 ? argv[3] : "neck-ijv", n > 0 ? n : 10);
+    }
     const char *dir = argc > 1 ? argv[1] : "bscan_png";
     const int frames = argc > 2 ? atoi(argv[2]) : 40;
     scn_make_volume(&g_vol);

@@ -246,3 +246,46 @@ int bench_contact_run(const char *cases_dir, const char *case_name, int method, 
            nf, tf[0], tf[nf / 2]);
     return 0;
 }
+
+__attribute__((noinline)) void bench_contact_walker_frames(int frames)
+{
+    sc_engine *e = &g_rig.engine;
+    const sc_tissue *t = sc_engine_get_tissue(e);
+    const sc_case *cs = sc_engine_get_case(e);
+    const sc_probe_in *p = sc_engine_get_probe(e);
+    for (int i = 0; i < frames; i++) {
+        (void)sc_bscan_frame(&e->bscan, &t->mesh, &t->nodes, &cs->volume, &p->to_volume, 1, &g_kd,
+                             100000u + (uint32_t)i);
+    }
+}
+
+int bench_contact_walker(const char *cases_dir, const char *case_name, int frames)
+{
+    if (bench_contact_setup(cases_dir, case_name, -1, 8.0f, 2.0) != SC_OK) {
+        return 1;
+    }
+    const sc_engine *e = &g_rig.engine;
+    const uint32_t rel0 = e->bscan.status.walk_relocations;
+    bench_contact_walker_frames(frames);
+    /* FNV-1a of the last frame's bytes: a change of the imaging code must keep it */
+    uint32_t h = 2166136261u;
+    const size_t nb = (size_t)e->bscan.def.scan.lines_n * e->bscan.def.scan.samples_n;
+    for (size_t i = 0; i < nb; i++) {
+        h = (h ^ g_keep[i]) * 16777619u;
+    }
+    /* and of the label areas (the compression measure): their float bits */
+    uint32_t ha = 2166136261u;
+    for (uint32_t i = 0; i < SC_LABEL_COUNT; i++) {
+        uint32_t w[2];
+        memcpy(&w[0], &e->bscan.status.area_now_mm2[i], 4);
+        memcpy(&w[1], &e->bscan.status.area_rest_mm2[i], 4);
+        for (uint32_t q = 0; q < 2u; q++) {
+            ha = (ha ^ w[q]) * 16777619u;
+        }
+    }
+    printf("contact-walker: %s, %d walker frames at the deepest point (mapper %u, acoustics %u), "
+           "fold relocations %u per frame, image hash %08x, areas hash %08x\n",
+           case_name, frames, e->bscan.def.mapper, e->bscan.def.acoustics,
+           (e->bscan.status.walk_relocations - rel0) / (uint32_t)(frames > 0 ? frames : 1), h, ha);
+    return 0;
+}

@@ -17,4 +17,12 @@ const sc_display_dev *bench_contact_display(void);
  * Returns 0, or 1 when the case cannot be loaded. */
 int bench_contact_run(const char *cases_dir, const char *case_name, int method, int frames);
 
+/* For instruction counts: the engine's walker imaging (the engine's settings) of the deepest
+ * point, `frames` times inside bench_contact_walker_frames, nothing else timed or run after it:
+ *   valgrind --tool=callgrind --toggle-collect=bench_contact_walker_frames bench_bscan
+ *   contact-walker CASES CASE N   (the collected instructions / N: one walker frame).
+ * Returns 0, or 1 when the case cannot be loaded. */
+int bench_contact_walker(const char *cases_dir, const char *case_name, int frames);
+void bench_contact_walker_frames(int frames);
+
 #endif
