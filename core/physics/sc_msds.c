@@ -393,8 +393,8 @@ static uint32_t edge_family(const sc_mesh *m, uint32_t a, uint32_t b)
  * in double, to the three uniaxial Young's moduli (1 / (A^-1)_ii = E / mu), the bulk modulus
  * (sum A_ij / 9 = lambda / mu + 2/3) and, weighted 0.1, the shear moduli (s_ij = 1): on cubes
  * the exact answer, on the default box's cells (1 : 1 : 1.5) the moduli within 1.3% with the
- * shear of the planes across the long axis at about 0.5 mu (tools: the python prototype in the
- * commit message). Only + - * /, so every target computes the same bits. */
+ * shear of the planes across the long axis at about 0.5 mu. Only + - * /, so every target
+ * computes the same bits. */
 #define SC_MSDS_FIT_P 7u
 #define SC_MSDS_FIT_STEPS 60u
 
