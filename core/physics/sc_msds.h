@@ -125,7 +125,7 @@ typedef enum sc_msds_integrator {
  *   modulus); the fit keeps the uniaxial and bulk moduli within 1.3% and lets the shear of the
  *   two planes across the long axis fall to about 0.5 mu. Measured on the uniaxial block
  *   (tests/unit/test_sc_stiffness.c), MSDS / FEM: 0.98-1.01 on the default box at 20x10x10
- *   to 64x32x32 and on cubic cells at 20x10x10 to 48x24x24 (the former k = 2 mu V / L^2 per
+ *   to 64x32x32 and on cubic cells (the former k = 2 mu V / L^2 per
  *   edge: 1.44 on the box).
  * SC_MSDS_SPRINGS_PAPER: Algorithm 1's k = 0.002 E per tet edge (sc_springs.h) and the
  *   volume term on lambda (the former calibration: ratio 6), for the paper's tables. */
