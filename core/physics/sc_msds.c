@@ -379,13 +379,211 @@ static uint32_t edge_family(const sc_mesh *m, uint32_t a, uint32_t b)
     return SC_MSDS_FAMILIES;
 }
 
+/* ---- derived springs: the lattice fit (sc_msds.h, SC_MSDS_SPRINGS_DERIVED) ------------------
+ * Under a homogeneous strain eps the springs of one grid cell (a box L0 x L1 x L2, in the bulk:
+ * one spring per axis family and one face diagonal per plane) and the volume term store the
+ * energy 1/2 C eps eps with, in units of mu, the orthotropic normal block
+ *   A_ii = e_i + l + sum_j s_ij L_i^2 / L_j^2,  A_ij = s_ij + l   (i != j),
+ * shear moduli s_ij (a lattice of central springs is fully symmetric: C_iijj = C_ijij), where
+ * e_i is the axis springs' share, s_ij the face diagonals' and l the volume term's modulus. The
+ * FEM's isotropic material is e_i = 1, s_ij = 1, l = lambda / mu - 1: reachable on cubic cells
+ * only, since e_i >= 0 needs sum_j s_ij L_i^2 / L_j^2 <= 3 (a cell 1.5 x longer along z than
+ * across has 4.7 there: the former k ~ V / L^2 springs were 1.44 x the FEM along z). So the 7
+ * non-negative parameters are fitted, by a fixed number of projected Levenberg-Marquardt steps
+ * in double, to the three uniaxial Young's moduli (1 / (A^-1)_ii = E / mu), the bulk modulus
+ * (sum A_ij / 9 = lambda / mu + 2/3) and, weighted 0.1, the shear moduli (s_ij = 1): on cubes
+ * the exact answer, on the default box's cells (1 : 1 : 1.5) the moduli within 1.3% with the
+ * shear of the planes across the long axis at about 0.5 mu. Only + - * /, so every target
+ * computes the same bits. */
+#define SC_MSDS_FIT_P 7u
+#define SC_MSDS_FIT_STEPS 60u
+
+/* residuals of parameters p (sxy sxz syz ex ey ez l) for cell sides L; 0 if A is not positive */
+static int fit_residuals(const double L[3], const double p[SC_MSDS_FIT_P], double lam, double e,
+                         double r[SC_MSDS_FIT_P])
+{
+    const double s[3][3] = {{0.0, p[0], p[1]}, {p[0], 0.0, p[2]}, {p[1], p[2], 0.0}};
+    double a[3][3];
+    double ksum = 0.0;
+    for (uint32_t i = 0; i < 3u; i++) {
+        a[i][i] = p[3u + i] + p[6];
+        for (uint32_t j = 0; j < 3u; j++) {
+            if (j != i) {
+                a[i][i] += s[i][j] * (L[i] * L[i]) / (L[j] * L[j]);
+                a[i][j] = s[i][j] + p[6];
+            }
+        }
+    }
+    for (uint32_t i = 0; i < 3u; i++) {
+        for (uint32_t j = 0; j < 3u; j++) {
+            ksum += a[i][j];
+        }
+    }
+    const double c0 = a[1][1] * a[2][2] - a[1][2] * a[2][1];
+    const double c1 = a[0][0] * a[2][2] - a[0][2] * a[2][0];
+    const double c2 = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+    const double det = a[0][0] * c0 - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+                       a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+    if (!(det > 0.0) || !(c0 > 0.0) || !(c1 > 0.0) || !(c2 > 0.0)) {
+        return 0;
+    }
+    /* uniaxial modulus along i: det / cofactor_ii */
+    r[0] = det / (c0 * e) - 1.0;
+    r[1] = det / (c1 * e) - 1.0;
+    r[2] = det / (c2 * e) - 1.0;
+    r[3] = (ksum / 9.0) / (lam + 2.0 / 3.0) - 1.0;
+    for (uint32_t k = 0; k < 3u; k++) {
+        r[4u + k] = 0.1 * (p[k] - 1.0);
+    }
+    return 1;
+}
+
+static double fit_cost(const double r[SC_MSDS_FIT_P])
+{
+    double c = 0.0;
+    for (uint32_t i = 0; i < SC_MSDS_FIT_P; i++) {
+        c += r[i] * r[i];
+    }
+    return c;
+}
+
+/* The fit above for Poisson ratio nu on cells of sides cell_mm: p in units of mu. O(1). */
+static void derived_fit(float nu, const float cell_mm[3], double p[SC_MSDS_FIT_P])
+{
+    const double L[3] = {(double)cell_mm[0], (double)cell_mm[1], (double)cell_mm[2]};
+    const double lam = 2.0 * (double)nu / (1.0 - 2.0 * (double)nu);
+    const double e = 2.0 * (1.0 + (double)nu);
+    /* start: s_ij = 1 scaled down until every axis can have e_i >= 0, l = lambda - mu */
+    double s[3][3] = {{0.0, 1.0, 1.0}, {1.0, 0.0, 1.0}, {1.0, 1.0, 0.0}};
+    for (uint32_t pass = 0; pass < 2u; pass++) {
+        for (uint32_t i = 0; i < 3u; i++) {
+            double tot = 0.0;
+            for (uint32_t j = 0; j < 3u; j++) {
+                tot += j != i ? s[i][j] * (L[i] * L[i]) / (L[j] * L[j]) : 0.0;
+            }
+            if (tot > 3.0) {
+                for (uint32_t j = 0; j < 3u; j++) {
+                    s[i][j] *= j != i ? 3.0 / tot : 1.0;
+                    s[j][i] = s[i][j];
+                }
+            }
+        }
+    }
+    p[0] = s[0][1];
+    p[1] = s[0][2];
+    p[2] = s[1][2];
+    for (uint32_t i = 0; i < 3u; i++) {
+        double tot = 0.0;
+        for (uint32_t j = 0; j < 3u; j++) {
+            tot += j != i ? s[i][j] * (L[i] * L[i]) / (L[j] * L[j]) : 0.0;
+        }
+        p[3u + i] = tot < 3.0 ? 3.0 - tot : 0.0;
+    }
+    p[6] = lam > 1.0 ? lam - 1.0 : 0.0;
+    double r[SC_MSDS_FIT_P];
+    if (!fit_residuals(L, p, lam, e, r)) {
+        return; /* the start itself (not reached for 0 <= nu < 0.5 and positive sides) */
+    }
+    double cost = fit_cost(r), damp = 1e-3;
+    for (uint32_t it = 0; it < SC_MSDS_FIT_STEPS && cost > 0.0; it++) {
+        double jac[SC_MSDS_FIT_P][SC_MSDS_FIT_P]; /* jac[k][i] = d r_i / d p_k */
+        for (uint32_t k = 0; k < SC_MSDS_FIT_P; k++) {
+            double q[SC_MSDS_FIT_P], r2[SC_MSDS_FIT_P];
+            const double h = 1e-6 * (p[k] > 1.0 ? p[k] : 1.0);
+            for (uint32_t i = 0; i < SC_MSDS_FIT_P; i++) {
+                q[i] = p[i];
+            }
+            q[k] += h;
+            if (!fit_residuals(L, q, lam, e, r2)) {
+                q[k] = p[k] - h; /* one-sided the other way at the boundary */
+                if (!fit_residuals(L, q, lam, e, r2)) {
+                    return;
+                }
+                for (uint32_t i = 0; i < SC_MSDS_FIT_P; i++) {
+                    jac[k][i] = (r[i] - r2[i]) / h;
+                }
+                continue;
+            }
+            for (uint32_t i = 0; i < SC_MSDS_FIT_P; i++) {
+                jac[k][i] = (r2[i] - r[i]) / h;
+            }
+        }
+        double n[SC_MSDS_FIT_P][SC_MSDS_FIT_P], g[SC_MSDS_FIT_P];
+        for (uint32_t a = 0; a < SC_MSDS_FIT_P; a++) {
+            g[a] = 0.0;
+            for (uint32_t i = 0; i < SC_MSDS_FIT_P; i++) {
+                g[a] += jac[a][i] * r[i];
+            }
+            for (uint32_t b = 0; b < SC_MSDS_FIT_P; b++) {
+                n[a][b] = 0.0;
+                for (uint32_t i = 0; i < SC_MSDS_FIT_P; i++) {
+                    n[a][b] += jac[a][i] * jac[b][i];
+                }
+            }
+        }
+        int accepted = 0;
+        while (!accepted && damp <= 1e8) {
+            double m[SC_MSDS_FIT_P][SC_MSDS_FIT_P + 1u];
+            for (uint32_t a = 0; a < SC_MSDS_FIT_P; a++) {
+                for (uint32_t b = 0; b < SC_MSDS_FIT_P; b++) {
+                    m[a][b] = n[a][b] + (a == b ? damp * (n[a][a] + 1e-9) : 0.0);
+                }
+                m[a][SC_MSDS_FIT_P] = -g[a];
+            }
+            /* Gaussian elimination: m is symmetric positive definite (damped normal matrix) */
+            for (uint32_t c = 0; c < SC_MSDS_FIT_P; c++) {
+                for (uint32_t row = c + 1u; row < SC_MSDS_FIT_P; row++) {
+                    const double f = m[row][c] / m[c][c];
+                    for (uint32_t k = c; k <= SC_MSDS_FIT_P; k++) {
+                        m[row][k] -= f * m[c][k];
+                    }
+                }
+            }
+            double dp[SC_MSDS_FIT_P], q[SC_MSDS_FIT_P], r2[SC_MSDS_FIT_P];
+            for (uint32_t row = SC_MSDS_FIT_P; row-- > 0u;) {
+                double v = m[row][SC_MSDS_FIT_P];
+                for (uint32_t k = row + 1u; k < SC_MSDS_FIT_P; k++) {
+                    v -= m[row][k] * dp[k];
+                }
+                dp[row] = v / m[row][row];
+            }
+            for (uint32_t k = 0; k < SC_MSDS_FIT_P; k++) {
+                q[k] = p[k] + dp[k] > 0.0 ? p[k] + dp[k] : 0.0; /* projected on p >= 0 */
+            }
+            if (fit_residuals(L, q, lam, e, r2) && fit_cost(r2) < cost) {
+                for (uint32_t k = 0; k < SC_MSDS_FIT_P; k++) {
+                    p[k] = q[k];
+                    r[k] = r2[k];
+                }
+                cost = fit_cost(r2);
+                damp = damp * 0.3 > 1e-9 ? damp * 0.3 : 1e-9;
+                accepted = 1;
+            } else {
+                damp *= 10.0;
+            }
+        }
+        if (!accepted) {
+            break;
+        }
+    }
+}
+
 /* Derived spring constants (sc_msds.h, SC_MSDS_SPRINGS_DERIVED): the families' k replaced by
- * the sum over the tets of k = factor * 2.5 mu V / L^2 per edge. O(tets). */
+ * the fit above, shared out to the tets. A cell's axis edge (one tet of the cell holds it,
+ * V = Vc / 6) gets e_i mu Vc / (4 L_i^2) from the cell (four cells share it), a face diagonal
+ * s_ij mu Vc Ld^2 / (2 L_i^2 L_j^2) (two cells share it; its three tets hold 2 Vc / 3), split
+ * by tet volume, so that a tet of volume V gives k = 1.5 e_i mu V / L_i^2 to an axis edge and
+ * 0.75 s_ij mu V Ld^2 / (L_i^2 L_j^2) to a diagonal. fit[label] is derived_fit's p. O(tets). */
 static int derive_springs(sc_msds *s, const sc_mesh *m, const sc_material_table *mat,
-                          double *energy_ref)
+                          const double (*fit)[SC_MSDS_FIT_P], double *energy_ref)
 {
     static const uint8_t pa[6] = {0u, 0u, 0u, 1u, 1u, 2u};
     static const uint8_t pb[6] = {1u, 2u, 3u, 2u, 3u, 3u};
+    /* family -> fit parameter: axes x y z -> e (3..5), planes xy xz yz -> s (0..2) */
+    static const uint8_t fam_par[SC_MSDS_FAMILIES] = {3u, 4u, 5u, 0u, 0u, 1u, 1u, 2u, 2u};
+    static const uint8_t fam_ax[SC_MSDS_FAMILIES][2] = {{0u, 0u}, {1u, 1u}, {2u, 2u},
+                                                        {0u, 1u}, {0u, 1u}, {0u, 2u},
+                                                        {0u, 2u}, {1u, 2u}, {1u, 2u}};
     for (uint32_t d = 0; d < SC_MSDS_FAMILIES; d++) {
         for (uint32_t i = 0; i < s->node_count; i++) {
             s->k_n_per_mm[d][i] = 0.0f;
@@ -394,12 +592,15 @@ static int derive_springs(sc_msds *s, const sc_mesh *m, const sc_material_table 
     for (uint32_t i = 0; i < s->node_count; i++) {
         s->ksum_n_per_mm[i] = 0.0f;
     }
+    const double cell2[3] = {(double)m->cell_mm[0] * (double)m->cell_mm[0],
+                             (double)m->cell_mm[1] * (double)m->cell_mm[1],
+                             (double)m->cell_mm[2] * (double)m->cell_mm[2]};
     for (uint32_t t = 0; t < m->tet_count; t++) {
         if (m->tet_label[t] >= mat->count) {
             return SC_ERR_CASE_LABEL;
         }
         const sc_material *r = &mat->row[m->tet_label[t]];
-        const float mu_n_mm2 = r->e_pa / (2.0f * (1.0f + r->poisson)) * 1e-6f;
+        const double mu_n_mm2 = (double)r->e_pa / (2.0 * (1.0 + (double)r->poisson)) * 1e-6;
         const float v_mm3 = sc_mesh_tet_volume_mm3(m->rest_x, m->rest_y, m->rest_z, m->tet[t]);
         for (uint32_t p = 0; p < 6u; p++) {
             uint32_t a = m->tet[t][pa[p]], b = m->tet[t][pb[p]];
@@ -418,7 +619,12 @@ static int derive_springs(sc_msds *s, const sc_mesh *m, const sc_material_table 
             if (!(l2 > 0.0f) || !(v_mm3 > 0.0f)) {
                 return SC_ERR_MESH_SPRINGS;
             }
-            const float k = SC_MSDS_DERIVED_K_FACTOR * 2.5f * mu_n_mm2 * v_mm3 / l2;
+            const double q = fit[m->tet_label[t]][fam_par[fam]];
+            const uint32_t i = fam_ax[fam][0], j = fam_ax[fam][1];
+            const double kd = fam < 3u ? 1.5 * q * mu_n_mm2 * (double)v_mm3 / (double)l2
+                                       : 0.75 * q * mu_n_mm2 * (double)v_mm3 * (double)l2 /
+                                             (cell2[i] * cell2[j]);
+            const float k = (float)kd;
             s->k_n_per_mm[fam][a] += k;
             s->ksum_n_per_mm[a] += k;
             s->ksum_n_per_mm[b] += k;
@@ -500,8 +706,15 @@ int sc_msds_init_begin(sc_msds *s, const sc_mesh *m, const sc_springs *sp,
     }
     s->spring_count = sp->count;
     const int derived = def->springs == (uint8_t)SC_MSDS_SPRINGS_DERIVED;
+    double fit[SC_MAX_LABELS][SC_MSDS_FIT_P] = {{0.0}};
     if (derived) {
-        rc = derive_springs(s, m, mat, &energy_ref);
+        if (mat->count > SC_MAX_LABELS) {
+            return SC_ERR_CASE_LABEL;
+        }
+        for (uint32_t l = 0; l < mat->count; l++) {
+            derived_fit(mat->row[l].poisson, m->cell_mm, fit[l]);
+        }
+        rc = derive_springs(s, m, mat, (const double(*)[SC_MSDS_FIT_P])fit, &energy_ref);
         if (rc != SC_OK) {
             return rc;
         }
@@ -522,9 +735,10 @@ int sc_msds_init_begin(sc_msds *s, const sc_mesh *m, const sc_springs *sp,
         float lam_n_mm2 =
             r->e_pa * r->poisson / ((1.0f + r->poisson) * (1.0f - 2.0f * r->poisson)) * 1e-6f;
         if (derived) {
-            /* the springs carry mu of lambda (Cauchy lattice), the volume term the rest */
-            const float mu_n_mm2 = r->e_pa / (2.0f * (1.0f + r->poisson)) * 1e-6f;
-            lam_n_mm2 = lam_n_mm2 > mu_n_mm2 ? lam_n_mm2 - mu_n_mm2 : 0.0f;
+            /* the springs carry a part of lambda (Cauchy lattice), the volume term the fitted
+             * rest (derived_fit's l, in units of mu) */
+            const double mu_n_mm2 = (double)r->e_pa / (2.0 * (1.0 + (double)r->poisson)) * 1e-6;
+            lam_n_mm2 = (float)(fit[m->tet_label[t]][6] * mu_n_mm2);
         }
         const float kvol = v_mm3 > 0.0f ? lam_n_mm2 / v_mm3 : 0.0f;
         s->kvol36[t] = kvol / 36.0f;

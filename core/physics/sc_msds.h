@@ -111,29 +111,28 @@ typedef enum sc_msds_integrator {
 
 /* Spring constants of the MSDS:
  * SC_MSDS_SPRINGS_DERIVED (default): from each tet's material, volume and edge lengths, so
- *   that the MSDS's static stiffness follows the FEM's at every mesh resolution. A lattice of
- *   central springs is a material with Lame lambda = mu (Poisson 1/4, the Cauchy relation);
- *   each tet gives each of its 6 edges k = SC_MSDS_DERIVED_K_FACTOR * E_s V / L^2 with
- *   E_s = 2.5 mu (the Young's modulus of that lattice material at the tet's shear modulus
- *   mu), van Gelder 1998's form (k ~ E V / L^2, dimensionally E x length, so a finer mesh
- *   keeps the material), and the volume term supplies the rest of lambda: k_vol =
- *   volume_stiffness_ratio * max(0, lambda - mu) / V0. With the ratio 1 the sum is the FEM's
- *   (lambda, mu). The factor is measured on the uniaxial block (tests/unit/test_sc_stiffness.c):
- *   cubic cells of 4, 2 and 1.07 mm give E A / L within 0.1% (Poisson 0.45; 0.96-0.97 at 0.3).
- *   Limitation: k ~ V / L^2 favours short edges, so cells far from cubic are too stiff along
- *   their long axis (the default 40 x 20 x 30 mm box, cells 1 : 1 : 1.5: 1.44 x the FEM along
- *   z at 20x10x10 and at 32x16x16); a per-tet fit of the 6 edge constants to the tet's
- *   stiffness (Lloyd et al. 2007) would remove it (tried: projecting each off-diagonal block
- *   onto its edge gives 1.37 on cubes, worse).
+ *   that the MSDS's static stiffness follows the FEM's at every mesh resolution and cell shape.
+ *   Under a homogeneous strain a grid cell's springs and the volume term store an orthotropic
+ *   energy whose moduli are linear in three per-family shares (axis edges e_i, face diagonals
+ *   s_ij, volume term l); at load time these 7 numbers are fitted per material (sc_msds.c,
+ *   derived_fit: projected Levenberg-Marquardt in double, 60 steps, + - * / only) to the
+ *   FEM's three uniaxial Young's moduli and bulk modulus and, weighted 0.1, its shear modulus,
+ *   and shared out to the tets by volume (k ~ mu V / L^2 per axis edge, mu V Ld^2 / (L_i^2
+ *   L_j^2) per face diagonal: E x length, so a finer mesh keeps the material). On cubic cells
+ *   the fit is exact (e = s = mu, l = lambda - mu: the Cauchy lattice plus the rest of lambda).
+ *   On the default 40 x 20 x 30 mm box (cells 1 : 1 : 1.5) a central-spring lattice cannot
+ *   hold all of the FEM's moduli (the long axis's face diagonals alone exceed its normal
+ *   modulus); the fit keeps the uniaxial and bulk moduli within 1.3% and lets the shear of the
+ *   two planes across the long axis fall to about 0.5 mu. Measured on the uniaxial block
+ *   (tests/unit/test_sc_stiffness.c), MSDS / FEM: 0.98-1.01 on the default box at 20x10x10
+ *   to 64x32x32 and on cubic cells (the former k = 2 mu V / L^2 per
+ *   edge: 1.44 on the box).
  * SC_MSDS_SPRINGS_PAPER: Algorithm 1's k = 0.002 E per tet edge (sc_springs.h) and the
  *   volume term on lambda (the former calibration: ratio 6), for the paper's tables. */
 typedef enum sc_msds_springs {
     SC_MSDS_SPRINGS_DERIVED = 0,
     SC_MSDS_SPRINGS_PAPER = 1,
 } sc_msds_springs;
-#ifndef SC_MSDS_DERIVED_K_FACTOR
-#define SC_MSDS_DERIVED_K_FACTOR 0.80f
-#endif
 
 typedef struct sc_msds_def {
     float dt_s;                    /* explicit Euler step, > 0 (default SC_PHYS_DT_DEFAULT_S) */

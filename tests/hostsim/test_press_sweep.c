@@ -40,7 +40,22 @@ static sc_emu_row rows[MAX_ROWS];
 
 typedef struct sweep_point {
     float depth_mm, vein, artery, thrombus;
+    uint32_t inverted;     /* tets with V <= 0 at the end of the hold */
+    uint32_t inverted_max; /* most in any frame of the step (ramp and hold) */
 } sweep_point;
+
+/* tets turned inside out (V <= 0) in the active tissue */
+static uint32_t inverted_tets(void)
+{
+    const sc_tissue *t = &rig.engine.tissue[rig.engine.active];
+    uint32_t inv = 0;
+    for (uint32_t k = 0; k < t->mesh.tet_count; k++) {
+        inv += sc_mesh_tet_volume_mm3(t->nodes.x, t->nodes.y, t->nodes.z, t->mesh.tet[k]) > 0.0f
+                   ? 0u
+                   : 1u;
+    }
+    return inv;
+}
 
 /* the compression exam without pulse and breathing (the lumen pressures at their means) */
 static void drive_off(void)
@@ -219,9 +234,12 @@ static void sweep_mesh(const char *case_name, sc_tissue_method m, uint32_t fine)
     uint32_t np = 0;
     for (uint32_t s = 0; s <= steps && s < 64u; s++) {
         const uint32_t frames = (uint32_t)((s == 0u ? HOLD_S : RAMP_S + HOLD_S) * hz);
+        uint32_t inv_max = 0;
         for (uint32_t f = 0; f < frames; f++) {
             frame(t0, &more);
             assert_true(state_finite());
+            const uint32_t inv = inverted_tets();
+            inv_max = inv > inv_max ? inv : inv_max;
             if (getenv("SC_PRESS_DEBUG") != NULL) {
                 debug_frame(s, f);
             }
@@ -237,7 +255,8 @@ static void sweep_mesh(const char *case_name, sc_tissue_method m, uint32_t fine)
             }
         }
         pts[np++] = (sweep_point){s == 0u ? 0.0f : STEP_MM * (float)s, ratio(b, SC_LABEL_VEIN),
-                                  ratio(b, SC_LABEL_ARTERY), ratio(b, SC_LABEL_THROMBUS)};
+                                  ratio(b, SC_LABEL_ARTERY), ratio(b, SC_LABEL_THROMBUS),
+                                  inverted_tets(), inv_max};
     }
     /* the lift (ramp) and 1 s without contact */
     for (uint32_t f = 0; f < (uint32_t)(RAMP_S * hz) + hz; f++) {
@@ -254,12 +273,13 @@ static void sweep_mesh(const char *case_name, sc_tissue_method m, uint32_t fine)
     sc_engine_status st;
     sc_engine_get_status(&rig.engine, &st);
     print_message("%s %s, mesh %ux%ux%u: press mm / vein / artery / thrombus image-area ratio "
-                  "(-1: not in view)\n",
+                  "(-1: not in view) / inverted tets at the hold's end (most in any frame)\n",
                   case_name, m == SC_TISSUE_MSDS ? "msds" : "fem", rig.engine.tissue[rig.engine.active].mesh.nx,
                   rig.engine.tissue[rig.engine.active].mesh.ny, rig.engine.tissue[rig.engine.active].mesh.nz);
     for (uint32_t i = 0; i < np; i++) {
-        print_message("  %5.1f  %6.3f  %6.3f  %6.3f\n", (double)pts[i].depth_mm,
-                      (double)pts[i].vein, (double)pts[i].artery, (double)pts[i].thrombus);
+        print_message("  %5.1f  %6.3f  %6.3f  %6.3f  %5u (%u)\n", (double)pts[i].depth_mm,
+                      (double)pts[i].vein, (double)pts[i].artery, (double)pts[i].thrombus,
+                      pts[i].inverted, pts[i].inverted_max);
     }
     print_message("  1 s after the lift: largest node distance from rest %.3f mm (2 s: %.3f mm); "
                   "resets %llu (last guard %u), faults 0x%04x\n",

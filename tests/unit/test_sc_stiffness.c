@@ -11,6 +11,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "sc_err.h"
@@ -111,19 +112,22 @@ static double uniaxial_box_ratio(uint32_t nx, uint32_t ny, uint32_t nz, const fl
             }
         }
     }
+    /* quasi-static: steps of 1 s (the masses and the damping ~1/10 of the matrix) with 200 CG
+     * iterations each, until the top's mean displacement changes by at most 1e-7 of itself */
     double prev = 0.0, mean = 0.0;
     for (int it = 0; it < 2000; it++) {
         if (which == USE_FEM) {
-            sc_fem_step(&g_fem, &g_mesh, &g_nodes, 0.2f, 20u);
+            sc_fem_step(&g_fem, &g_mesh, &g_nodes, 1.0f, SC_PHYS_ITERATIONS_MAX);
         } else {
-            sc_msds_implicit_step(&g_msds, &g_fem, &g_mesh, &g_nodes, 0.2f, 20u, NULL);
+            sc_msds_implicit_step(&g_msds, &g_fem, &g_mesh, &g_nodes, 1.0f,
+                                  SC_PHYS_ITERATIONS_MAX, NULL);
         }
         mean = 0.0;
         for (uint32_t i = 0; i < nxy; i++) {
             mean += (double)(g_nodes.z[i] - g_mesh.rest_z[i]);
         }
         mean /= (double)nxy;
-        if (it > 200 && fabs(mean - prev) <= 1e-7 * fabs(mean)) {
+        if (it > 10 && fabs(mean - prev) <= 1e-7 * fabs(mean)) {
             break;
         }
         prev = mean;
@@ -161,31 +165,44 @@ msds_derived_springs_give_e_a_over_l_within_20_percent_at_three_resolutions(void
     }
 }
 
-/* The default mesh box (40 x 20 x 30 mm: cells 2.1 x 2.2 x 3.2 mm at 20x10x10, 1.3 x 1.3 x
- * 2.0 mm at 32x16x16) at the smallest and the largest mesh of the paper's Table I. The FEM is
- * exact; the MSDS's k ~ V / L^2 favours the short edges, so on cells this far from cubic it
- * is stiffer along the long axis than the +-20% of the cubic cells: printed and bounded here
- * (a known limitation, see sc_msds.h), not the cubes' 20%. */
-static void default_box_fem_exact_and_msds_within_60_percent_on_non_cubic_cells(void **state)
+/* The default mesh box (40 x 20 x 30 mm: cells 2.1 x 2.2 x 3.3 mm at 20x10x10 down to 0.63 x
+ * 0.65 x 0.97 mm at 64x32x32, 1 : 1 : 1.5) and boxes of cubic 1 mm cells with the same node
+ * counts, at the four meshes of the paper's Table I: the FEM exact, the MSDS within 20% of it
+ * (the springs are fitted to the cell's shape, sc_msds.c derived_fit; before that fit the
+ * default box gave 1.44 x the FEM along z). The two finer meshes take minutes (hundreds of
+ * 200-iteration CG steps on up to 65,536 nodes; far more under ASan), so they run when
+ * SC_STIFFNESS_FINE is set: `SC_STIFFNESS_FINE=1 build/release/tests/test_sc_stiffness`. */
+static void msds_within_20_percent_of_fem_on_default_box_and_cubic_cells_at_four_meshes(
+    void **state)
 {
     (void)state;
-    static const uint32_t res[2][3] = {{20u, 10u, 10u}, {32u, 16u, 16u}};
-    const float size[3] = {40.0f, 20.0f, 30.0f};
-    for (uint32_t r = 0; r < 2u; r++) {
-        const double f = uniaxial_box_ratio(res[r][0], res[r][1], res[r][2], size, USE_FEM);
-        const double q = uniaxial_box_ratio(res[r][0], res[r][1], res[r][2], size, USE_MSDS);
-        print_message("40x20x30 mm box, %ux%ux%u nodes: stiffness / (E A / L) FEM %.3f, MSDS "
-                      "derived %.3f (ratio MSDS / FEM %.3f)\n",
-                      res[r][0], res[r][1], res[r][2], f, q, q / f);
-        assert_true(f >= 0.98 && f <= 1.02);
-        assert_true(q >= 0.8 && q <= 1.6);
+    static const uint32_t res[4][3] = {
+        {20u, 10u, 10u}, {32u, 16u, 16u}, {48u, 24u, 24u}, {64u, 32u, 32u}};
+    const uint32_t meshes = getenv("SC_STIFFNESS_FINE") != NULL ? 4u : 2u;
+    for (uint32_t r = 0; r < meshes; r++) {
+        for (uint32_t cubic = 0; cubic < 2u; cubic++) {
+            const float size[3] = {
+                cubic ? (float)(res[r][0] - 1u) : 40.0f,
+                cubic ? (float)(res[r][1] - 1u) : 20.0f,
+                cubic ? (float)(res[r][2] - 1u) : 30.0f,
+            };
+            const double f = uniaxial_box_ratio(res[r][0], res[r][1], res[r][2], size, USE_FEM);
+            const double q = uniaxial_box_ratio(res[r][0], res[r][1], res[r][2], size, USE_MSDS);
+            print_message("%.0fx%.0fx%.0f mm box, %ux%ux%u nodes: stiffness / (E A / L) FEM "
+                          "%.3f, MSDS derived %.3f (ratio MSDS / FEM %.3f)\n",
+                          (double)size[0], (double)size[1], (double)size[2], res[r][0],
+                          res[r][1], res[r][2], f, q, q / f);
+            assert_true(f >= 0.98 && f <= 1.02);
+            assert_true(q / f >= 0.8 && q / f <= 1.2);
+        }
     }
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(default_box_fem_exact_and_msds_within_60_percent_on_non_cubic_cells),
+        cmocka_unit_test(
+            msds_within_20_percent_of_fem_on_default_box_and_cubic_cells_at_four_meshes),
         cmocka_unit_test(fem_uniaxial_block_gives_e_a_over_l_at_three_resolutions),
         cmocka_unit_test(
             msds_derived_springs_give_e_a_over_l_within_20_percent_at_three_resolutions),
