@@ -72,6 +72,7 @@ int sc_assess_init(sc_assess *a, const sc_assess_def *def)
     a->def = *def;
     a->r.finding = SC_ASSESS_CALL_NORMAL;
     clear_record(&a->r);
+    a->artery_low_frames = 0u;
     sc_assess_score(&a->def, &a->r);
     return SC_OK;
 }
@@ -83,6 +84,7 @@ int sc_assess_begin_case(sc_assess *a, uint8_t finding)
     }
     a->r.finding = finding;
     clear_record(&a->r);
+    a->artery_low_frames = 0u;
     sc_assess_score(&a->def, &a->r);
     return SC_OK;
 }
@@ -91,6 +93,7 @@ void sc_assess_reset(sc_assess *a)
 {
     a->r.resets++;
     clear_record(&a->r);
+    a->artery_low_frames = 0u;
     sc_assess_score(&a->def, &a->r);
 }
 
@@ -124,6 +127,7 @@ void sc_assess_update(sc_assess *a, const sc_assess_in *in)
         sc_assess_score(&a->def, r);
     }
     if (!in->contact) {
+        a->artery_low_frames = 0u;
         return;
     }
     r->contact_frames++;
@@ -134,6 +138,9 @@ void sc_assess_update(sc_assess *a, const sc_assess_in *in)
     for (uint32_t v = 0; v < SC_ASSESS_VESSELS; v++) {
         const float ratio = avail(in->area_ratio[v]);
         if (ratio < 0.0f) {
+            if (v == SC_ASSESS_ARTERY) {
+                a->artery_low_frames = 0u;
+            }
             continue;
         }
         sc_assess_vessel_rec *x = &r->vessel[v];
@@ -147,8 +154,21 @@ void sc_assess_update(sc_assess *a, const sc_assess_in *in)
         if (v != SC_ASSESS_ARTERY && force > r->venous_force_max_n) {
             r->venous_force_max_n = force;
         }
-        if (v == SC_ASSESS_ARTERY && ratio < a->def.artery_min_ratio) {
-            r->artery_over = 1u;
+        /* The artery counts as compressed when it is held below the limit for
+         * min_view_frames (0.1 s) in a row, the same span that makes a vessel count as imaged:
+         * a single frame's dip (the pulse's diastolic trough as the press lands) is not a
+         * trainee squeezing the artery. */
+        if (v == SC_ASSESS_ARTERY) {
+            if (ratio < a->def.artery_min_ratio) {
+                if (a->artery_low_frames < UINT32_MAX) {
+                    a->artery_low_frames++;
+                }
+                if (a->artery_low_frames >= a->def.min_view_frames) {
+                    r->artery_over = 1u;
+                }
+            } else {
+                a->artery_low_frames = 0u;
+            }
         }
     }
     sc_assess_score(&a->def, r);

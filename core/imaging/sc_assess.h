@@ -49,8 +49,8 @@ typedef enum sc_assess_criterion {
     SC_ASSESS_CRIT_COMPRESSED,      /* the compression was decisive: the vein coapted, or a
                                      * press of at least firm_force_n with the vein (or the
                                      * thrombosed vein) in view did not make it coapt */
-    SC_ASSESS_CRIT_ARTERY_SPARED,   /* a vein was imaged and the artery never fell below
-                                     * artery_min_ratio */
+    SC_ASSESS_CRIT_ARTERY_SPARED,   /* a vein was imaged and the artery was never held below
+                                     * artery_min_ratio for min_view_frames frames in a row */
     SC_ASSESS_CRIT_FORCE_SAFE,      /* a vein was imaged and the peak force stayed <=
                                      * force_max_n (met when the force is not available) */
     SC_ASSESS_CRIT_CALL_CORRECT,    /* the trainee's call equals the case's finding */
@@ -121,6 +121,8 @@ _Static_assert(sizeof(sc_assess_report) == 104u, "assessment record layout (docs
 typedef struct sc_assess {
     sc_assess_def def;
     sc_assess_report r;
+    uint32_t artery_low_frames; /* consecutive contact frames with the artery in view below
+                                 * artery_min_ratio; artery_over at min_view_frames of them */
 } sc_assess;
 
 /* coapt 0.05, artery 0.75, firm press 8 N, unsafe above 60 N, 6 frames (0.1 s) in view;
