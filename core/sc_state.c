@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "sc_err.h"
+#include "sc_le.h"
 
 #define CAT_NAME_BYTES 240u
 
@@ -352,26 +353,21 @@ uint32_t sc_state_emit(sc_state_tx *t, const sc_state_dev *dev, const sc_state_i
     return sent;
 }
 
-static uint32_t rd_u32(const uint8_t *p)
-{
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
-}
-
 int sc_state_check(const uint8_t *rec, uint32_t len, uint32_t *seq, uint32_t *frame_no)
 {
     if (rec == NULL || len < SC_STATE_HEADER_SIZE) {
         return SC_ERR_INVALID_ARG;
     }
     const uint32_t plen = (uint32_t)rec[6] | ((uint32_t)rec[7] << 8);
-    if (rd_u32(rec) != SC_STATE_MAGIC || rec[4] != SC_STATE_VERSION || rec[5] == 0u ||
+    if (sc_le_rd_u32(rec) != SC_STATE_MAGIC || rec[4] != SC_STATE_VERSION || rec[5] == 0u ||
         plen != len - SC_STATE_HEADER_SIZE) {
         return SC_ERR_RANGE;
     }
     if (seq) {
-        *seq = rd_u32(rec + 8);
+        *seq = sc_le_rd_u32(rec + 8);
     }
     if (frame_no) {
-        *frame_no = rd_u32(rec + 12);
+        *frame_no = sc_le_rd_u32(rec + 12);
     }
     return (int)rec[5];
 }

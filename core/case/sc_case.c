@@ -6,46 +6,7 @@
 
 #include "sc_crc32.h"
 #include "sc_err.h"
-
-/* ---- little-endian field access (alignment- and host-endianness-independent) ------------- */
-static uint32_t rd_u32(const uint8_t *p)
-{
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
-}
-
-static uint64_t rd_u64(const uint8_t *p)
-{
-    return (uint64_t)rd_u32(p) | ((uint64_t)rd_u32(p + 4) << 32);
-}
-
-static float rd_f32(const uint8_t *p)
-{
-    uint32_t u = rd_u32(p);
-    float f;
-    memcpy(&f, &u, sizeof f);
-    return f;
-}
-
-static void wr_u32(uint8_t *p, uint32_t v)
-{
-    p[0] = (uint8_t)v;
-    p[1] = (uint8_t)(v >> 8);
-    p[2] = (uint8_t)(v >> 16);
-    p[3] = (uint8_t)(v >> 24);
-}
-
-static void wr_u64(uint8_t *p, uint64_t v)
-{
-    wr_u32(p, (uint32_t)v);
-    wr_u32(p + 4, (uint32_t)(v >> 32));
-}
-
-static void wr_f32(uint8_t *p, float f)
-{
-    uint32_t u;
-    memcpy(&u, &f, sizeof u);
-    wr_u32(p, u);
-}
+#include "sc_le.h"
 
 static int all_zero(const uint8_t *p, size_t n)
 {
@@ -129,20 +90,20 @@ static int finite3(const float v[3])
 static void rd_xform(const uint8_t *p, sc_xform *x)
 {
     for (int i = 0; i < 9; i++) {
-        x->r[i] = rd_f32(p + 4 * i);
+        x->r[i] = sc_le_rd_f32(p + 4 * i);
     }
     for (int i = 0; i < 3; i++) {
-        x->t_mm[i] = rd_f32(p + 36 + 4 * i);
+        x->t_mm[i] = sc_le_rd_f32(p + 36 + 4 * i);
     }
 }
 
 static void wr_xform(uint8_t *p, const sc_xform *x)
 {
     for (int i = 0; i < 9; i++) {
-        wr_f32(p + 4 * i, x->r[i]);
+        sc_le_wr_f32(p + 4 * i, x->r[i]);
     }
     for (int i = 0; i < 3; i++) {
-        wr_f32(p + 36 + 4 * i, x->t_mm[i]);
+        sc_le_wr_f32(p + 36 + 4 * i, x->t_mm[i]);
     }
 }
 
@@ -243,11 +204,11 @@ int sc_case_write(const sc_case_def *def, uint8_t *buf, size_t cap, size_t *out_
     memset(buf, 0, (size_t)total);
 
     memcpy(buf + HDR_MAGIC, SC_CASE_MAGIC, SC_CASE_MAGIC_LEN);
-    wr_u32(buf + HDR_VERSION, SC_CASE_VERSION);
-    wr_u32(buf + HDR_HEADER_SIZE, SC_CASE_HEADER_SIZE);
-    wr_u64(buf + HDR_FILE_SIZE, total);
-    wr_u32(buf + HDR_SECTION_COUNT, SC_CASE_SECTION_COUNT);
-    wr_u32(buf + HDR_CRC, sc_crc32(buf, HDR_CRC));
+    sc_le_wr_u32(buf + HDR_VERSION, SC_CASE_VERSION);
+    sc_le_wr_u32(buf + HDR_HEADER_SIZE, SC_CASE_HEADER_SIZE);
+    sc_le_wr_u64(buf + HDR_FILE_SIZE, total);
+    sc_le_wr_u32(buf + HDR_SECTION_COUNT, SC_CASE_SECTION_COUNT);
+    sc_le_wr_u32(buf + HDR_CRC, sc_crc32(buf, HDR_CRC));
 
     size_t off = SC_CASE_HEADER_SIZE;
     for (unsigned s = 0; s < SC_CASE_SECTION_COUNT; s++) {
@@ -261,15 +222,15 @@ int sc_case_write(const sc_case_def *def, uint8_t *buf, size_t cap, size_t *out_
             break;
         case 1:
             for (int a = 0; a < 3; a++) {
-                wr_u32(p + 4 * a, def->volume.dim[a]);
-                wr_f32(p + 16 + 4 * a, def->volume.spacing_mm[a]);
-                wr_f32(p + 28 + 4 * a, def->volume.origin_mm[a]);
+                sc_le_wr_u32(p + 4 * a, def->volume.dim[a]);
+                sc_le_wr_f32(p + 16 + 4 * a, def->volume.spacing_mm[a]);
+                sc_le_wr_f32(p + 28 + 4 * a, def->volume.origin_mm[a]);
             }
             for (int i = 0; i < 9; i++) {
-                wr_f32(p + 40 + 4 * i, def->orientation[i]);
+                sc_le_wr_f32(p + 40 + 4 * i, def->orientation[i]);
             }
-            wr_u32(p + 76, def->imaging_flags);
-            wr_f32(p + 12, def->usable_depth_mm);
+            sc_le_wr_u32(p + 76, def->imaging_flags);
+            sc_le_wr_f32(p + 12, def->usable_depth_mm);
             break;
         case 2:
             memcpy(p, def->volume.voxels, n);
@@ -278,34 +239,34 @@ int sc_case_write(const sc_case_def *def, uint8_t *buf, size_t cap, size_t *out_
             memcpy(p, def->volume.labels, n);
             break;
         case 4:
-            wr_u32(p, def->material_count);
+            sc_le_wr_u32(p, def->material_count);
             for (uint32_t m = 0; m < def->material_count; m++) {
                 uint8_t *r = p + SC_CASE_MATL_HEAD_SIZE + m * SC_CASE_MATERIAL_RECORD_SIZE;
-                wr_f32(r, def->materials[m].e_pa);
-                wr_f32(r + 4, def->materials[m].poisson);
-                wr_f32(r + 8, def->materials[m].density_kg_m3);
+                sc_le_wr_f32(r, def->materials[m].e_pa);
+                sc_le_wr_f32(r + 4, def->materials[m].poisson);
+                sc_le_wr_f32(r + 8, def->materials[m].density_kg_m3);
             }
             break;
         case 5:
-            wr_f32(p + 0, def->mesh.origin_mm[0]);
-            wr_f32(p + 4, def->mesh.origin_mm[1]);
-            wr_f32(p + 8, def->mesh.origin_mm[2]);
-            wr_f32(p + 12, def->mesh.size_mm[0]);
-            wr_f32(p + 16, def->mesh.size_mm[1]);
-            wr_f32(p + 20, def->mesh.size_mm[2]);
-            wr_u32(p + 24, def->mesh.nx);
-            wr_u32(p + 28, def->mesh.ny);
-            wr_u32(p + 32, def->mesh.nz);
+            sc_le_wr_f32(p + 0, def->mesh.origin_mm[0]);
+            sc_le_wr_f32(p + 4, def->mesh.origin_mm[1]);
+            sc_le_wr_f32(p + 8, def->mesh.origin_mm[2]);
+            sc_le_wr_f32(p + 12, def->mesh.size_mm[0]);
+            sc_le_wr_f32(p + 16, def->mesh.size_mm[1]);
+            sc_le_wr_f32(p + 20, def->mesh.size_mm[2]);
+            sc_le_wr_u32(p + 24, def->mesh.nx);
+            sc_le_wr_u32(p + 28, def->mesh.ny);
+            sc_le_wr_u32(p + 32, def->mesh.nz);
             break;
         default:
             wr_xform(p, &def->image_to_probe);
             wr_xform(p + 48, &def->tracker_to_patient);
             break;
         }
-        wr_u32(h + SEC_TAG, tags[s]);
-        wr_u64(h + SEC_SIZE, sizes[s]);
-        wr_u32(h + SEC_CRC, sc_crc32(p, n));
-        wr_u32(h + SEC_HCRC, sc_crc32(h, SEC_HCRC));
+        sc_le_wr_u32(h + SEC_TAG, tags[s]);
+        sc_le_wr_u64(h + SEC_SIZE, sizes[s]);
+        sc_le_wr_u32(h + SEC_CRC, sc_crc32(p, n));
+        sc_le_wr_u32(h + SEC_HCRC, sc_crc32(h, SEC_HCRC));
         off = (size_t)align_up((uint64_t)off + SC_CASE_SECTION_HEADER_SIZE + sizes[s]);
     }
     *out_size = (size_t)total;
@@ -355,27 +316,27 @@ static int load_sections(const uint8_t *bytes, size_t size, section_ref sec[SC_C
     if (size < SC_CASE_HEADER_SIZE) {
         return SC_ERR_CASE_TRUNCATED;
     }
-    if (rd_u32(bytes + HDR_CRC) != sc_crc32(bytes, HDR_CRC)) {
+    if (sc_le_rd_u32(bytes + HDR_CRC) != sc_crc32(bytes, HDR_CRC)) {
         return SC_ERR_CASE_CRC;
     }
-    if (rd_u32(bytes + HDR_VERSION) != SC_CASE_VERSION) {
+    if (sc_le_rd_u32(bytes + HDR_VERSION) != SC_CASE_VERSION) {
         return SC_ERR_CASE_VERSION;
     }
-    if (rd_u32(bytes + HDR_HEADER_SIZE) != SC_CASE_HEADER_SIZE) {
+    if (sc_le_rd_u32(bytes + HDR_HEADER_SIZE) != SC_CASE_HEADER_SIZE) {
         return SC_ERR_CASE_SECTION;
     }
-    if (rd_u32(bytes + HDR_FLAGS) != 0u ||
+    if (sc_le_rd_u32(bytes + HDR_FLAGS) != 0u ||
         !all_zero(bytes + HDR_RESERVED, HDR_CRC - HDR_RESERVED)) {
         return SC_ERR_CASE_RESERVED;
     }
-    const uint64_t file_size = rd_u64(bytes + HDR_FILE_SIZE);
+    const uint64_t file_size = sc_le_rd_u64(bytes + HDR_FILE_SIZE);
     if (file_size > (uint64_t)size) {
         return SC_ERR_CASE_TRUNCATED;
     }
     if (file_size < (uint64_t)size || (file_size % SC_CASE_ALIGN) != 0u) {
         return SC_ERR_CASE_SIZE; /* trailing bytes after the last section, or odd size */
     }
-    const uint32_t count = rd_u32(bytes + HDR_SECTION_COUNT);
+    const uint32_t count = sc_le_rd_u32(bytes + HDR_SECTION_COUNT);
     if (count < SC_CASE_SECTION_COUNT || count > SC_CASE_MAX_SECTIONS) {
         return SC_ERR_CASE_SECTION;
     }
@@ -395,14 +356,15 @@ static int load_sections(const uint8_t *bytes, size_t size, section_ref sec[SC_C
             return SC_ERR_CASE_TRUNCATED;
         }
         const uint8_t *h = bytes + off;
-        if (rd_u32(h + SEC_HCRC) != sc_crc32(h, SEC_HCRC)) {
+        if (sc_le_rd_u32(h + SEC_HCRC) != sc_crc32(h, SEC_HCRC)) {
             return SC_ERR_CASE_CRC;
         }
         id = sc_crc32_update(id, h, SEC_HCRC);
-        if (rd_u32(h + SEC_FLAGS) != 0u || !all_zero(h + SEC_RESERVED, SEC_HCRC - SEC_RESERVED)) {
+        if (sc_le_rd_u32(h + SEC_FLAGS) != 0u ||
+            !all_zero(h + SEC_RESERVED, SEC_HCRC - SEC_RESERVED)) {
             return SC_ERR_CASE_RESERVED;
         }
-        const uint64_t psize = rd_u64(h + SEC_SIZE);
+        const uint64_t psize = sc_le_rd_u64(h + SEC_SIZE);
         const uint64_t avail = file_size - off - SC_CASE_SECTION_HEADER_SIZE;
         if (psize > avail) {
             return SC_ERR_CASE_TRUNCATED;
@@ -411,8 +373,8 @@ static int load_sections(const uint8_t *bytes, size_t size, section_ref sec[SC_C
         if (chk != NULL) {
             chk->sec_off[i] = off + SC_CASE_SECTION_HEADER_SIZE;
             chk->sec_size[i] = psize;
-            chk->sec_crc[i] = rd_u32(h + SEC_CRC);
-        } else if (rd_u32(h + SEC_CRC) != sc_crc32(p, (size_t)psize)) {
+            chk->sec_crc[i] = sc_le_rd_u32(h + SEC_CRC);
+        } else if (sc_le_rd_u32(h + SEC_CRC) != sc_crc32(p, (size_t)psize)) {
             return SC_ERR_CASE_CRC;
         }
         /* padding up to the next 64-byte boundary: present and zero */
@@ -424,7 +386,7 @@ static int load_sections(const uint8_t *bytes, size_t size, section_ref sec[SC_C
         if (!all_zero(bytes + end, (size_t)(next - end))) {
             return SC_ERR_CASE_RESERVED;
         }
-        int idx = tag_index(rd_u32(h + SEC_TAG));
+        int idx = tag_index(sc_le_rd_u32(h + SEC_TAG));
         if (idx >= 0) {
             if (sec[idx].p != NULL) {
                 return SC_ERR_CASE_SECTION; /* duplicated */
@@ -500,23 +462,23 @@ static int parse_case(const section_ref sec[SC_CASE_SECTION_COUNT], uint32_t cas
     if (sec[1].size != SC_CASE_GRID_SIZE) {
         return SC_ERR_CASE_SIZE;
     }
-    if ((rd_u32(g + 76) & ~SC_CASE_IMAGING_KNOWN) != 0u) {
+    if ((sc_le_rd_u32(g + 76) & ~SC_CASE_IMAGING_KNOWN) != 0u) {
         return SC_ERR_CASE_RESERVED;
     }
-    c.imaging_flags = rd_u32(g + 76);
-    c.usable_depth_mm = rd_f32(g + 12); /* formerly reserved zero: 0 = not stated */
+    c.imaging_flags = sc_le_rd_u32(g + 76);
+    c.usable_depth_mm = sc_le_rd_f32(g + 12); /* formerly reserved zero: 0 = not stated */
     if (!isfinite(c.usable_depth_mm) || c.usable_depth_mm < 0.0f ||
         (c.usable_depth_mm > 0.0f && !(c.usable_depth_mm >= SC_CASE_MIN_DEPTH_MM &&
                                        c.usable_depth_mm <= SC_CASE_MAX_DEPTH_MM))) {
         return SC_ERR_CASE_DEPTH;
     }
     for (int a = 0; a < 3; a++) {
-        c.volume.dim[a] = rd_u32(g + 4 * a);
-        c.volume.spacing_mm[a] = rd_f32(g + 16 + 4 * a);
-        c.volume.origin_mm[a] = rd_f32(g + 28 + 4 * a);
+        c.volume.dim[a] = sc_le_rd_u32(g + 4 * a);
+        c.volume.spacing_mm[a] = sc_le_rd_f32(g + 16 + 4 * a);
+        c.volume.origin_mm[a] = sc_le_rd_f32(g + 28 + 4 * a);
     }
     for (int i = 0; i < 9; i++) {
-        c.orientation[i] = rd_f32(g + 40 + 4 * i);
+        c.orientation[i] = sc_le_rd_f32(g + 40 + 4 * i);
     }
     rc = dims_voxels(c.volume.dim, &c.voxel_count);
     if (rc != SC_OK) {
@@ -559,8 +521,8 @@ static int parse_case(const section_ref sec[SC_CASE_SECTION_COUNT], uint32_t cas
     if (sec[4].size < SC_CASE_MATL_HEAD_SIZE) {
         return SC_ERR_CASE_SIZE;
     }
-    c.material_count = rd_u32(mt);
-    if (rd_u32(mt + 4) != 0u) {
+    c.material_count = sc_le_rd_u32(mt);
+    if (sc_le_rd_u32(mt + 4) != 0u) {
         return SC_ERR_CASE_RESERVED;
     }
     if (c.material_count == 0u || c.material_count > SC_MAX_LABELS) {
@@ -572,10 +534,10 @@ static int parse_case(const section_ref sec[SC_CASE_SECTION_COUNT], uint32_t cas
     }
     for (uint32_t m = 0; m < c.material_count; m++) {
         const uint8_t *r = mt + SC_CASE_MATL_HEAD_SIZE + m * SC_CASE_MATERIAL_RECORD_SIZE;
-        c.materials[m].e_pa = rd_f32(r);
-        c.materials[m].poisson = rd_f32(r + 4);
-        c.materials[m].density_kg_m3 = rd_f32(r + 8);
-        if (rd_u32(r + 12) != 0u) {
+        c.materials[m].e_pa = sc_le_rd_f32(r);
+        c.materials[m].poisson = sc_le_rd_f32(r + 4);
+        c.materials[m].density_kg_m3 = sc_le_rd_f32(r + 8);
+        if (sc_le_rd_u32(r + 12) != 0u) {
             return SC_ERR_CASE_RESERVED;
         }
         if (!material_ok(&c.materials[m])) {
@@ -611,16 +573,16 @@ static int parse_case(const section_ref sec[SC_CASE_SECTION_COUNT], uint32_t cas
     if (sec[5].size != SC_CASE_MESH_SIZE) {
         return SC_ERR_CASE_SIZE;
     }
-    if (rd_u32(mp + 36) != 0u) {
+    if (sc_le_rd_u32(mp + 36) != 0u) {
         return SC_ERR_CASE_RESERVED;
     }
     for (int a = 0; a < 3; a++) {
-        c.mesh.origin_mm[a] = rd_f32(mp + 4 * a);
-        c.mesh.size_mm[a] = rd_f32(mp + 12 + 4 * a);
+        c.mesh.origin_mm[a] = sc_le_rd_f32(mp + 4 * a);
+        c.mesh.size_mm[a] = sc_le_rd_f32(mp + 12 + 4 * a);
     }
-    c.mesh.nx = rd_u32(mp + 24);
-    c.mesh.ny = rd_u32(mp + 28);
-    c.mesh.nz = rd_u32(mp + 32);
+    c.mesh.nx = sc_le_rd_u32(mp + 24);
+    c.mesh.ny = sc_le_rd_u32(mp + 28);
+    c.mesh.nz = sc_le_rd_u32(mp + 32);
     if (c.mesh.nx < 2u || c.mesh.nx > SC_MAX_MESH_NX || c.mesh.ny < 2u ||
         c.mesh.ny > SC_MAX_MESH_NY || c.mesh.nz < 2u || c.mesh.nz > SC_MAX_MESH_NZ) {
         return SC_ERR_CASE_MESH_NODES;

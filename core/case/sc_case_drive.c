@@ -5,56 +5,30 @@
 
 #include "sc_case.h"
 #include "sc_err.h"
-
-static uint32_t rd_u32(const uint8_t *p)
-{
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
-}
-
-static float rd_f32(const uint8_t *p)
-{
-    const uint32_t u = rd_u32(p);
-    float f;
-    memcpy(&f, &u, sizeof f);
-    return f;
-}
-
-static void wr_u32(uint8_t *p, uint32_t v)
-{
-    p[0] = (uint8_t)v;
-    p[1] = (uint8_t)(v >> 8);
-    p[2] = (uint8_t)(v >> 16);
-    p[3] = (uint8_t)(v >> 24);
-}
-
-static void wr_f32(uint8_t *p, float f)
-{
-    uint32_t u;
-    memcpy(&u, &f, sizeof u);
-    wr_u32(p, u);
-}
+#include "sc_le.h"
 
 int sc_case_drive_parse(const uint8_t *p, uint64_t n, sc_case_drive *out)
 {
     if (p == NULL || out == NULL) {
         return SC_ERR_INVALID_ARG;
     }
-    if (n != SC_CASE_DRIVE_SIZE || rd_u32(p) != SC_CASE_DRIVE_VERSION || rd_u32(p + 28) != 0u) {
+    if (n != SC_CASE_DRIVE_SIZE || sc_le_rd_u32(p) != SC_CASE_DRIVE_VERSION ||
+        sc_le_rd_u32(p + 28) != 0u) {
         return SC_ERR_CASE_DRIVE;
     }
-    const uint32_t wave = rd_u32(p + 12);
+    const uint32_t wave = sc_le_rd_u32(p + 12);
     if (wave > (uint32_t)SC_LUMEN_WAVE_SINE) {
         return SC_ERR_CASE_DRIVE;
     }
     sc_case_drive v;
     memset(&v, 0, sizeof v);
     v.present = 1u;
-    v.d.heart_rate_bpm = rd_f32(p + 4);
-    v.d.pulse_pa = rd_f32(p + 8);
+    v.d.heart_rate_bpm = sc_le_rd_f32(p + 4);
+    v.d.pulse_pa = sc_le_rd_f32(p + 8);
     v.d.wave = (uint8_t)wave;
-    v.d.resp_rate_bpm = rd_f32(p + 16);
-    v.d.resp_pa = rd_f32(p + 20);
-    v.d.valsalva_pa = rd_f32(p + 24);
+    v.d.resp_rate_bpm = sc_le_rd_f32(p + 16);
+    v.d.resp_pa = sc_le_rd_f32(p + 20);
+    v.d.valsalva_pa = sc_le_rd_f32(p + 24);
     v.d.valsalva = 0u;
     if (sc_lumen_drive_validate(&v.d) != SC_OK) {
         return SC_ERR_CASE_DRIVE;
@@ -68,17 +42,18 @@ int sc_case_drive_find(const uint8_t *bytes, size_t size, sc_case_drive *out)
     if (bytes == NULL || out == NULL || size < SC_CASE_HEADER_SIZE) {
         return SC_ERR_INVALID_ARG;
     }
-    const uint32_t count = rd_u32(bytes + 24);
+    const uint32_t count = sc_le_rd_u32(bytes + 24);
     uint64_t off = SC_CASE_HEADER_SIZE;
     const uint8_t *found = NULL;
     uint64_t found_n = 0;
     for (uint32_t i = 0; i < count && off + SC_CASE_SECTION_HEADER_SIZE <= size; i++) {
         const uint8_t *h = bytes + off;
-        const uint64_t psize = (uint64_t)rd_u32(h + 8) | ((uint64_t)rd_u32(h + 12) << 32);
+        const uint64_t psize =
+            (uint64_t)sc_le_rd_u32(h + 8) | ((uint64_t)sc_le_rd_u32(h + 12) << 32);
         if (psize > size - off - SC_CASE_SECTION_HEADER_SIZE) {
             return SC_ERR_CASE_TRUNCATED; /* the framing check would have refused it */
         }
-        if (rd_u32(h) == SC_CASE_TAG_DRIV_U32) {
+        if (sc_le_rd_u32(h) == SC_CASE_TAG_DRIV_U32) {
             if (found != NULL) {
                 return SC_ERR_CASE_SECTION; /* duplicated */
             }
@@ -107,12 +82,12 @@ int sc_case_drive_encode(const sc_lumen_drive *d, uint8_t out[SC_CASE_DRIVE_SIZE
         return rc;
     }
     memset(out, 0, SC_CASE_DRIVE_SIZE);
-    wr_u32(out, SC_CASE_DRIVE_VERSION);
-    wr_f32(out + 4, v.heart_rate_bpm);
-    wr_f32(out + 8, v.pulse_pa);
-    wr_u32(out + 12, v.wave);
-    wr_f32(out + 16, v.resp_rate_bpm);
-    wr_f32(out + 20, v.resp_pa);
-    wr_f32(out + 24, v.valsalva_pa);
+    sc_le_wr_u32(out, SC_CASE_DRIVE_VERSION);
+    sc_le_wr_f32(out + 4, v.heart_rate_bpm);
+    sc_le_wr_f32(out + 8, v.pulse_pa);
+    sc_le_wr_u32(out + 12, v.wave);
+    sc_le_wr_f32(out + 16, v.resp_rate_bpm);
+    sc_le_wr_f32(out + 20, v.resp_pa);
+    sc_le_wr_f32(out + 24, v.valsalva_pa);
     return SC_OK;
 }

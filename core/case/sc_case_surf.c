@@ -7,38 +7,7 @@
 #include "sc_case.h"
 #include "sc_crc32.h"
 #include "sc_err.h"
-
-static uint32_t rd_u32(const uint8_t *p)
-{
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
-}
-
-static uint64_t rd_u64(const uint8_t *p)
-{
-    return (uint64_t)rd_u32(p) | ((uint64_t)rd_u32(p + 4) << 32);
-}
-
-static float rd_f32(const uint8_t *p)
-{
-    const uint32_t u = rd_u32(p);
-    float f;
-    memcpy(&f, &u, sizeof f);
-    return f;
-}
-
-static void wr_u32(uint8_t *p, uint32_t v)
-{
-    p[0] = (uint8_t)v;
-    p[1] = (uint8_t)(v >> 8);
-    p[2] = (uint8_t)(v >> 16);
-    p[3] = (uint8_t)(v >> 24);
-}
-
-static void wr_u64(uint8_t *p, uint64_t v)
-{
-    wr_u32(p, (uint32_t)v);
-    wr_u32(p + 4, (uint32_t)(v >> 32));
-}
+#include "sc_le.h"
 
 uint64_t sc_case_surf_payload_size(uint32_t surfaces, uint32_t vertices, uint32_t triangles)
 {
@@ -57,10 +26,10 @@ int sc_case_surf_parse(const uint8_t *p, uint64_t n, uint32_t tet_count, sc_case
     if (p == NULL || out == NULL) {
         return SC_ERR_INVALID_ARG;
     }
-    if (n < SC_CASE_SURF_HEAD_SIZE || rd_u32(p) != SC_CASE_SURF_VERSION) {
+    if (n < SC_CASE_SURF_HEAD_SIZE || sc_le_rd_u32(p) != SC_CASE_SURF_VERSION) {
         return SC_ERR_CASE_SURFACE;
     }
-    const uint32_t ns = rd_u32(p + 4), nv = rd_u32(p + 8), nt = rd_u32(p + 12);
+    const uint32_t ns = sc_le_rd_u32(p + 4), nv = sc_le_rd_u32(p + 8), nt = sc_le_rd_u32(p + 12);
     if (ns < 1u || ns > SC_CASE_SURF_MAX_SURFACES || nv > SC_CASE_SURF_MAX_VERTICES ||
         nt > SC_CASE_SURF_MAX_TRIANGLES || n != sc_case_surf_payload_size(ns, nv, nt)) {
         return SC_ERR_CASE_SURFACE;
@@ -78,9 +47,9 @@ int sc_case_surf_parse(const uint8_t *p, uint64_t n, uint32_t tet_count, sc_case
         sc_case_surface *s = &v.s[i];
         s->label = r[0];
         s->kind = r[1];
-        s->first_vertex = rd_u32(r + 4);
-        s->vertex_count = rd_u32(r + 8);
-        s->triangle_count = rd_u32(r + 12);
+        s->first_vertex = sc_le_rd_u32(r + 4);
+        s->vertex_count = sc_le_rd_u32(r + 8);
+        s->triangle_count = sc_le_rd_u32(r + 12);
         s->first_triangle = tsum;
         if ((s->kind != SC_CASE_SURF_SKIN && s->kind != SC_CASE_SURF_VESSEL) || r[2] != 0u ||
             r[3] != 0u || s->label >= SC_MAX_LABELS || s->first_vertex != vsum ||
@@ -95,8 +64,8 @@ int sc_case_surf_parse(const uint8_t *p, uint64_t n, uint32_t tet_count, sc_case
     }
     for (uint32_t i = 0; i < nv; i++) {
         const uint8_t *q = v.vertices + (size_t)i * SC_CASE_SURF_VERTEX_SIZE;
-        const float w0 = rd_f32(q + 4), w1 = rd_f32(q + 8), w2 = rd_f32(q + 12);
-        if (rd_u32(q) >= tet_count || !weight_ok(w0) || !weight_ok(w1) || !weight_ok(w2) ||
+        const float w0 = sc_le_rd_f32(q + 4), w1 = sc_le_rd_f32(q + 8), w2 = sc_le_rd_f32(q + 12);
+        if (sc_le_rd_u32(q) >= tet_count || !weight_ok(w0) || !weight_ok(w1) || !weight_ok(w2) ||
             !weight_ok(1.0f - w0 - w1 - w2)) {
             return SC_ERR_CASE_SURFACE;
         }
@@ -106,7 +75,7 @@ int sc_case_surf_parse(const uint8_t *p, uint64_t n, uint32_t tet_count, sc_case
         for (uint32_t t = s->first_triangle; t < s->first_triangle + s->triangle_count; t++) {
             const uint8_t *q = v.triangles + (size_t)t * SC_CASE_SURF_TRI_SIZE;
             for (int k = 0; k < 3; k++) {
-                const uint32_t a = rd_u32(q + 4 * k);
+                const uint32_t a = sc_le_rd_u32(q + 4 * k);
                 if (a < s->first_vertex || a - s->first_vertex >= s->vertex_count) {
                     return SC_ERR_CASE_SURFACE;
                 }
@@ -123,18 +92,18 @@ int sc_case_surf_find(const uint8_t *bytes, size_t size, const sc_mesh_def *mesh
     if (bytes == NULL || mesh == NULL || out == NULL || size < SC_CASE_HEADER_SIZE) {
         return SC_ERR_INVALID_ARG;
     }
-    const uint32_t count = rd_u32(bytes + 24);
+    const uint32_t count = sc_le_rd_u32(bytes + 24);
     const uint32_t tets = 5u * (mesh->nx - 1u) * (mesh->ny - 1u) * (mesh->nz - 1u);
     uint64_t off = SC_CASE_HEADER_SIZE;
     const uint8_t *found = NULL;
     uint64_t found_n = 0;
     for (uint32_t i = 0; i < count && off + SC_CASE_SECTION_HEADER_SIZE <= size; i++) {
         const uint8_t *h = bytes + off;
-        const uint64_t psize = rd_u64(h + 8);
+        const uint64_t psize = sc_le_rd_u64(h + 8);
         if (psize > size - off - SC_CASE_SECTION_HEADER_SIZE) {
             return SC_ERR_CASE_TRUNCATED; /* the framing check would have refused it */
         }
-        if (rd_u32(h) == SC_CASE_TAG_SURF_U32) {
+        if (sc_le_rd_u32(h) == SC_CASE_TAG_SURF_U32) {
             if (found != NULL) {
                 return SC_ERR_CASE_SECTION; /* duplicated */
             }
@@ -154,19 +123,19 @@ int sc_case_surf_find(const uint8_t *bytes, size_t size, const sc_mesh_def *mesh
 void sc_case_surf_vertex(const sc_case_surf *s, uint32_t v, uint32_t *tet, float w[4])
 {
     const uint8_t *q = s->vertices + (size_t)v * SC_CASE_SURF_VERTEX_SIZE;
-    *tet = rd_u32(q);
-    w[0] = rd_f32(q + 4);
-    w[1] = rd_f32(q + 8);
-    w[2] = rd_f32(q + 12);
+    *tet = sc_le_rd_u32(q);
+    w[0] = sc_le_rd_f32(q + 4);
+    w[1] = sc_le_rd_f32(q + 8);
+    w[2] = sc_le_rd_f32(q + 12);
     w[3] = 1.0f - w[0] - w[1] - w[2];
 }
 
 void sc_case_surf_triangle(const sc_case_surf *s, uint32_t t, uint32_t idx[3])
 {
     const uint8_t *q = s->triangles + (size_t)t * SC_CASE_SURF_TRI_SIZE;
-    idx[0] = rd_u32(q);
-    idx[1] = rd_u32(q + 4);
-    idx[2] = rd_u32(q + 8);
+    idx[0] = sc_le_rd_u32(q);
+    idx[1] = sc_le_rd_u32(q + 4);
+    idx[2] = sc_le_rd_u32(q + 8);
 }
 
 int sc_case_append_section(uint8_t *buf, size_t cap, size_t *size, uint32_t tag,
@@ -183,16 +152,16 @@ int sc_case_append_section(uint8_t *buf, size_t cap, size_t *size, uint32_t tag,
     }
     uint8_t *h = buf + *size;
     memset(h, 0, SC_CASE_SECTION_HEADER_SIZE + padded);
-    wr_u32(h, tag);
-    wr_u64(h + 8, n);
+    sc_le_wr_u32(h, tag);
+    sc_le_wr_u64(h + 8, n);
     if (n > 0u) {
         memcpy(h + SC_CASE_SECTION_HEADER_SIZE, payload, n);
     }
-    wr_u32(h + 16, sc_crc32(h + SC_CASE_SECTION_HEADER_SIZE, n));
-    wr_u32(h + 60, sc_crc32(h, 60));
-    wr_u64(buf + 16, need);
-    wr_u32(buf + 24, rd_u32(buf + 24) + 1u);
-    wr_u32(buf + 60, sc_crc32(buf, 60));
+    sc_le_wr_u32(h + 16, sc_crc32(h + SC_CASE_SECTION_HEADER_SIZE, n));
+    sc_le_wr_u32(h + 60, sc_crc32(h, 60));
+    sc_le_wr_u64(buf + 16, need);
+    sc_le_wr_u32(buf + 24, sc_le_rd_u32(buf + 24) + 1u);
+    sc_le_wr_u32(buf + 60, sc_crc32(buf, 60));
     *size = need;
     return SC_OK;
 }
