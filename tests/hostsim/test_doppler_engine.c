@@ -5,13 +5,11 @@
  * colour for the same input (replayed, hashes). */
 #include "sc_test.h"
 
-#include <math.h>
 #include <stdlib.h>
-#include <string.h>
 
 #include "sc_err.h"
 #include "sc_hs_rig.h"
-#include "sc_hs_storage.h"
+#include "sc_test_block_rig.h"
 #include "sc_test_case.h"
 #include "sc_trkemu.h"
 
@@ -40,47 +38,15 @@ typedef struct run_out {
 
 static run_out run_session(uint32_t frames)
 {
-    sc_engine_def def = sc_test_engine_def();
-    def.tissue.collider = sc_test_scene_collider(&block.scene);
-    def.doppler.box_u0 = 0.0f;
-    def.doppler.box_u1 = 1.0f;
-    def.doppler.box_v0 = 0.0f;
-    def.doppler.box_v1 = 1.0f;
-    def.doppler.prf_hz = 8000.0f;
-    def.case_names[0] = "block";
-    def.case_count = 1;
-    assert_int_equal(sc_hs_rig_init(&rig, &def, 3, 0), SC_OK);
-    assert_int_equal(sc_hs_storage_add(&rig.storage, "block", block.bytes, block.size), SC_OK);
-    assert_int_equal(sc_engine_load_case(&rig.engine, "block"), SC_OK);
-    sc_emu_def pd = sc_emu_default_def();
-    pd.script = SC_EMU_PRESS;
-    memcpy(pd.point_mm, block.centre_tracker_mm, sizeof pd.point_mm);
-    pd.hover_mm = 2.0f;
-    pd.depth_mm = 3.0f;
-    pd.duration_s = 10.0;
+    sc_test_block_rig_up(&rig, &block, 3, 1);
     /* the default orientation (beam down) rolled 20 degrees about x */
-    const float a = 10.0f * 3.14159265f / 180.0f;
-    const float r[4] = {cosf(a), sinf(a), 0.0f, 0.0f};
-    const float b[4] = {pd.base_q[0], pd.base_q[1], pd.base_q[2], pd.base_q[3]};
-    pd.base_q[0] = r[0] * b[0] - r[1] * b[1] - r[2] * b[2] - r[3] * b[3];
-    pd.base_q[1] = r[0] * b[1] + r[1] * b[0] + r[2] * b[3] - r[3] * b[2];
-    pd.base_q[2] = r[0] * b[2] - r[1] * b[3] + r[2] * b[0] + r[3] * b[1];
-    pd.base_q[3] = r[0] * b[3] + r[1] * b[2] - r[2] * b[1] + r[3] * b[0];
+    const sc_emu_def pd = sc_test_block_probe_def(&block, 3.0f, 20.0f);
     assert_int_equal(sc_emu_init(&emu, &pd), SC_OK);
-    const uint64_t t0 = rig.clock.now_ns;
-    uint64_t next = 0, contact_frames = 0;
-    sc_can_frame f[SC_EMU_MAX_FRAMES];
+    sc_test_feed feed;
+    sc_test_feed_start(&feed, &rig, &emu, NULL);
+    uint64_t contact_frames = 0;
     for (uint32_t i = 0; i < frames; i++) {
-        const uint64_t release = sc_engine_next_release_ns(&rig.engine);
-        while (t0 + next <= release) {
-            uint64_t t;
-            const int k = sc_emu_next(&emu, f, SC_EMU_MAX_FRAMES, &t);
-            assert_true(k >= 0);
-            for (int j = 0; j < k; j++) {
-                (void)sc_can_send(&rig.peer, &f[j]);
-            }
-            next = t + (uint64_t)(1e9 / emu.def.rate_hz);
-        }
+        sc_test_feed_due(&feed, &rig, sc_engine_next_release_ns(&rig.engine));
         sc_engine_step(&rig.engine, NULL);
         contact_frames += rig.engine.tissue_out.contact;
     }

@@ -9,14 +9,13 @@
  * identical; at the end the needle's punctures and the assessment are the same. */
 #include "sc_test.h"
 
-#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "sc_candump.h"
 #include "sc_err.h"
 #include "sc_hs_rig.h"
-#include "sc_hs_storage.h"
+#include "sc_test_block_rig.h"
 #include "sc_test_case.h"
 #include "sc_trkemu.h"
 
@@ -72,47 +71,17 @@ static void record_frame(void *user, const sc_can_frame *f)
 
 static void rig_up(void)
 {
-    sc_engine_def def = sc_test_engine_def();
-    def.tissue.collider = sc_test_scene_collider(&block.scene);
-    def.doppler.box_u0 = 0.0f;
-    def.doppler.box_u1 = 1.0f;
-    def.doppler.box_v0 = 0.0f;
-    def.doppler.box_v1 = 1.0f;
-    def.doppler.prf_hz = 8000.0f;
-    def.case_names[0] = "block";
-    def.case_count = 1;
-    assert_int_equal(sc_hs_rig_init(&rig, &def, 3, 0), SC_OK);
-    assert_int_equal(sc_hs_storage_add(&rig.storage, "block", block.bytes, block.size), SC_OK);
-    assert_int_equal(sc_engine_load_case(&rig.engine, "block"), SC_OK);
+    sc_test_block_rig_up(&rig, &block, 3, 1);
 }
 
 static void emulators_up(void)
 {
-    sc_emu_def pd = sc_emu_default_def();
-    pd.script = SC_EMU_PRESS;
-    memcpy(pd.point_mm, block.centre_tracker_mm, sizeof pd.point_mm);
-    pd.hover_mm = 2.0f;
-    pd.depth_mm = 2.0f;
-    pd.duration_s = 10.0;
-    const float a = 5.0f * 3.14159265f / 180.0f; /* half of a 10-degree roll about x */
-    const float r[4] = {cosf(a), sinf(a), 0.0f, 0.0f};
-    const float b[4] = {pd.base_q[0], pd.base_q[1], pd.base_q[2], pd.base_q[3]};
-    pd.base_q[0] = r[0] * b[0] - r[1] * b[1] - r[2] * b[2] - r[3] * b[3];
-    pd.base_q[1] = r[0] * b[1] + r[1] * b[0] + r[2] * b[3] - r[3] * b[2];
-    pd.base_q[2] = r[0] * b[2] - r[1] * b[3] + r[2] * b[0] + r[3] * b[1];
-    pd.base_q[3] = r[0] * b[3] + r[1] * b[2] - r[2] * b[1] + r[3] * b[0];
+    /* the probe pressing 2 mm with a 10-degree roll about x */
+    const sc_emu_def pd = sc_test_block_probe_def(&block, 2.0f, 10.0f);
     assert_int_equal(sc_emu_init(&emu, &pd), SC_OK);
     /* the needle of test_needle_engine: from 8 mm beside the vein toward its axis */
-    sc_emu_needle_def nd = sc_emu_needle_default_def();
-    nd.entry_mm[0] = block.vein_tracker_mm[0] - 8.0f;
-    nd.entry_mm[1] = block.vein_tracker_mm[1];
-    nd.entry_mm[2] = 0.0f;
-    nd.dir[0] = 8.0f;
-    nd.dir[1] = 0.0f;
-    nd.dir[2] = -10.0f;
-    nd.speed_mm_s = 10.0f;
-    nd.max_depth_mm = 14.0f;
-    nd.hold_s = 0.5;
+    const sc_emu_needle_def nd =
+        sc_test_block_needle_def(&block, block.vein_tracker_mm[0] - 8.0f, 8.0f, 0.5);
     assert_int_equal(sc_emu_needle_init(&needle, &nd), SC_OK);
 }
 
@@ -142,28 +111,10 @@ static void record_session(void)
     rig_up();
     emulators_up();
     rig.tap.fn = record_frame;
-    const uint64_t t0 = rig.clock.now_ns;
-    uint64_t probe_next = 0, needle_next = 0;
-    sc_can_frame f[SC_EMU_MAX_FRAMES];
+    sc_test_feed feed;
+    sc_test_feed_start(&feed, &rig, &emu, &needle);
     for (uint32_t i = 0; i < FRAMES; i++) {
-        const uint64_t release = sc_engine_next_release_ns(&rig.engine);
-        while (t0 + probe_next <= release) {
-            uint64_t t;
-            const int k = sc_emu_next(&emu, f, SC_EMU_MAX_FRAMES, &t);
-            assert_true(k >= 0);
-            for (int j = 0; j < k; j++) {
-                (void)sc_can_send(&rig.peer, &f[j]);
-            }
-            probe_next = t + (uint64_t)(1e9 / emu.def.rate_hz);
-        }
-        while (t0 + needle_next <= release) {
-            uint64_t t;
-            assert_int_equal(sc_emu_needle_next(&needle, f, 3u, &t), 3);
-            for (int j = 0; j < 3; j++) {
-                (void)sc_can_send(&rig.peer, &f[j]);
-            }
-            needle_next = t + (uint64_t)(1e9 / needle.def.rate_hz);
-        }
+        sc_test_feed_due(&feed, &rig, sc_engine_next_release_ns(&rig.engine));
         sc_engine_step(&rig.engine, NULL);
         after_frame(&g_rec, i);
         sc_can_frame r;

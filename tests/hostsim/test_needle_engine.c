@@ -9,12 +9,11 @@
 
 #include <math.h>
 #include <stdlib.h>
-#include <string.h>
 
 #include "sc_canproto.h"
 #include "sc_err.h"
 #include "sc_hs_rig.h"
-#include "sc_hs_storage.h"
+#include "sc_test_block_rig.h"
 #include "sc_test_case.h"
 #include "sc_trkemu.h"
 
@@ -48,35 +47,17 @@ typedef struct needle_seen {
 
 /* n frames; probe and needle samples due before each frame go on the bus, the engine's
  * NeedleStatus frames are read back by the peer */
-static uint64_t t0, probe_next, needle_next; /* emulator time 0 on the rig's clock, next samples */
+static sc_test_feed feed;
 
 static void run(uint32_t n, needle_seen *seen)
 {
-    sc_can_frame f[SC_EMU_MAX_FRAMES];
     for (uint32_t i = 0; i < n; i++) {
-        const uint64_t release = sc_engine_next_release_ns(&rig.engine);
-        while (t0 + probe_next <= release) {
-            uint64_t t;
-            const int k = sc_emu_next(&emu, f, SC_EMU_MAX_FRAMES, &t);
-            assert_true(k >= 0);
-            for (int j = 0; j < k; j++) {
-                (void)sc_can_send(&rig.peer, &f[j]);
-            }
-            probe_next = t + (uint64_t)(1e9 / emu.def.rate_hz);
-        }
-        while (t0 + needle_next <= release) {
-            uint64_t t;
-            assert_int_equal(sc_emu_needle_next(&needle, f, 3u, &t), 3);
-            for (int j = 0; j < 3; j++) {
-                (void)sc_can_send(&rig.peer, &f[j]);
-            }
-            needle_next = t + (uint64_t)(1e9 / needle.def.rate_hz);
-        }
+        sc_test_feed_due(&feed, &rig, sc_engine_next_release_ns(&rig.engine));
         sc_engine_step(&rig.engine, NULL);
         const sc_needle_status *ns = sc_engine_get_needle_status(&rig.engine);
         if (getenv("NEEDLE_TRACE") && i % 10u == 0u) {
             print_message("t %.2f present %u tip %u (deformed %u) depth %.1f rej %u\n",
-                          (double)(rig.clock.now_ns - t0) * 1e-9, ns->present, ns->tip_label,
+                          (double)(rig.clock.now_ns - feed.t0_ns) * 1e-9, ns->present, ns->tip_label,
                           ns->tip_label_deformed, (double)rig.engine.needle.depth_mm,
                           rig.engine.needle_rx.rejected);
         }
@@ -109,36 +90,16 @@ static void run(uint32_t n, needle_seen *seen)
 static void a_needle_into_the_vein_is_reported_once_per_entry_on_can(void **state)
 {
     (void)state;
-    sc_engine_def def = sc_test_engine_def();
-    def.tissue.collider = sc_test_scene_collider(&block.scene);
-    def.case_names[0] = "block";
-    def.case_count = 1;
-    assert_int_equal(sc_hs_rig_init(&rig, &def, 7, 0), SC_OK);
-    assert_int_equal(sc_hs_storage_add(&rig.storage, "block", block.bytes, block.size), SC_OK);
-    assert_int_equal(sc_engine_load_case(&rig.engine, "block"), SC_OK);
+    sc_test_block_rig_up(&rig, &block, 7, 0);
     /* the probe rests lightly over the block's middle (its plane holds both vessels) */
-    sc_emu_def pd = sc_emu_default_def();
-    pd.script = SC_EMU_PRESS;
-    memcpy(pd.point_mm, block.centre_tracker_mm, sizeof pd.point_mm);
-    pd.hover_mm = 2.0f;
-    pd.depth_mm = 1.0f;
-    pd.duration_s = 10.0;
+    const sc_emu_def pd = sc_test_block_probe_def(&block, 1.0f, 0.0f);
     assert_int_equal(sc_emu_init(&emu, &pd), SC_OK);
     /* the needle in the image plane, from 8 mm beside the vein toward its axis (8 mm across,
      * 10 mm down; tracker frame: (x, -y, -z) of the volume), 14 mm deep at most */
-    sc_emu_needle_def nd = sc_emu_needle_default_def();
-    nd.entry_mm[0] = block.vein_tracker_mm[0] - 8.0f;
-    nd.entry_mm[1] = block.vein_tracker_mm[1];
-    nd.entry_mm[2] = 0.0f;
-    nd.dir[0] = 8.0f;
-    nd.dir[1] = 0.0f;
-    nd.dir[2] = -10.0f;
-    nd.speed_mm_s = 10.0f;
-    nd.max_depth_mm = 14.0f;
-    nd.hold_s = 1.0;
+    const sc_emu_needle_def nd =
+        sc_test_block_needle_def(&block, block.vein_tracker_mm[0] - 8.0f, 8.0f, 1.0);
     assert_int_equal(sc_emu_needle_init(&needle, &nd), SC_OK);
-    t0 = rig.clock.now_ns;
-    probe_next = needle_next = 0u;
+    sc_test_feed_start(&feed, &rig, &emu, &needle);
     needle_seen seen = {0};
     run(180, &seen); /* 3 s: in (the wall at about 1.5 s), held */
     print_message("after 3 s: %u status frames, vein %u artery %u last %u tip %u, drawn %u px\n",
@@ -198,34 +159,14 @@ static void a_needle_into_the_vein_is_reported_once_per_entry_on_can(void **stat
 static void a_needle_into_the_artery_is_a_fault_of_the_exam_once(void **state)
 {
     (void)state;
-    sc_engine_def def = sc_test_engine_def();
-    def.tissue.collider = sc_test_scene_collider(&block.scene);
-    def.case_names[0] = "block";
-    def.case_count = 1;
-    assert_int_equal(sc_hs_rig_init(&rig, &def, 7, 0), SC_OK);
-    assert_int_equal(sc_hs_storage_add(&rig.storage, "block", block.bytes, block.size), SC_OK);
-    assert_int_equal(sc_engine_load_case(&rig.engine, "block"), SC_OK);
-    sc_emu_def pd = sc_emu_default_def();
-    pd.script = SC_EMU_PRESS;
-    memcpy(pd.point_mm, block.centre_tracker_mm, sizeof pd.point_mm);
-    pd.hover_mm = 2.0f;
-    pd.depth_mm = 1.0f;
-    pd.duration_s = 10.0;
+    sc_test_block_rig_up(&rig, &block, 7, 0);
+    const sc_emu_def pd = sc_test_block_probe_def(&block, 1.0f, 0.0f);
     assert_int_equal(sc_emu_init(&emu, &pd), SC_OK);
     /* from 8 mm beyond the artery (away from the vein) toward its axis, 14 mm deep at most */
-    sc_emu_needle_def nd = sc_emu_needle_default_def();
-    nd.entry_mm[0] = block.scene.p.artery_x_mm + 8.0f;
-    nd.entry_mm[1] = block.vein_tracker_mm[1];
-    nd.entry_mm[2] = 0.0f;
-    nd.dir[0] = -8.0f;
-    nd.dir[1] = 0.0f;
-    nd.dir[2] = -10.0f;
-    nd.speed_mm_s = 10.0f;
-    nd.max_depth_mm = 14.0f;
-    nd.hold_s = 1.0;
+    const sc_emu_needle_def nd =
+        sc_test_block_needle_def(&block, block.scene.p.artery_x_mm + 8.0f, -8.0f, 1.0);
     assert_int_equal(sc_emu_needle_init(&needle, &nd), SC_OK);
-    t0 = rig.clock.now_ns;
-    probe_next = needle_next = 0u;
+    sc_test_feed_start(&feed, &rig, &emu, &needle);
     needle_seen seen = {0};
     run(180, &seen); /* 3 s: in and held in the artery */
     const sc_assess_report *ar = sc_engine_assessment(&rig.engine);
