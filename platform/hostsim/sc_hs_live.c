@@ -118,6 +118,11 @@ int sc_hs_live_open(sc_hs_live *l, const sc_hs_live_def *def, sc_hs_rig *rig, ch
     char host[256];
     uint16_t port;
     if (def->can_port) {
+        const sc_can_rxmb_def mbd = sc_can_rxmb_default_def();
+        if (sc_can_rxmb_init(&l->rxmb, &mbd) != SC_OK) {
+            snprintf(err, cap, "receive mailboxes: bad definition");
+            return SC_ERR_RANGE;
+        }
         if (sc_udpcan_open_rx(&l->can, def->can_port) != SC_OK) {
             snprintf(err, cap, "cannot bind UDP CAN port %u: %s", (unsigned)def->can_port,
                      strerror(l->can.last_errno));
@@ -184,10 +189,14 @@ void sc_hs_live_before_frame(sc_hs_live *l, sc_hs_rig *rig, uint64_t release_ns)
         }
     }
     if (l->def.can_port) {
-        sc_can_dev dev = sc_udpcan_dev(&l->can);
+        const sc_can_dev dev = sc_udpcan_dev(&l->can);
+        const uint32_t n = sc_can_rxmb_drain(&l->rxmb, &dev, SC_HS_LIVE_DRAIN_MAX, release_ns);
+        l->drained_max = n > l->drained_max ? n : l->drained_max;
+        l->drain_limited += n == SC_HS_LIVE_DRAIN_MAX;
+        const sc_hs_can_node *node = &rig->bus.nodes[rig->engine_node];
+        uint32_t budget = node->count < SC_CAN_RX_BURST_MAX ? SC_CAN_RX_BURST_MAX - node->count : 0u;
         sc_can_frame f;
-        for (int i = 0; i < 256 && sc_can_recv(&dev, &f) == SC_OK; i++) {
-            f.ts_ns = release_ns;
+        for (; budget > 0u && sc_can_rxmb_take(&l->rxmb, &f) == SC_OK; budget--) {
             if (sc_hs_can_inject(&rig->bus, rig->engine_node, &f) == SC_OK) {
                 l->can_injected++;
             } else {
@@ -204,6 +213,16 @@ void sc_hs_live_summary(const sc_hs_live *l, const sc_hs_rig *rig, FILE *f)
                " overruns); state stream %" PRIu64 " records sent, %" PRIu64 " dropped%s\n",
             l->can_injected, l->can.rejected, l->can_overruns, t->records_sent,
             t->records_dropped, l->state_fp ? " (also written to the state file)" : "");
+    if (l->def.can_port) {
+        const sc_can_rxmb_counters *c = &l->rxmb.c;
+        fprintf(f,
+                "can rx          mailboxes: %" PRIu64 " commands, %" PRIu64
+                " stream frames taken; %" PRIu64 " stream frames overwritten by newer ones, %" PRIu64
+                " commands refused (mailbox full); deepest %u commands, %u stream frames; "
+                "up to %u datagrams drained before a frame (%" PRIu64 " drains at the bound)\n",
+                c->prio_taken, c->stream_taken, c->stream_overwritten, c->prio_dropped,
+                c->prio_depth_max, c->stream_depth_max, l->drained_max, l->drain_limited);
+    }
 }
 
 void sc_hs_live_close(sc_hs_live *l)

@@ -13,6 +13,7 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "sc_can_rxmb.h"
 #include "sc_hs_rig.h"
 #include "sc_udp_display.h"
 #include "sc_udp_state.h"
@@ -38,14 +39,31 @@ typedef struct sc_hs_live {
     double wall0_s;
     uint64_t t0_ns;
     uint64_t can_injected, can_overruns;
+    /* the controller's receive mailboxes between the socket and the engine's bus node
+     * (sc_can_rxmb.h): the socket drained every frame, commands first, the newest poses */
+    sc_can_rxmb rxmb;
+    uint32_t drained_max;   /* most datagrams drained before one frame */
+    uint64_t drain_limited; /* frames whose drain stopped at SC_HS_LIVE_DRAIN_MAX */
 } sc_hs_live;
+
+/* Datagrams drained from the CAN socket before one frame at most (at 76 bytes each, far more
+ * than a 1 MB socket buffer's worth of seconds of a 100 Hz tracker). */
+#ifndef SC_HS_LIVE_DRAIN_MAX
+#define SC_HS_LIVE_DRAIN_MAX 4096u
+#endif
 
 /* Open the sockets and files of def and wire them into rig->hal (display tee, state device).
  * 0, or a negative sc_err with a message in err. */
 int sc_hs_live_open(sc_hs_live *l, const sc_hs_live_def *def, sc_hs_rig *rig, char *err,
                     size_t cap);
-/* Before each frame: wait for its wall-clock release (pace), then inject every UDP CAN frame
- * waiting (at most 256). */
+/* Before each frame: wait for its wall-clock release (pace), then drain every UDP CAN frame
+ * waiting (at most SC_HS_LIVE_DRAIN_MAX) into the receive mailboxes, stamped with the frame's
+ * release time, and give the engine's bus node what the engine takes in one frame
+ * (SC_CAN_RX_BURST_MAX, less what its queue still holds): commands first, then the oldest of
+ * the newest stream frames the mailboxes kept. So a command waits at most one frame behind
+ * tracker frames however slow the host runs the engine, and the poses the engine sees are the
+ * newest; a pose frame the mailboxes overwrote is counted (summary) and reaches the engine's
+ * E2E receiver as a counter gap. */
 void sc_hs_live_before_frame(sc_hs_live *l, sc_hs_rig *rig, uint64_t release_ns);
 /* SIGINT / SIGTERM received (installed by open). */
 int sc_hs_live_stop(void);
