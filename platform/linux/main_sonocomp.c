@@ -22,6 +22,7 @@
 #include <unistd.h>
 
 #include "sc_can_replay.h"
+#include "sc_can_rxmb.h"
 #include "sc_cmdsign.h"
 #include "sc_engine.h"
 #include "sc_err.h"
@@ -734,6 +735,7 @@ int main(int argc, char **argv)
     static sc_socketcan can;
     static sc_can_replay replay;
     static sc_udpcan can_udp;
+    static sc_can_rxmb_port can_udp_mb; /* a controller's mailboxes in front of the socket */
     int can_open = 0, replay_open = 0;
     if (a.can_udp_port && !a.can_replay_path) {
         if (sc_udpcan_open_rx(&can_udp, a.can_udp_port) != 0) {
@@ -742,7 +744,11 @@ int main(int argc, char **argv)
             sc_log_linux_stop(&g_log);
             return EXIT_RUNTIME;
         }
-        hal.can = sc_udpcan_dev(&can_udp);
+        /* the socket is one FIFO: drained whole at each receive into the mailboxes, so that
+         * commands go first and the newest poses win (sc_can_rxmb.h) */
+        const sc_can_rxmb_def mbd = sc_can_rxmb_default_def();
+        (void)sc_can_rxmb_port_init(&can_udp_mb, &mbd, sc_udpcan_dev(&can_udp), 4096u);
+        hal.can = sc_can_rxmb_port_dev(&can_udp_mb);
         sc_log_linux_msg(&g_log, SC_LOG_INFO, "can_udp", "port=%u can_interface_ignored=%s",
                          (unsigned)a.can_udp_port, cfg.can_interface);
     } else if (a.can_replay_path) {
@@ -957,6 +963,16 @@ int main(int argc, char **argv)
         wall_s = (double)(sc_rt_now_ns() - t0) / 1e9;
         sc_log_linux_status_done(&g_log);
         final_report(e, wall_s, stop_reason, &hal.display, &rtr, udp_open ? &udp : NULL);
+        if (a.can_udp_port && !a.can_replay_path) {
+            const sc_can_rxmb_counters *mc = &can_udp_mb.mb.c;
+            printf("  can over udp    %llu datagrams (%llu malformed); mailboxes: %llu commands, "
+                   "%llu stream frames taken, %llu stream frames overwritten by newer ones, "
+                   "%llu commands refused (full)\n",
+                   (unsigned long long)can_udp.received, (unsigned long long)can_udp.rejected,
+                   (unsigned long long)mc->prio_taken, (unsigned long long)mc->stream_taken,
+                   (unsigned long long)mc->stream_overwritten,
+                   (unsigned long long)mc->prio_dropped);
+        }
         if (a.hist_path && write_hist(a.hist_path, e) != 0) {
             fprintf(stderr, "sonocomp: --hist %s: %s\n", a.hist_path, strerror(errno));
         }
