@@ -205,10 +205,11 @@ if (scenario === 'sessions') {
   const tilt = (20 * Math.PI) / 180, qw = Math.cos((Math.PI + tilt) / 2), qx = Math.sin((Math.PI + tilt) / 2);
   const rows = [[0, 30], [0.5, 30], [1.5, 0], [2.5, -1], [120, -1]];
   writeFileSync(csv, rows.map(([t, z]) => `${t},${GATE_X_MM},0,${z},${qw.toFixed(5)},${qx.toFixed(5)},0,0,${(Math.max(0, -z) * 0.5).toFixed(2)}`).join('\n') + '\n');
-  const emu = start('sc-tracker-emu', [path.join(build, 'tools/tracker_emu/sc-tracker-emu'), '--csv', csv, '--duration-s', '120', '--rate-hz', '30',
+  const emu = start('sc-tracker-emu', [path.join(build, 'tools/tracker_emu/sc-tracker-emu'), '--csv', csv, '--duration-s', '120', '--rate-hz', '100',
     '--udp', `127.0.0.1:${canPort}`]);
-  // (30 poses a second: on this loaded host the engine may run at a fraction of real time, and
-  // 100 Hz of tracker frames would queue up in front of the page's commands)
+  // (100 poses a second, the tracker's rate: the engine may run at a fraction of real time on
+  // this loaded host, and its CAN receive mailboxes (platform/linux/sc_can_rxmb.h) put the
+  // page's commands before the poses that wait and keep only the newest of those)
   // colour on from the page's Colour Doppler panel (every field is sent with the slider)
   await page.locator('#colour').setChecked(true);
   await page.locator('#prf').fill('3000');
@@ -451,6 +452,8 @@ const m = /deadline\s+(\d+) misses on the virtual clock/.exec(engine.out);
 if (!m) await fail(`no engine summary: ${engine.out.slice(-500)}`);
 if (+m[1] !== 0 || misses !== 0) await fail(`deadline misses with clients connected: ${m[1]} (engine summary), ${misses} (state stream)`);
 ok(`zero deadline misses on the virtual clock with clients connected (${/frames at/.test(engine.out) ? engine.out.match(/probe .*frames at \d+ Hz/)[0] : ''})`);
+const canRx = /can rx\s+(.*)/.exec(engine.out); // the engine's CAN receive mailboxes (sc_hs_live.h)
+if (canRx) ok(`engine's CAN receive: ${canRx[1]}`);
 const gw = gateway.out.trim().split('\n').pop();
 ok(gw);
 console.log('PASS');
