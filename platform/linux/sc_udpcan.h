@@ -8,7 +8,9 @@
  *
  * Datagram (little-endian, 76 bytes): u32 magic "SCCN", u32 id, u8 len (0..64, a valid CAN or
  * CAN FD length), u8 flags (SC_CAN_FLAG_*), u16 0, 64 data bytes (bytes past len zero).
- * Not thread-safe; never blocks (MSG_DONTWAIT both ways).
+ * Not thread-safe; never blocks (MSG_DONTWAIT both ways). The socket is one FIFO: receivers
+ * that feed an engine put sc_can_rxmb.h's mailboxes in front of it (commands first, the newest
+ * poses win).
  */
 #ifndef SC_UDPCAN_H
 #define SC_UDPCAN_H

@@ -2,9 +2,12 @@
  * sc-cmd-latency: how long the page's commands take to reach a live engine while a tracker
  * streams poses, measured from outside as the console sees it (tools/cmd-latency.sh runs it
  * against sc-hostsim --live). Over CAN over UDP (sc_udpcan.h) it sends the tracker emulator's
- * poses at --rate-hz (a probe held on the skin, the press script's hover) and, every --every-ms,
- * one signed command (CmdAssessment reset: cheap to apply, each one counted by the engine),
- * each preceded by a freshness sync, as the gateway sends them. It listens to the engine's
+ * poses at --rate-hz (the press script: from 2 mm above the default point to 1 mm into the
+ * skin, held), first a CmdDoppler with colour on (the engine images and colours every frame,
+ * as in the console's Doppler test; not measured) and then, every --every-ms, one signed
+ * command (CmdAssessment reset: cheap to apply, each one counted by the engine), each
+ * preceded by a freshness sync, as the gateway sends them. Nothing is sent before the
+ * engine's first FRAME record arrives (it is up). It listens to the engine's
  * state stream (--state-port) and takes a command as acknowledged when a FRAME record's
  * "commands applied + refused" counter reaches it. Per command: latency in wall-clock ms from
  * the send to the first FRAME record showing it, and in engine frames (record's frame number
