@@ -194,7 +194,8 @@ void sc_hs_live_before_frame(sc_hs_live *l, sc_hs_rig *rig, uint64_t release_ns)
         l->drained_max = n > l->drained_max ? n : l->drained_max;
         l->drain_limited += n == SC_HS_LIVE_DRAIN_MAX;
         const sc_hs_can_node *node = &rig->bus.nodes[rig->engine_node];
-        uint32_t budget = node->count < SC_CAN_RX_BURST_MAX ? SC_CAN_RX_BURST_MAX - node->count : 0u;
+        uint32_t budget =
+            node->count < SC_CAN_RX_BURST_MAX ? SC_CAN_RX_BURST_MAX - node->count : 0u;
         sc_can_frame f;
         for (; budget > 0u && sc_can_rxmb_take(&l->rxmb, &f) == SC_OK; budget--) {
             if (sc_hs_can_inject(&rig->bus, rig->engine_node, &f) == SC_OK) {
@@ -217,7 +218,8 @@ void sc_hs_live_summary(const sc_hs_live *l, const sc_hs_rig *rig, FILE *f)
         const sc_can_rxmb_counters *c = &l->rxmb.c;
         fprintf(f,
                 "can rx          mailboxes: %" PRIu64 " commands, %" PRIu64
-                " stream frames taken; %" PRIu64 " stream frames overwritten by newer ones, %" PRIu64
+                " stream frames taken; %" PRIu64
+                " stream frames overwritten by newer ones, %" PRIu64
                 " commands refused (mailbox full); deepest %u commands, %u stream frames; "
                 "up to %u datagrams drained before a frame (%" PRIu64 " drains at the bound)\n",
                 c->prio_taken, c->stream_taken, c->stream_overwritten, c->prio_dropped,

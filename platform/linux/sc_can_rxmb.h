@@ -42,10 +42,10 @@ typedef struct sc_can_rxmb_def {
 } sc_can_rxmb_def;
 
 typedef struct sc_can_rxmb_counters {
-    uint64_t put;                /* frames offered */
+    uint64_t put; /* frames offered */
     uint64_t prio_taken, stream_taken;
-    uint64_t prio_dropped;       /* priority mailbox full: the newest refused */
-    uint64_t stream_overwritten; /* the oldest stream frame replaced by a newer one */
+    uint64_t prio_dropped;                     /* priority mailbox full: the newest refused */
+    uint64_t stream_overwritten;               /* the oldest stream frame replaced by a newer one */
     uint32_t prio_depth_max, stream_depth_max; /* deepest the mailboxes were after a put */
 } sc_can_rxmb_counters;
 

@@ -5,30 +5,14 @@
  * colour for the same input (replayed, hashes). */
 #include "sc_test.h"
 
-#include <stdlib.h>
-
 #include "sc_err.h"
 #include "sc_hs_rig.h"
 #include "sc_test_block_rig.h"
 #include "sc_test_case.h"
 #include "sc_trkemu.h"
 
-static sc_test_case block;
 static sc_hs_rig rig;
 static sc_emu emu;
-
-static int group_setup(void **state)
-{
-    (void)state;
-    return sc_test_case_make(&block, 12, 6, 8, SC_LABEL_VEIN, "block") == SC_OK ? 0 : -1;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    free(block.bytes);
-    return 0;
-}
 
 typedef struct run_out {
     uint32_t red, blue; /* coloured pixels of the last frame, by sign */
@@ -38,9 +22,9 @@ typedef struct run_out {
 
 static run_out run_session(uint32_t frames)
 {
-    sc_test_block_rig_up(&rig, &block, 3, 1);
+    sc_test_block_rig_up(&rig, &sc_test_block, 3, 1);
     /* the default orientation (beam down) rolled 20 degrees about x */
-    const sc_emu_def pd = sc_test_block_probe_def(&block, 3.0f, 20.0f);
+    const sc_emu_def pd = sc_test_block_probe_def(&sc_test_block, 3.0f, 20.0f);
     assert_int_equal(sc_emu_init(&emu, &pd), SC_OK);
     sc_test_feed feed;
     sc_test_feed_start(&feed, &rig, &emu, NULL);
@@ -89,5 +73,5 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(colour_reaches_the_display_in_the_vessels_and_is_replayable),
     };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, sc_test_block_group_setup, sc_test_block_group_teardown);
 }

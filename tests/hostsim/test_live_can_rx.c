@@ -18,7 +18,6 @@
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
-#include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -32,24 +31,10 @@
 #include "sc_trkemu.h"
 #include "sc_udpcan.h"
 
-static sc_test_case block;
 static sc_hs_rig rig;
 static sc_hs_live live;
 static sc_emu emu;
 static sc_udpcan tx;
-
-static int group_setup(void **state)
-{
-    (void)state;
-    return sc_test_case_make(&block, 12, 6, 8, SC_LABEL_VEIN, "block") == SC_OK ? 0 : -1;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    free(block.bytes);
-    return 0;
-}
 
 /* a free loopback UDP port (bound and released: the live layer binds it next) */
 static uint16_t free_udp_port(void)
@@ -83,14 +68,15 @@ static uint8_t send_sample(const sc_can_dev *dev)
     return (uint8_t)(f[0].data[1] & 0x0Fu);
 }
 
-static const sc_cmd k_reset = {.kind = SC_CMD_ASSESS, .assess_action = SC_ASSESS_ACTION_RESET,
+static const sc_cmd k_reset = {.kind = SC_CMD_ASSESS,
+                               .assess_action = SC_ASSESS_ACTION_RESET,
                                .assess_call = SC_ASSESS_CALL_NONE};
 
 static void a_command_is_applied_in_the_next_frame_however_many_poses_wait(void **state)
 {
     (void)state;
-    sc_test_block_rig_up(&rig, &block, 5, 0);
-    const sc_emu_def pd = sc_test_block_probe_def(&block, 1.0f, 0.0f); /* 100 Hz */
+    sc_test_block_rig_up(&rig, &sc_test_block, 5, 0);
+    const sc_emu_def pd = sc_test_block_probe_def(&sc_test_block, 1.0f, 0.0f); /* 100 Hz */
     assert_int_equal(sc_emu_init(&emu, &pd), SC_OK);
     const uint16_t port = free_udp_port();
     const sc_hs_live_def ld = {.pace = 0, .can_port = port};
@@ -144,7 +130,7 @@ static void a_command_is_applied_in_the_next_frame_however_many_poses_wait(void 
     uint64_t release = sc_engine_next_release_ns(&rig.engine);
     sc_hs_live_before_frame(&live, &rig, release);
     sc_engine_step(&rig.engine, NULL);
-    assert_int_equal(applied() - before, 1u); /* the command: in the next frame */
+    assert_int_equal(applied() - before, 1u);       /* the command: in the next frame */
     assert_int_equal(live.rxmb.c.put - put0, 184u); /* the socket drained whole */
     /* the newest pose frames win: 64 taken this frame (4 of them the command's), 116 older
      * ones overwritten, the 4 left taken the frame after */
@@ -176,5 +162,5 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(a_command_is_applied_in_the_next_frame_however_many_poses_wait),
     };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, sc_test_block_group_setup, sc_test_block_group_teardown);
 }

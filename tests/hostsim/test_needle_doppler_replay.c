@@ -9,7 +9,6 @@
  * identical; at the end the needle's punctures and the assessment are the same. */
 #include "sc_test.h"
 
-#include <stdlib.h>
 #include <string.h>
 
 #include "sc_candump.h"
@@ -22,7 +21,6 @@
 #define FRAMES 240u /* 4 s at 60 Hz */
 #define LOG_CAP (1u << 21)
 
-static sc_test_case block;
 static sc_hs_rig rig;
 static sc_emu emu;
 static sc_emu_needle needle;
@@ -42,19 +40,6 @@ typedef struct session {
 
 static session g_rec, g_rep;
 
-static int group_setup(void **state)
-{
-    (void)state;
-    return sc_test_case_make(&block, 12, 6, 8, SC_LABEL_VEIN, "block") == SC_OK ? 0 : -1;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    free(block.bytes);
-    return 0;
-}
-
 static void record_frame(void *user, const sc_can_frame *f)
 {
     (void)user;
@@ -71,17 +56,17 @@ static void record_frame(void *user, const sc_can_frame *f)
 
 static void rig_up(void)
 {
-    sc_test_block_rig_up(&rig, &block, 3, 1);
+    sc_test_block_rig_up(&rig, &sc_test_block, 3, 1);
 }
 
 static void emulators_up(void)
 {
     /* the probe pressing 2 mm with a 10-degree roll about x */
-    const sc_emu_def pd = sc_test_block_probe_def(&block, 2.0f, 10.0f);
+    const sc_emu_def pd = sc_test_block_probe_def(&sc_test_block, 2.0f, 10.0f);
     assert_int_equal(sc_emu_init(&emu, &pd), SC_OK);
     /* the needle of test_needle_engine: from 8 mm beside the vein toward its axis */
-    const sc_emu_needle_def nd =
-        sc_test_block_needle_def(&block, block.vein_tracker_mm[0] - 8.0f, 8.0f, 0.5);
+    const sc_emu_needle_def nd = sc_test_block_needle_def(
+        &sc_test_block, sc_test_block.vein_tracker_mm[0] - 8.0f, 8.0f, 0.5);
     assert_int_equal(sc_emu_needle_init(&needle, &nd), SC_OK);
 }
 
@@ -210,5 +195,5 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(a_needle_and_doppler_session_replays_to_the_same_hashes),
     };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, sc_test_block_group_setup, sc_test_block_group_teardown);
 }

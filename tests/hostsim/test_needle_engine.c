@@ -17,23 +17,9 @@
 #include "sc_test_case.h"
 #include "sc_trkemu.h"
 
-static sc_test_case block;
 static sc_hs_rig rig;
 static sc_emu emu;
 static sc_emu_needle needle;
-
-static int group_setup(void **state)
-{
-    (void)state;
-    return sc_test_case_make(&block, 12, 6, 8, SC_LABEL_VEIN, "block") == SC_OK ? 0 : -1;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    free(block.bytes);
-    return 0;
-}
 
 typedef struct needle_seen {
     uint32_t status_frames;
@@ -57,8 +43,8 @@ static void run(uint32_t n, needle_seen *seen)
         const sc_needle_status *ns = sc_engine_get_needle_status(&rig.engine);
         if (getenv("NEEDLE_TRACE") && i % 10u == 0u) {
             print_message("t %.2f present %u tip %u (deformed %u) depth %.1f rej %u\n",
-                          (double)(rig.clock.now_ns - feed.t0_ns) * 1e-9, ns->present, ns->tip_label,
-                          ns->tip_label_deformed, (double)rig.engine.needle.depth_mm,
+                          (double)(rig.clock.now_ns - feed.t0_ns) * 1e-9, ns->present,
+                          ns->tip_label, ns->tip_label_deformed, (double)rig.engine.needle.depth_mm,
                           rig.engine.needle_rx.rejected);
         }
         seen->max_drawn = ns->drawn_pixels > seen->max_drawn ? ns->drawn_pixels : seen->max_drawn;
@@ -90,14 +76,14 @@ static void run(uint32_t n, needle_seen *seen)
 static void a_needle_into_the_vein_is_reported_once_per_entry_on_can(void **state)
 {
     (void)state;
-    sc_test_block_rig_up(&rig, &block, 7, 0);
+    sc_test_block_rig_up(&rig, &sc_test_block, 7, 0);
     /* the probe rests lightly over the block's middle (its plane holds both vessels) */
-    const sc_emu_def pd = sc_test_block_probe_def(&block, 1.0f, 0.0f);
+    const sc_emu_def pd = sc_test_block_probe_def(&sc_test_block, 1.0f, 0.0f);
     assert_int_equal(sc_emu_init(&emu, &pd), SC_OK);
     /* the needle in the image plane, from 8 mm beside the vein toward its axis (8 mm across,
      * 10 mm down; tracker frame: (x, -y, -z) of the volume), 14 mm deep at most */
-    const sc_emu_needle_def nd =
-        sc_test_block_needle_def(&block, block.vein_tracker_mm[0] - 8.0f, 8.0f, 1.0);
+    const sc_emu_needle_def nd = sc_test_block_needle_def(
+        &sc_test_block, sc_test_block.vein_tracker_mm[0] - 8.0f, 8.0f, 1.0);
     assert_int_equal(sc_emu_needle_init(&needle, &nd), SC_OK);
     sc_test_feed_start(&feed, &rig, &emu, &needle);
     needle_seen seen = {0};
@@ -159,12 +145,12 @@ static void a_needle_into_the_vein_is_reported_once_per_entry_on_can(void **stat
 static void a_needle_into_the_artery_is_a_fault_of_the_exam_once(void **state)
 {
     (void)state;
-    sc_test_block_rig_up(&rig, &block, 7, 0);
-    const sc_emu_def pd = sc_test_block_probe_def(&block, 1.0f, 0.0f);
+    sc_test_block_rig_up(&rig, &sc_test_block, 7, 0);
+    const sc_emu_def pd = sc_test_block_probe_def(&sc_test_block, 1.0f, 0.0f);
     assert_int_equal(sc_emu_init(&emu, &pd), SC_OK);
     /* from 8 mm beyond the artery (away from the vein) toward its axis, 14 mm deep at most */
-    const sc_emu_needle_def nd =
-        sc_test_block_needle_def(&block, block.scene.p.artery_x_mm + 8.0f, -8.0f, 1.0);
+    const sc_emu_needle_def nd = sc_test_block_needle_def(
+        &sc_test_block, sc_test_block.scene.p.artery_x_mm + 8.0f, -8.0f, 1.0);
     assert_int_equal(sc_emu_needle_init(&needle, &nd), SC_OK);
     sc_test_feed_start(&feed, &rig, &emu, &needle);
     needle_seen seen = {0};
@@ -199,5 +185,5 @@ int main(void)
         cmocka_unit_test(a_needle_into_the_vein_is_reported_once_per_entry_on_can),
         cmocka_unit_test(a_needle_into_the_artery_is_a_fault_of_the_exam_once),
     };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, sc_test_block_group_setup, sc_test_block_group_teardown);
 }

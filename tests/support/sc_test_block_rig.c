@@ -4,10 +4,27 @@
 #include "sc_test.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "sc_err.h"
 #include "sc_hs_storage.h"
+
+sc_test_case sc_test_block;
+
+int sc_test_block_group_setup(void **state)
+{
+    (void)state;
+    return sc_test_case_make(&sc_test_block, 12, 6, 8, SC_LABEL_VEIN, "block") == SC_OK ? 0 : -1;
+}
+
+int sc_test_block_group_teardown(void **state)
+{
+    (void)state;
+    free(sc_test_block.bytes);
+    sc_test_block.bytes = NULL;
+    return 0;
+}
 
 void sc_test_block_rig_up(sc_hs_rig *rig, const sc_test_case *block, uint64_t seed,
                           int doppler_whole_image)

@@ -16,6 +16,12 @@
 #include "sc_test_case.h"
 #include "sc_trkemu.h"
 
+/* The block case of these tests: 12 x 6 x 8 nodes, a vein (not thrombosed), named "block";
+ * built by sc_test_block_group_setup (a cmocka group setup), freed by the teardown. */
+extern sc_test_case sc_test_block;
+int sc_test_block_group_setup(void **state);
+int sc_test_block_group_teardown(void **state);
+
 /* Initialise rig with sc_test_engine_def() for block (its collider, the case named "block",
  * the only catalogue entry), the rig's seed, and, with doppler_whole_image, the colour box over
  * the whole image at a PRF of 8000 Hz; then add and load the case. Asserts each step. */

@@ -129,8 +129,8 @@ static void a_full_command_mailbox_refuses_the_newest_and_never_overwrites(void 
     assert_int_equal(sc_can_rxmb_init(&mb, &d), SC_OK);
     for (uint32_t i = 0; i < SC_CAN_RXMB_PRIO_MAX + 5u; i++) {
         const sc_can_frame c = frame(0x081, (uint8_t)i);
-        assert_int_equal(sc_can_rxmb_put(&mb, &c), i < SC_CAN_RXMB_PRIO_MAX ? SC_OK
-                                                                             : SC_ERR_NO_SPACE);
+        assert_int_equal(sc_can_rxmb_put(&mb, &c),
+                         i < SC_CAN_RXMB_PRIO_MAX ? SC_OK : SC_ERR_NO_SPACE);
     }
     assert_int_equal(mb.c.prio_dropped, 5u);
     accounted(&mb);
@@ -193,8 +193,7 @@ static void the_port_device_takes_the_command_first_in_one_recv(void **state)
     const sc_can_rxmb_def d = sc_can_rxmb_default_def();
     assert_int_equal(sc_can_rxmb_port_init(&port, &d, (sc_can_dev){.ops = &ops, .ctx = &src}, 0),
                      SC_ERR_INVALID_ARG);
-    assert_int_equal(sc_can_rxmb_port_init(&port, &d, (sc_can_dev){.ops = &ops, .ctx = &src},
-                                           4096),
+    assert_int_equal(sc_can_rxmb_port_init(&port, &d, (sc_can_dev){.ops = &ops, .ctx = &src}, 4096),
                      SC_OK);
     const sc_can_dev dev = sc_can_rxmb_port_dev(&port);
     sc_can_frame out;

@@ -73,16 +73,20 @@ static int parse_cli(int argc, char **argv, lat_cli *a)
 {
     *a = (lat_cli){.rate_hz = 100.0, .seconds = 20.0, .every_ms = 500.0};
     optind = 0;
-    static const struct option opts[] = {
-        {"can-udp", required_argument, 0, 'u'}, {"state-port", required_argument, 0, 'p'},
-        {"rate-hz", required_argument, 0, 'r'}, {"seconds", required_argument, 0, 's'},
-        {"every-ms", required_argument, 0, 'e'}, {"help", no_argument, 0, 'h'},
-        {0, 0, 0, 0}};
+    static const struct option opts[] = {{"can-udp", required_argument, 0, 'u'},
+                                         {"state-port", required_argument, 0, 'p'},
+                                         {"rate-hz", required_argument, 0, 'r'},
+                                         {"seconds", required_argument, 0, 's'},
+                                         {"every-ms", required_argument, 0, 'e'},
+                                         {"help", no_argument, 0, 'h'},
+                                         {0, 0, 0, 0}};
     int c;
     double v;
     while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
         switch (c) {
-        case 'u': a->can_udp = optarg; break;
+        case 'u':
+            a->can_udp = optarg;
+            break;
         case 'p':
             if (parse_double(optarg, 1.0, 65535.0, &v) != 0 || v > floor(v)) {
                 fprintf(stderr, "sc-cmd-latency: --state-port: 1..65535\n");
@@ -108,8 +112,12 @@ static int parse_cli(int argc, char **argv, lat_cli *a)
                 return 2;
             }
             break;
-        case 'h': usage(stdout); return 0;
-        default: usage(stderr); return 2;
+        case 'h':
+            usage(stdout);
+            return 0;
+        default:
+            usage(stderr);
+            return 2;
         }
     }
     if (optind != argc || a->can_udp == NULL || a->state_port == 0u) {
@@ -123,8 +131,7 @@ static int parse_cli(int argc, char **argv, lat_cli *a)
         return 2;
     }
     if (a->seconds * 1000.0 / a->every_ms > (double)MAX_CMDS) {
-        fprintf(stderr, "sc-cmd-latency: at most %u commands (--seconds / --every-ms)\n",
-                MAX_CMDS);
+        fprintf(stderr, "sc-cmd-latency: at most %u commands (--seconds / --every-ms)\n", MAX_CMDS);
         return 2;
     }
     return -1;
@@ -149,8 +156,8 @@ static long udp_rx_queue(unsigned port)
     while (fgets(line, sizeof line, f)) {
         unsigned sl, la, lp, ra, rp, st;
         unsigned long tx, rx;
-        if (sscanf(line, " %u: %x:%x %x:%x %x %lx:%lx", &sl, &la, &lp, &ra, &rp, &st, &tx,
-                   &rx) == 8 &&
+        if (sscanf(line, " %u: %x:%x %x:%x %x %lx:%lx", &sl, &la, &lp, &ra, &rp, &st, &tx, &rx) ==
+                8 &&
             lp == port) {
             q = (long)rx;
             break;
@@ -225,11 +232,12 @@ int main(int argc, char **argv)
     sc_cmdsign signer;
     (void)sc_cmdsign_init(&signer, sc_secoc_bench_key, 2u, sc_cmdsign_fv_now(), 1);
     /* colour Doppler on first (not measured), as the console's Doppler test turns it on */
-    const sc_cmd colour = {.kind = SC_CMD_DOPPLER,
-                           .doppler = {.on = 1, .prf_hz = 3000.0f, .steer_deg = 0.0f,
-                                       .gain_db = 0.0f}};
+    const sc_cmd colour = {
+        .kind = SC_CMD_DOPPLER,
+        .doppler = {.on = 1, .prf_hz = 3000.0f, .steer_deg = 0.0f, .gain_db = 0.0f}};
     int colour_sent = 0;
-    const sc_cmd cmd = {.kind = SC_CMD_ASSESS, .assess_action = SC_ASSESS_ACTION_RESET,
+    const sc_cmd cmd = {.kind = SC_CMD_ASSESS,
+                        .assess_action = SC_ASSESS_ACTION_RESET,
                         .assess_call = SC_ASSESS_CALL_NONE};
 
     const double t0 = mono_s();
@@ -241,8 +249,8 @@ int main(int argc, char **argv)
     double start = 0.0; /* the first FRAME record: the run's seconds count from there */
     for (;;) {
         const double now = mono_s() - t0;
-        if (have_base && (now >= start + a.seconds + 5.0 ||
-                          (now >= start + a.seconds && acked == n_cmds))) {
+        if (have_base &&
+            (now >= start + a.seconds + 5.0 || (now >= start + a.seconds && acked == n_cmds))) {
             break; /* 5 s for the last acknowledgements */
         }
         if (!have_base) {
@@ -283,8 +291,10 @@ int main(int argc, char **argv)
                 for (int j = 0; j < 4; j++) {
                     send_failed += sc_can_send(&dev, &f[j]) != SC_OK;
                 }
-                g_cmds[n_cmds] = (sent_cmd){.t_s = mono_s() - t0, .frame_at_send = last_frame,
-                                            .rxq_bytes = q, .lat_ms = NAN};
+                g_cmds[n_cmds] = (sent_cmd){.t_s = mono_s() - t0,
+                                            .frame_at_send = last_frame,
+                                            .rxq_bytes = q,
+                                            .lat_ms = NAN};
                 rxq_max = q > rxq_max ? q : rxq_max;
                 n_cmds++;
             }
@@ -320,8 +330,7 @@ int main(int argc, char **argv)
                 }
                 while (acked < n_cmds && done - base > acked) {
                     g_cmds[acked].lat_ms = (t - g_cmds[acked].t_s) * 1e3;
-                    g_cmds[acked].lat_frames =
-                        (int64_t)fno - (int64_t)g_cmds[acked].frame_at_send;
+                    g_cmds[acked].lat_frames = (int64_t)fno - (int64_t)g_cmds[acked].frame_at_send;
                     acked++;
                 }
             }
