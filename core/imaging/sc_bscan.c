@@ -1220,7 +1220,10 @@ typedef struct vol_ctx {
     float slab[3];          /* voxels of the slab the continuation beyond a face repeats */
     float beyond_gl_per_mm; /* darkening beyond the volume, grey levels per mm */
     sc_bscan_span_fn span; /* the selected variant's sampler of spans clear of the border */
+    sc_bscan_line_fn line; /* the selected variant's sampler of a whole line's positions */
 } vol_ctx;
+
+_Static_assert(SC_MAX_VOLUME_DIM < (1u << (32 - SC_W_BITS)), "position words fit 32 bits");
 
 /* Positions are 32.32 fixed point (int64): stepping along a span adds exactly, the step's
  * rounding drifts by less than 1e-7 voxel over a line. */
@@ -1333,11 +1336,19 @@ static void clear_steps(int64_t x, int64_t d, int64_t xm, int64_t n, int64_t *lo
     *hi = z < *hi ? z : *hi;
 }
 
+/* What sample_span and sample_span_inside do: everything; only the position words of the part
+ * clear of the border (for the line sampler, the rest of the words 0); or everything but that
+ * part (after the line sampler). The same intervals are computed in each mode. */
+typedef enum span_mode { SPAN_ALL = 0, SPAN_WORDS = 1, SPAN_REST = 2 } span_mode;
+
+static void fill_words(sc_bscan *b, uint32_t k0, uint32_t k1, int64_t X, int64_t Y, int64_t Z,
+                       int64_t DX, int64_t DY, int64_t DZ);
+
 /* Samples [k0, k1) at voxel positions a + k b, all inside the volume box (the ends are, and the
  * box is convex). The part clear of the half-voxel border (no clamping: an interval) goes to the
  * selected span kernel, the ends clamped sample by sample: the same values either way. */
 static void sample_span_inside(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1,
-                               const float a[3], const float bb[3])
+                               const float a[3], const float bb[3], span_mode mode)
 {
     const vol_regs vr = {vc->vox, vc->lab, vc->stride[1], vc->stride[2], vc->la};
     const int64_t *restrict lut = b->lut_b_fx;
@@ -1358,8 +1369,12 @@ static void sample_span_inside(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint
     for (int64_t j = 0; j < n; j++) {
         if (j == jlo) {
             /* clear of the half-voxel border: no clamping */
-            vc->span(vr, lut, k0 + (uint32_t)jlo, k0 + (uint32_t)jhi, X, Y, Z, DX, DY, DZ, out,
-                     lab);
+            if (mode == SPAN_ALL) {
+                vc->span(vr, lut, k0 + (uint32_t)jlo, k0 + (uint32_t)jhi, X, Y, Z, DX, DY, DZ,
+                         out, lab);
+            } else if (mode == SPAN_WORDS) {
+                fill_words(b, k0 + (uint32_t)jlo, k0 + (uint32_t)jhi, X, Y, Z, DX, DY, DZ);
+            }
             const int64_t m = jhi - jlo;
             X += m * DX;
             Y += m * DY;
@@ -1367,8 +1382,10 @@ static void sample_span_inside(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint
             j = jhi - 1;
             continue;
         }
-        sample_fx(vr, lut, k0 + (uint32_t)j, clamp_fx(X, xm0), clamp_fx(Y, xm1), clamp_fx(Z, xm2),
-                  out, lab);
+        if (mode != SPAN_WORDS) {
+            sample_fx(vr, lut, k0 + (uint32_t)j, clamp_fx(X, xm0), clamp_fx(Y, xm1),
+                      clamp_fx(Z, xm2), out, lab);
+        }
         X += DX;
         Y += DY;
         Z += DZ;
@@ -1381,12 +1398,39 @@ static int in_volume_k(const vol_ctx *vc, const float a[3], const float bb[3], u
     return in_volume(vc, p);
 }
 
+/* The position words (sc_bscan_kern.h) of samples [k0, k1) at 32.32 positions
+ * (X, Y, Z) + (k - k0) (DX, DY, DZ), every one inside [0, xmax]: the positions the span sampler
+ * would step, for the line sampler. */
+static void fill_words(sc_bscan *b, uint32_t k0, uint32_t k1, int64_t X, int64_t Y, int64_t Z,
+                       int64_t DX, int64_t DY, int64_t DZ)
+{
+    uint32_t *restrict hx = b->pos_h[0], *restrict hy = b->pos_h[1], *restrict hz = b->pos_h[2];
+    X += SC_W_HALF;
+    Y += SC_W_HALF;
+    Z += SC_W_HALF;
+    for (uint32_t k = k0; k < k1; k++) {
+        hx[k] = (uint32_t)((uint64_t)X >> SC_POS_SHIFT);
+        hy[k] = (uint32_t)((uint64_t)Y >> SC_POS_SHIFT);
+        hz[k] = (uint32_t)((uint64_t)Z >> SC_POS_SHIFT);
+        X += DX;
+        Y += DY;
+        Z += DZ;
+    }
+}
+
 /* Samples [k0, k1) at voxel positions a + k b: the part inside the volume box (an interval: the
  * line is straight, the box convex; its ends found from the slab intersection and confirmed by
  * the per-sample test) in fixed point, the parts beyond it continued (beyond_sample). */
-static void sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1, const float a[3],
-                        const float bb[3])
+static int sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1, const float a[3],
+                       const float bb[3], span_mode mode)
 {
+    if (mode == SPAN_WORDS) {
+        for (uint32_t k = k0; k < k1; k++) {
+            b->pos_h[0][k] = 0u;
+            b->pos_h[1][k] = 0u;
+            b->pos_h[2][k] = 0u;
+        }
+    }
     {
         /* the common case first (a mesh run is one tet's crossing, a few samples): both ends
          * clear of the half-voxel border, so every sample is, and the per-sample box test below
@@ -1402,8 +1446,13 @@ static void sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1
             X <= vc->xmax[0] && xe <= vc->xmax[0] && Y <= vc->xmax[1] && ye <= vc->xmax[1] &&
             Z <= vc->xmax[2] && ze <= vc->xmax[2]) {
             const vol_regs vr = {vc->vox, vc->lab, vc->stride[1], vc->stride[2], vc->la};
-            vc->span(vr, b->lut_b_fx, k0, k1, X, Y, Z, DX, DY, DZ, b->line_out, b->line_label);
-            return;
+            if (mode == SPAN_ALL) {
+                vc->span(vr, b->lut_b_fx, k0, k1, X, Y, Z, DX, DY, DZ, b->line_out,
+                         b->line_label);
+            } else if (mode == SPAN_WORDS) {
+                fill_words(b, k0, k1, X, Y, Z, DX, DY, DZ);
+            }
+            return 1;
         }
     }
     /* the line parameter range inside the box, per axis: -1/2 <= a + k b < hi */
@@ -1444,14 +1493,17 @@ static void sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1
     const vol_regs vr = {vc->vox, vc->lab, vc->stride[1], vc->stride[2], vc->la};
     for (uint32_t k = k0; k < k1; k++) {
         if (k == ka) {
-            sample_span_inside(b, vc, ka, kb, a, bb);
+            sample_span_inside(b, vc, ka, kb, a, bb, mode);
             k = kb - 1u;
             continue;
         }
         const float p[3] = {a[0] + (float)k * bb[0], a[1] + (float)k * bb[1],
                             a[2] + (float)k * bb[2]};
-        beyond_sample(vc, vr, b->lut_b_fx, k, p, b->line_out, b->line_label);
+        if (mode != SPAN_WORDS) {
+            beyond_sample(vc, vr, b->lut_b_fx, k, p, b->line_out, b->line_label);
+        }
     }
+    return 0;
 }
 
 /* The whole line: mesh runs at their rest positions, the gaps rigid; then label areas. */
@@ -1459,17 +1511,50 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
                         area_acc *acc)
 {
     const uint32_t n = c->n;
-    uint32_t k = 0;
+    /* the position words of every span's part clear of the volume's border (nearly every
+     * sample), one call of the line sampler for them all, then the rest of the spans (clamped
+     * ends, beyond the volume) sample by sample: the same intervals, positions and bytes as
+     * sample_span alone (SPAN_ALL) */
+    /* spans in line order: the rigid gap before run i is span 2 i, run i span 2 i + 1, the
+     * gap after the last run span 2 run_count; those between first and last need the rest */
+    uint32_t k = 0, first = UINT32_MAX, last = 0;
     for (uint32_t i = 0; i < b->run_count; i++) {
         const sc_bscan_run *r = &b->runs[i];
-        if (k < r->k0) {
-            sample_span(b, vc, k, r->k0, c->f0, c->fd);
+        if (k < r->k0 && !sample_span(b, vc, k, r->k0, c->f0, c->fd, SPAN_WORDS)) {
+            first = first < 2u * i ? first : 2u * i;
+            last = 2u * i;
         }
-        sample_span(b, vc, r->k0, r->k1, r->a, r->b);
+        if (!sample_span(b, vc, r->k0, r->k1, r->a, r->b, SPAN_WORDS)) {
+            first = first < 2u * i + 1u ? first : 2u * i + 1u;
+            last = 2u * i + 1u;
+        }
         k = r->k1;
     }
-    if (k < n) {
-        sample_span(b, vc, k, n, c->f0, c->fd);
+    if (k < n && !sample_span(b, vc, k, n, c->f0, c->fd, SPAN_WORDS)) {
+        first = first < 2u * b->run_count ? first : 2u * b->run_count;
+        last = 2u * b->run_count;
+    }
+    {
+        const vol_regs vr = {vc->vox, vc->lab, vc->stride[1], vc->stride[2], vc->la};
+        vc->line(vr, b->lut_b_fx, n, b->pos_h[0], b->pos_h[1], b->pos_h[2], b->line_out,
+                 b->line_label);
+    }
+    if (first != UINT32_MAX) {
+        const uint32_t i0 = first / 2u;
+        k = i0 > 0u ? b->runs[i0 - 1u].k1 : 0u;
+        for (uint32_t i = i0; i < b->run_count && 2u * i <= last; i++) {
+            const sc_bscan_run *r = &b->runs[i];
+            if (k < r->k0 && 2u * i >= first) {
+                (void)sample_span(b, vc, k, r->k0, c->f0, c->fd, SPAN_REST);
+            }
+            if (2u * i + 1u >= first && 2u * i + 1u <= last) {
+                (void)sample_span(b, vc, r->k0, r->k1, r->a, r->b, SPAN_REST);
+            }
+            k = r->k1;
+        }
+        if (k < n && last == 2u * b->run_count) {
+            (void)sample_span(b, vc, k, n, c->f0, c->fd, SPAN_REST);
+        }
     }
     if (b->def.acoustics != 0u) {
         /* along the beam as it runs now: the labels are this frame's (deformed) ones */
@@ -1728,6 +1813,7 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
     }
     vc.beyond_gl_per_mm = 255.0f * SC_BSCAN_BEYOND_DB_PER_MM / b->def.dynamic_range_db;
     vc.span = sc_bscan_span_selected();
+    vc.line = sc_bscan_line_selected();
     vc.sy32 = volume->dim[0];
     vc.sz32 = volume->dim[0] * volume->dim[1];
     area_acc acc;

@@ -15,6 +15,26 @@ void sc_bscan_span_generic(const vol_regs v, const int64_t *restrict lut_b_fx, u
     }
 }
 
+void sc_bscan_line_generic(const vol_regs v, const int64_t *restrict lut_b_fx, uint32_t n,
+                           const uint32_t *restrict hx, const uint32_t *restrict hy,
+                           const uint32_t *restrict hz, uint8_t *restrict out,
+                           uint8_t *restrict lab_out)
+{
+    for (uint32_t k = 0; k < n; k++) {
+        sc_bscan_sample_h(v, lut_b_fx, k, hx[k], hy[k], hz[k], out, lab_out);
+    }
+}
+
+sc_bscan_line_fn sc_bscan_line_selected(void)
+{
+#if defined(SC_SIMD_X86_64_V3_BUILT)
+    if (sc_simd_selected() != SC_SIMD_GENERIC) {
+        return sc_bscan_line_x86_64_v3;
+    }
+#endif
+    return sc_bscan_line_generic;
+}
+
 sc_bscan_span_fn sc_bscan_span_selected(void)
 {
 #if defined(SC_SIMD_X86_64_V3_BUILT)

@@ -7,6 +7,8 @@
  *                    the engine's contact case (bench_contact.c): a host-simulated engine
  *                    presses a built case (default neck-ijv from the build's cases folder) and
  *                    the deformed mesh at the deepest point of the press script is imaged
+ *        bench_bscan contact-walker|contact-hold [cases_dir] [case] [frames]
+ *                    for callgrind: walker frames / whole engine frames (bench_contact.h)
  * Prints a table; run it from a Release build (build/release).
  */
 #define _POSIX_C_SOURCE 200809L
@@ -324,6 +326,11 @@ int main(int argc, char **argv)
         const int n = argc > 4 ? atoi(argv[4]) : 10;
         return bench_contact_walker(argc > 2 ? argv[2] : SC_DEFAULT_CASES_DIR,
                                     argc > 3 ? argv[3] : "neck-ijv", n > 0 ? n : 10);
+    }
+    if (argc > 1 && strcmp(argv[1], "contact-hold") == 0) {
+        const int n = argc > 4 ? atoi(argv[4]) : 10;
+        return bench_contact_hold(argc > 2 ? argv[2] : SC_DEFAULT_CASES_DIR,
+                                  argc > 3 ? argv[3] : "neck-ijv", n > 0 ? n : 10);
     }
     const char *dir = argc > 1 ? argv[1] : "bscan_png";
     const int frames = argc > 2 ? atoi(argv[2]) : 40;

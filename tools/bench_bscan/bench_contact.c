@@ -289,3 +289,29 @@ int bench_contact_walker(const char *cases_dir, const char *case_name, int frame
            (e->bscan.status.walk_relocations - rel0) / (uint32_t)(frames > 0 ? frames : 1), h, ha);
     return 0;
 }
+
+__attribute__((noinline)) void bench_contact_hold_frames(int frames)
+{
+    const uint64_t t0 = g_rig.clock.now_ns - (uint64_t)(1.55e9);
+    for (int i = 0; i < frames; i++) {
+        const uint64_t release = sc_engine_next_release_ns(&g_rig.engine);
+        (void)sc_emu_feed(&g_emu, release - t0, send_peer, &g_rig.peer);
+        sc_engine_step(&g_rig.engine, NULL);
+    }
+}
+
+int bench_contact_hold(const char *cases_dir, const char *case_name, int frames)
+{
+    if (bench_contact_setup(cases_dir, case_name, -1, 8.0f, 1.55) != SC_OK) {
+        return 1;
+    }
+    frames = frames > 50 ? 50 : frames; /* the hold at the bottom lasts to t = 2.45 s */
+    bench_contact_hold_frames(frames);
+    sc_engine_status st;
+    sc_engine_get_status(&g_rig.engine, &st);
+    printf("contact-hold: %s, %d whole frames of the hold, contact %u, vein ratio %.4f, state hash "
+           "%016llx\n",
+           case_name, frames, st.probe_contact, (double)st.vein_area_ratio,
+           (unsigned long long)sc_engine_state_hash(&g_rig.engine));
+    return 0;
+}
