@@ -309,9 +309,18 @@ int bench_contact_hold(const char *cases_dir, const char *case_name, int frames)
     bench_contact_hold_frames(frames);
     sc_engine_status st;
     sc_engine_get_status(&g_rig.engine, &st);
+    /* the host simulator's display: every complete frame's image hash so far (folded) and the
+     * colour Doppler lines' hash: a change of the imaging code must keep them */
+    const sc_hs_display *hd = &g_rig.display;
+    uint64_t hi = 0;
+    for (uint32_t i = 0; i < hd->hash_count; i++) {
+        hi = (hi ^ hd->hashes[i]) * 0x100000001b3ull;
+    }
     printf("contact-hold: %s, %d whole frames of the hold, contact %u, vein ratio %.4f, state hash "
-           "%016llx\n",
+           "%016llx, images hash %016llx (%u frames), colour hash %016llx (%llu lines)\n",
            case_name, frames, st.probe_contact, (double)st.vein_area_ratio,
-           (unsigned long long)sc_engine_state_hash(&g_rig.engine));
+           (unsigned long long)sc_engine_state_hash(&g_rig.engine), (unsigned long long)hi,
+           hd->hash_count, (unsigned long long)hd->colour_hash,
+           (unsigned long long)hd->colour_lines);
     return 0;
 }
