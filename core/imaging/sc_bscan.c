@@ -1221,6 +1221,7 @@ typedef struct vol_ctx {
     float beyond_gl_per_mm; /* darkening beyond the volume, grey levels per mm */
     sc_bscan_span_fn span; /* the selected variant's sampler of spans clear of the border */
     sc_bscan_line_fn line; /* the selected variant's sampler of a whole line's positions */
+    sc_bscan_words_fn words; /* the selected variant's position words of a clear span */
 } vol_ctx;
 
 _Static_assert(SC_MAX_VOLUME_DIM < (1u << (32 - SC_W_BITS)), "position words fit 32 bits");
@@ -1341,8 +1342,6 @@ static void clear_steps(int64_t x, int64_t d, int64_t xm, int64_t n, int64_t *lo
  * part (after the line sampler). The same intervals are computed in each mode. */
 typedef enum span_mode { SPAN_ALL = 0, SPAN_WORDS = 1, SPAN_REST = 2 } span_mode;
 
-static void fill_words(sc_bscan *b, uint32_t k0, uint32_t k1, int64_t X, int64_t Y, int64_t Z,
-                       int64_t DX, int64_t DY, int64_t DZ);
 
 /* Samples [k0, k1) at voxel positions a + k b, all inside the volume box (the ends are, and the
  * box is convex). The part clear of the half-voxel border (no clamping: an interval) goes to the
@@ -1373,7 +1372,9 @@ static void sample_span_inside(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint
                 vc->span(vr, lut, k0 + (uint32_t)jlo, k0 + (uint32_t)jhi, X, Y, Z, DX, DY, DZ,
                          out, lab);
             } else if (mode == SPAN_WORDS) {
-                fill_words(b, k0 + (uint32_t)jlo, k0 + (uint32_t)jhi, X, Y, Z, DX, DY, DZ);
+                /* the exact words only: the span's clamped samples after these need theirs 0 */
+                sc_bscan_words_generic(b->pos_h[0], b->pos_h[1], b->pos_h[2], k0 + (uint32_t)jlo,
+                                       k0 + (uint32_t)jhi, X, Y, Z, DX, DY, DZ);
             }
             const int64_t m = jhi - jlo;
             X += m * DX;
@@ -1398,25 +1399,6 @@ static int in_volume_k(const vol_ctx *vc, const float a[3], const float bb[3], u
     return in_volume(vc, p);
 }
 
-/* The position words (sc_bscan_kern.h) of samples [k0, k1) at 32.32 positions
- * (X, Y, Z) + (k - k0) (DX, DY, DZ), every one inside [0, xmax]: the positions the span sampler
- * would step, for the line sampler. */
-static void fill_words(sc_bscan *b, uint32_t k0, uint32_t k1, int64_t X, int64_t Y, int64_t Z,
-                       int64_t DX, int64_t DY, int64_t DZ)
-{
-    uint32_t *restrict hx = b->pos_h[0], *restrict hy = b->pos_h[1], *restrict hz = b->pos_h[2];
-    X += SC_W_HALF;
-    Y += SC_W_HALF;
-    Z += SC_W_HALF;
-    for (uint32_t k = k0; k < k1; k++) {
-        hx[k] = (uint32_t)((uint64_t)X >> SC_POS_SHIFT);
-        hy[k] = (uint32_t)((uint64_t)Y >> SC_POS_SHIFT);
-        hz[k] = (uint32_t)((uint64_t)Z >> SC_POS_SHIFT);
-        X += DX;
-        Y += DY;
-        Z += DZ;
-    }
-}
 
 /* Samples [k0, k1) at voxel positions a + k b: the part inside the volume box (an interval: the
  * line is straight, the box convex; its ends found from the slab intersection and confirmed by
@@ -1450,7 +1432,8 @@ static int sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1,
                 vc->span(vr, b->lut_b_fx, k0, k1, X, Y, Z, DX, DY, DZ, b->line_out,
                          b->line_label);
             } else if (mode == SPAN_WORDS) {
-                fill_words(b, k0, k1, X, Y, Z, DX, DY, DZ);
+                /* (may write up to 7 words past k1: the next span writes its own after) */
+                vc->words(b->pos_h[0], b->pos_h[1], b->pos_h[2], k0, k1, X, Y, Z, DX, DY, DZ);
             }
             return 1;
         }
@@ -1814,6 +1797,7 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
     vc.beyond_gl_per_mm = 255.0f * SC_BSCAN_BEYOND_DB_PER_MM / b->def.dynamic_range_db;
     vc.span = sc_bscan_span_selected();
     vc.line = sc_bscan_line_selected();
+    vc.words = sc_bscan_words_selected();
     vc.sy32 = volume->dim[0];
     vc.sz32 = volume->dim[0] * volume->dim[1];
     area_acc acc;

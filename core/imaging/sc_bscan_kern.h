@@ -125,6 +125,23 @@ void sc_bscan_line_x86_64_v3(const vol_regs v, const int64_t *restrict lut_b_fx,
 /* The selected variant's line sampler (sc_simd_selected()). */
 sc_bscan_line_fn sc_bscan_line_selected(void);
 
+/* The position words h[d][k] of samples [k0, k1) at 32.32 positions (X, Y, Z) + (k - k0)
+ * (DX, DY, DZ), every one inside [0, xmax] of its axis: exactly the positions the span sampler
+ * steps. A variant may write the words of up to 7 samples past k1 (the arrays are padded; a
+ * later span overwrites them). */
+typedef void (*sc_bscan_words_fn)(uint32_t *restrict hx, uint32_t *restrict hy,
+                                  uint32_t *restrict hz, uint32_t k0, uint32_t k1, int64_t X,
+                                  int64_t Y, int64_t Z, int64_t DX, int64_t DY, int64_t DZ);
+void sc_bscan_words_generic(uint32_t *restrict hx, uint32_t *restrict hy, uint32_t *restrict hz,
+                            uint32_t k0, uint32_t k1, int64_t X, int64_t Y, int64_t Z, int64_t DX,
+                            int64_t DY, int64_t DZ);
+#if defined(SC_SIMD_X86_64_V3_BUILT)
+void sc_bscan_words_x86_64_v3(uint32_t *restrict hx, uint32_t *restrict hy,
+                              uint32_t *restrict hz, uint32_t k0, uint32_t k1, int64_t X,
+                              int64_t Y, int64_t Z, int64_t DX, int64_t DY, int64_t DZ);
+#endif
+sc_bscan_words_fn sc_bscan_words_selected(void);
+
 /* Samples [k0, k1) at 32.32 positions (X, Y, Z) + (k - k0) (DX, DY, DZ), every one inside
  * [0, xmax] of its axis (checked by the caller at both ends); out[k], lab_out[k] written. The
  * volume has fewer than 2^31 voxels (SC_MAX_VOLUME_VOXELS). */

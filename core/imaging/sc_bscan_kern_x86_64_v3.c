@@ -185,6 +185,36 @@ void sc_bscan_span_x86_64_v3(const vol_regs v, const int64_t *restrict lut_b_fx,
     }
 }
 
+/* 8 position words of one axis from x + HALF + j d (j = 0..7), 64-bit lanes shifted and packed */
+static inline __m256i words8(__m256i p0, __m256i p1)
+{
+    return pack_lo32(_mm256_srli_epi64(p0, SC_LOW_BITS), _mm256_srli_epi64(p1, SC_LOW_BITS));
+}
+
+void sc_bscan_words_x86_64_v3(uint32_t *restrict hx, uint32_t *restrict hy,
+                              uint32_t *restrict hz, uint32_t k0, uint32_t k1, int64_t X,
+                              int64_t Y, int64_t Z, int64_t DX, int64_t DY, int64_t DZ)
+{
+    __m256i x0 = _mm256_add_epi64(_mm256_set1_epi64x(X + SC_W_HALF),
+                                  _mm256_setr_epi64x(0, DX, 2 * DX, 3 * DX));
+    __m256i y0 = _mm256_add_epi64(_mm256_set1_epi64x(Y + SC_W_HALF),
+                                  _mm256_setr_epi64x(0, DY, 2 * DY, 3 * DY));
+    __m256i z0 = _mm256_add_epi64(_mm256_set1_epi64x(Z + SC_W_HALF),
+                                  _mm256_setr_epi64x(0, DZ, 2 * DZ, 3 * DZ));
+    const __m256i dx4 = _mm256_set1_epi64x(4 * DX), dy4 = _mm256_set1_epi64x(4 * DY),
+                  dz4 = _mm256_set1_epi64x(4 * DZ);
+    for (uint32_t k = k0; k < k1; k += 8u) {
+        const __m256i x1 = _mm256_add_epi64(x0, dx4), y1 = _mm256_add_epi64(y0, dy4),
+                      z1 = _mm256_add_epi64(z0, dz4);
+        _mm256_storeu_si256((__m256i *)(void *)(hx + k), words8(x0, x1));
+        _mm256_storeu_si256((__m256i *)(void *)(hy + k), words8(y0, y1));
+        _mm256_storeu_si256((__m256i *)(void *)(hz + k), words8(z0, z1));
+        x0 = _mm256_add_epi64(x1, dx4);
+        y0 = _mm256_add_epi64(y1, dy4);
+        z0 = _mm256_add_epi64(z1, dz4);
+    }
+}
+
 void sc_bscan_line_x86_64_v3(const vol_regs v, const int64_t *restrict lut_b_fx, uint32_t n,
                              const uint32_t *restrict hx, const uint32_t *restrict hy,
                              const uint32_t *restrict hz, uint8_t *restrict out,
