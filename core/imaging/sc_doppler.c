@@ -376,9 +376,21 @@ static void count_display(sc_doppler *d, int rc)
     }
 }
 
+/* floorf without the libm call (the portable x86-64 build has no rounding instruction and
+ * calls it for every colour sample): the same value for every finite x in int32's range (the
+ * argument here is never -0: v + nyq with nyq > 0), libm's beyond. */
+static inline float floor_f(float x)
+{
+    if (!(x > -2147483520.0f && x < 2147483520.0f)) {
+        return floorf(x);
+    }
+    const float t = (float)(int32_t)x; /* toward zero, exact below 2^24; above, x is whole */
+    return t > x ? t - 1.0f : t;
+}
+
 static float wrap_nyq(float v, float nyq)
 {
-    return v - 2.0f * nyq * floorf((v + nyq) / (2.0f * nyq));
+    return v - 2.0f * nyq * floor_f((v + nyq) / (2.0f * nyq));
 }
 
 /* Velocity toward the probe of sample k, before aliasing; *w the echo weight of blood there
@@ -561,7 +573,7 @@ void sc_doppler_line_hook(void *ctx, const sc_bscan_line_view *v)
                     } else {
                         float x = va / d->nyq_mm_s * 127.0f;
                         x = x > 127.0f ? 127.0f : (x < -127.0f ? -127.0f : x);
-                        int32_t qi = (int32_t)floorf(x + 0.5f);
+                        int32_t qi = (int32_t)floor_f(x + 0.5f);
                         qi = qi == 0 ? (va > 0.0f ? 1 : -1) : qi;
                         q = (int8_t)qi;
                         d->status.colour_pixels++;
