@@ -259,10 +259,15 @@ __attribute__((noinline)) void bench_contact_walker_frames(int frames)
     }
 }
 
-int bench_contact_walker(const char *cases_dir, const char *case_name, int frames)
+int bench_contact_walker(const char *cases_dir, const char *case_name, int frames, int acoustics)
 {
     if (bench_contact_setup(cases_dir, case_name, -1, 8.0f, 2.0) != SC_OK) {
         return 1;
+    }
+    if (acoustics >= 0) { /* the acoustics as asked, else the engine's setting for the case */
+        sc_bscan_def d = g_rig.engine.bscan.def;
+        d.acoustics = (uint32_t)(acoustics != 0);
+        (void)sc_bscan_set_def(&g_rig.engine.bscan, &d);
     }
     const sc_engine *e = &g_rig.engine;
     const uint32_t rel0 = e->bscan.status.walk_relocations;

@@ -20,9 +20,10 @@ int bench_contact_run(const char *cases_dir, const char *case_name, int method, 
 /* For instruction counts: the engine's walker imaging (the engine's settings) of the deepest
  * point, `frames` times inside bench_contact_walker_frames, nothing else timed or run after it:
  *   valgrind --tool=callgrind --toggle-collect=bench_contact_walker_frames bench_bscan
- *   contact-walker CASES CASE N   (the collected instructions / N: one walker frame).
+ *   contact-walker CASES CASE N [acoustics|no-acoustics]   (the collected instructions / N:
+ *   one walker frame; the acoustics as the engine runs the case unless asked).
  * Returns 0, or 1 when the case cannot be loaded. */
-int bench_contact_walker(const char *cases_dir, const char *case_name, int frames);
+int bench_contact_walker(const char *cases_dir, const char *case_name, int frames, int acoustics);
 void bench_contact_walker_frames(int frames);
 
 /* For instruction counts of whole frames: the engine run to the hold at the bottom of the press
