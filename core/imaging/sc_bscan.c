@@ -1489,6 +1489,70 @@ static int sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1,
     return 0;
 }
 
+/* The labels of the rigid slice (the compression measure's rest reference) at the samples of the
+ * mesh runs, in place of their deformed labels. Every loop-invariant in a local: the label
+ * stores (uint8_t) may alias anything, so the compiler would reload them after each store. */
+static void rest_labels(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, const frame_ctx *c)
+{
+    uint8_t *restrict out = b->line_label;
+    const uint8_t *restrict lab = vc->lab;
+    const size_t sy = vc->stride[1], sz = vc->stride[2];
+    const float f0[3] = {c->f0[0], c->f0[1], c->f0[2]}, fd[3] = {c->fd[0], c->fd[1], c->fd[2]};
+    const float hx = vc->hi[0], hy = vc->hi[1], hz = vc->hi[2];
+    const int64_t DX = to_fx32(fd[0]), DY = to_fx32(fd[1]), DZ = to_fx32(fd[2]);
+    const int64_t lx = (int64_t)v->dim[0] - 1, ly = (int64_t)v->dim[1] - 1,
+                  lz = (int64_t)v->dim[2] - 1;
+    const uint32_t runs = b->run_count;
+    const sc_bscan_run *restrict rs = b->runs;
+    for (uint32_t i = 0; i < runs; i++) {
+        const uint32_t k0 = rs[i].k0, k1 = rs[i].k1;
+        float p0[3], p1[3];
+        for (uint32_t d = 0; d < 3u; d++) {
+            p0[d] = f0[d] + (float)k0 * fd[d];
+            p1[d] = f0[d] + (float)(k1 - 1u) * fd[d];
+        }
+        /* in_volume of both ends */
+        if (p0[0] >= -0.5f && p0[0] < hx && p0[1] >= -0.5f && p0[1] < hy && p0[2] >= -0.5f &&
+            p0[2] < hz && p1[0] >= -0.5f && p1[0] < hx && p1[1] >= -0.5f && p1[1] < hy &&
+            p1[2] >= -0.5f && p1[2] < hz) {
+            /* nearest voxel: 16.16 positions offset by a half */
+            int64_t X = to_fx32(p0[0] + 0.5f), Y = to_fx32(p0[1] + 0.5f), Z = to_fx32(p0[2] + 0.5f);
+            const int64_t m1 = (int64_t)(k1 - 1u - k0);
+            const int64_t xe = X + m1 * DX, ye = Y + m1 * DY, ze = Z + m1 * DZ;
+            if (X >= 0 && xe >= 0 && Y >= 0 && ye >= 0 && Z >= 0 && ze >= 0 &&
+                (X >> 32) <= lx && (xe >> 32) <= lx && (Y >> 32) <= ly && (ye >> 32) <= ly &&
+                (Z >> 32) <= lz && (ze >> 32) <= lz) {
+                /* both ends clear of the clamps, so every position between them is (they are
+                 * linear in kk): the loop below without them, the same labels */
+                for (uint32_t kk = k0; kk < k1; kk++) {
+                    out[kk] = lab[(size_t)(X >> 32) + sy * (size_t)(Y >> 32) +
+                                  sz * (size_t)(Z >> 32)];
+                    X += DX;
+                    Y += DY;
+                    Z += DZ;
+                }
+                continue;
+            }
+            for (uint32_t kk = k0; kk < k1; kk++) {
+                int64_t ix = X < 0 ? 0 : X >> 32, iy = Y < 0 ? 0 : Y >> 32,
+                        iz = Z < 0 ? 0 : Z >> 32;
+                ix = ix > lx ? lx : ix;
+                iy = iy > ly ? ly : iy;
+                iz = iz > lz ? lz : iz;
+                out[kk] = lab[(size_t)ix + sy * (size_t)iy + sz * (size_t)iz];
+                X += DX;
+                Y += DY;
+                Z += DZ;
+            }
+            continue;
+        }
+        for (uint32_t kk = k0; kk < k1; kk++) {
+            const float t = (float)kk;
+            out[kk] = label_at(v, f0[0] + t * fd[0], f0[1] + t * fd[1], f0[2] + t * fd[2]);
+        }
+    }
+}
+
 /* The whole line: mesh runs at their rest positions, the gaps rigid; then label areas. */
 static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, const frame_ctx *c,
                         area_acc *acc)
@@ -1558,55 +1622,7 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
     }
     count_labels(b->line_label, n, acc->now_n, acc->now_k);
     /* rest areas: the rigid slice's labels; outside the mesh identical to the above */
-    for (uint32_t i = 0; i < b->run_count; i++) {
-        const uint32_t k0 = b->runs[i].k0, k1 = b->runs[i].k1;
-        float p0[3], p1[3];
-        for (uint32_t d = 0; d < 3u; d++) {
-            p0[d] = c->f0[d] + (float)k0 * c->fd[d];
-            p1[d] = c->f0[d] + (float)(k1 - 1u) * c->fd[d];
-        }
-        if (in_volume(vc, p0) && in_volume(vc, p1)) {
-            /* nearest voxel: 16.16 positions offset by a half */
-            int64_t X = to_fx32(p0[0] + 0.5f), Y = to_fx32(p0[1] + 0.5f), Z = to_fx32(p0[2] + 0.5f);
-            const int64_t DX = to_fx32(c->fd[0]), DY = to_fx32(c->fd[1]), DZ = to_fx32(c->fd[2]);
-            const int64_t lx = (int64_t)v->dim[0] - 1, ly = (int64_t)v->dim[1] - 1,
-                          lz = (int64_t)v->dim[2] - 1;
-            const int64_t m1 = (int64_t)(k1 - 1u - k0);
-            const int64_t xe = X + m1 * DX, ye = Y + m1 * DY, ze = Z + m1 * DZ;
-            if (X >= 0 && xe >= 0 && Y >= 0 && ye >= 0 && Z >= 0 && ze >= 0 &&
-                (X >> 32) <= lx && (xe >> 32) <= lx && (Y >> 32) <= ly && (ye >> 32) <= ly &&
-                (Z >> 32) <= lz && (ze >> 32) <= lz) {
-                /* both ends clear of the clamps, so every position between them is (they are
-                 * linear in kk): the loop below without them, the same labels */
-                for (uint32_t kk = k0; kk < k1; kk++) {
-                    b->line_label[kk] = vc->lab[(size_t)(X >> 32) + vc->stride[1] * (size_t)(Y >> 32) +
-                                                vc->stride[2] * (size_t)(Z >> 32)];
-                    X += DX;
-                    Y += DY;
-                    Z += DZ;
-                }
-                continue;
-            }
-            for (uint32_t kk = k0; kk < k1; kk++) {
-                int64_t ix = X < 0 ? 0 : X >> 32, iy = Y < 0 ? 0 : Y >> 32,
-                        iz = Z < 0 ? 0 : Z >> 32;
-                ix = ix > lx ? lx : ix;
-                iy = iy > ly ? ly : iy;
-                iz = iz > lz ? lz : iz;
-                b->line_label[kk] =
-                    vc->lab[(size_t)ix + vc->stride[1] * (size_t)iy + vc->stride[2] * (size_t)iz];
-                X += DX;
-                Y += DY;
-                Z += DZ;
-            }
-            continue;
-        }
-        for (uint32_t kk = k0; kk < k1; kk++) {
-            const float s = (float)kk;
-            b->line_label[kk] = label_at(v, c->f0[0] + s * c->fd[0], c->f0[1] + s * c->fd[1],
-                                         c->f0[2] + s * c->fd[2]);
-        }
-    }
+    rest_labels(b, vc, v, c);
     count_labels(b->line_label, n, acc->rest_n, acc->rest_k);
     /* the rest reference continues above the face by the margin: tissue the probe has pushed
      * into the image was there at rest (every 4th sample, each counting for 4) */
