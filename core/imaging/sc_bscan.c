@@ -1220,7 +1220,11 @@ typedef struct vol_ctx {
     float slab[3];          /* voxels of the slab the continuation beyond a face repeats */
     float beyond_gl_per_mm; /* darkening beyond the volume, grey levels per mm */
     sc_bscan_span_fn span; /* the selected variant's sampler of spans clear of the border */
+    sc_bscan_line_fn line; /* the selected variant's sampler of a whole line's positions */
+    sc_bscan_words_fn words; /* the selected variant's position words of a clear span */
 } vol_ctx;
+
+_Static_assert(SC_MAX_VOLUME_DIM < (1u << (32 - SC_W_BITS)), "position words fit 32 bits");
 
 /* Positions are 32.32 fixed point (int64): stepping along a span adds exactly, the step's
  * rounding drifts by less than 1e-7 voxel over a line. */
@@ -1333,11 +1337,17 @@ static void clear_steps(int64_t x, int64_t d, int64_t xm, int64_t n, int64_t *lo
     *hi = z < *hi ? z : *hi;
 }
 
+/* What sample_span and sample_span_inside do: everything; only the position words of the part
+ * clear of the border (for the line sampler, the rest of the words 0); or everything but that
+ * part (after the line sampler). The same intervals are computed in each mode. */
+typedef enum span_mode { SPAN_ALL = 0, SPAN_WORDS = 1, SPAN_REST = 2 } span_mode;
+
+
 /* Samples [k0, k1) at voxel positions a + k b, all inside the volume box (the ends are, and the
  * box is convex). The part clear of the half-voxel border (no clamping: an interval) goes to the
  * selected span kernel, the ends clamped sample by sample: the same values either way. */
 static void sample_span_inside(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1,
-                               const float a[3], const float bb[3])
+                               const float a[3], const float bb[3], span_mode mode)
 {
     const vol_regs vr = {vc->vox, vc->lab, vc->stride[1], vc->stride[2], vc->la};
     const int64_t *restrict lut = b->lut_b_fx;
@@ -1358,8 +1368,14 @@ static void sample_span_inside(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint
     for (int64_t j = 0; j < n; j++) {
         if (j == jlo) {
             /* clear of the half-voxel border: no clamping */
-            vc->span(vr, lut, k0 + (uint32_t)jlo, k0 + (uint32_t)jhi, X, Y, Z, DX, DY, DZ, out,
-                     lab);
+            if (mode == SPAN_ALL) {
+                vc->span(vr, lut, k0 + (uint32_t)jlo, k0 + (uint32_t)jhi, X, Y, Z, DX, DY, DZ,
+                         out, lab);
+            } else if (mode == SPAN_WORDS) {
+                /* the exact words only: the span's clamped samples after these need theirs 0 */
+                sc_bscan_words_generic(b->pos_h[0], b->pos_h[1], b->pos_h[2], k0 + (uint32_t)jlo,
+                                       k0 + (uint32_t)jhi, X, Y, Z, DX, DY, DZ);
+            }
             const int64_t m = jhi - jlo;
             X += m * DX;
             Y += m * DY;
@@ -1367,8 +1383,10 @@ static void sample_span_inside(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint
             j = jhi - 1;
             continue;
         }
-        sample_fx(vr, lut, k0 + (uint32_t)j, clamp_fx(X, xm0), clamp_fx(Y, xm1), clamp_fx(Z, xm2),
-                  out, lab);
+        if (mode != SPAN_WORDS) {
+            sample_fx(vr, lut, k0 + (uint32_t)j, clamp_fx(X, xm0), clamp_fx(Y, xm1),
+                      clamp_fx(Z, xm2), out, lab);
+        }
         X += DX;
         Y += DY;
         Z += DZ;
@@ -1381,12 +1399,20 @@ static int in_volume_k(const vol_ctx *vc, const float a[3], const float bb[3], u
     return in_volume(vc, p);
 }
 
+
 /* Samples [k0, k1) at voxel positions a + k b: the part inside the volume box (an interval: the
  * line is straight, the box convex; its ends found from the slab intersection and confirmed by
  * the per-sample test) in fixed point, the parts beyond it continued (beyond_sample). */
-static void sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1, const float a[3],
-                        const float bb[3])
+static int sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1, const float a[3],
+                       const float bb[3], span_mode mode)
 {
+    if (mode == SPAN_WORDS) {
+        for (uint32_t k = k0; k < k1; k++) {
+            b->pos_h[0][k] = 0u;
+            b->pos_h[1][k] = 0u;
+            b->pos_h[2][k] = 0u;
+        }
+    }
     {
         /* the common case first (a mesh run is one tet's crossing, a few samples): both ends
          * clear of the half-voxel border, so every sample is, and the per-sample box test below
@@ -1402,8 +1428,14 @@ static void sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1
             X <= vc->xmax[0] && xe <= vc->xmax[0] && Y <= vc->xmax[1] && ye <= vc->xmax[1] &&
             Z <= vc->xmax[2] && ze <= vc->xmax[2]) {
             const vol_regs vr = {vc->vox, vc->lab, vc->stride[1], vc->stride[2], vc->la};
-            vc->span(vr, b->lut_b_fx, k0, k1, X, Y, Z, DX, DY, DZ, b->line_out, b->line_label);
-            return;
+            if (mode == SPAN_ALL) {
+                vc->span(vr, b->lut_b_fx, k0, k1, X, Y, Z, DX, DY, DZ, b->line_out,
+                         b->line_label);
+            } else if (mode == SPAN_WORDS) {
+                /* (may write up to 7 words past k1: the next span writes its own after) */
+                vc->words(b->pos_h[0], b->pos_h[1], b->pos_h[2], k0, k1, X, Y, Z, DX, DY, DZ);
+            }
+            return 1;
         }
     }
     /* the line parameter range inside the box, per axis: -1/2 <= a + k b < hi */
@@ -1444,13 +1476,80 @@ static void sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1
     const vol_regs vr = {vc->vox, vc->lab, vc->stride[1], vc->stride[2], vc->la};
     for (uint32_t k = k0; k < k1; k++) {
         if (k == ka) {
-            sample_span_inside(b, vc, ka, kb, a, bb);
+            sample_span_inside(b, vc, ka, kb, a, bb, mode);
             k = kb - 1u;
             continue;
         }
         const float p[3] = {a[0] + (float)k * bb[0], a[1] + (float)k * bb[1],
                             a[2] + (float)k * bb[2]};
-        beyond_sample(vc, vr, b->lut_b_fx, k, p, b->line_out, b->line_label);
+        if (mode != SPAN_WORDS) {
+            beyond_sample(vc, vr, b->lut_b_fx, k, p, b->line_out, b->line_label);
+        }
+    }
+    return 0;
+}
+
+/* The labels of the rigid slice (the compression measure's rest reference) at the samples of the
+ * mesh runs, in place of their deformed labels. Every loop-invariant in a local: the label
+ * stores (uint8_t) may alias anything, so the compiler would reload them after each store. */
+static void rest_labels(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, const frame_ctx *c)
+{
+    uint8_t *restrict out = b->line_label;
+    const uint8_t *restrict lab = vc->lab;
+    const size_t sy = vc->stride[1], sz = vc->stride[2];
+    const float f0[3] = {c->f0[0], c->f0[1], c->f0[2]}, fd[3] = {c->fd[0], c->fd[1], c->fd[2]};
+    const float hx = vc->hi[0], hy = vc->hi[1], hz = vc->hi[2];
+    const int64_t DX = to_fx32(fd[0]), DY = to_fx32(fd[1]), DZ = to_fx32(fd[2]);
+    const int64_t lx = (int64_t)v->dim[0] - 1, ly = (int64_t)v->dim[1] - 1,
+                  lz = (int64_t)v->dim[2] - 1;
+    const uint32_t runs = b->run_count;
+    const sc_bscan_run *restrict rs = b->runs;
+    for (uint32_t i = 0; i < runs; i++) {
+        const uint32_t k0 = rs[i].k0, k1 = rs[i].k1;
+        float p0[3], p1[3];
+        for (uint32_t d = 0; d < 3u; d++) {
+            p0[d] = f0[d] + (float)k0 * fd[d];
+            p1[d] = f0[d] + (float)(k1 - 1u) * fd[d];
+        }
+        /* in_volume of both ends */
+        if (p0[0] >= -0.5f && p0[0] < hx && p0[1] >= -0.5f && p0[1] < hy && p0[2] >= -0.5f &&
+            p0[2] < hz && p1[0] >= -0.5f && p1[0] < hx && p1[1] >= -0.5f && p1[1] < hy &&
+            p1[2] >= -0.5f && p1[2] < hz) {
+            /* nearest voxel: 16.16 positions offset by a half */
+            int64_t X = to_fx32(p0[0] + 0.5f), Y = to_fx32(p0[1] + 0.5f), Z = to_fx32(p0[2] + 0.5f);
+            const int64_t m1 = (int64_t)(k1 - 1u - k0);
+            const int64_t xe = X + m1 * DX, ye = Y + m1 * DY, ze = Z + m1 * DZ;
+            if (X >= 0 && xe >= 0 && Y >= 0 && ye >= 0 && Z >= 0 && ze >= 0 &&
+                (X >> 32) <= lx && (xe >> 32) <= lx && (Y >> 32) <= ly && (ye >> 32) <= ly &&
+                (Z >> 32) <= lz && (ze >> 32) <= lz) {
+                /* both ends clear of the clamps, so every position between them is (they are
+                 * linear in kk): the loop below without them, the same labels */
+                for (uint32_t kk = k0; kk < k1; kk++) {
+                    out[kk] = lab[(size_t)(X >> 32) + sy * (size_t)(Y >> 32) +
+                                  sz * (size_t)(Z >> 32)];
+                    X += DX;
+                    Y += DY;
+                    Z += DZ;
+                }
+                continue;
+            }
+            for (uint32_t kk = k0; kk < k1; kk++) {
+                int64_t ix = X < 0 ? 0 : X >> 32, iy = Y < 0 ? 0 : Y >> 32,
+                        iz = Z < 0 ? 0 : Z >> 32;
+                ix = ix > lx ? lx : ix;
+                iy = iy > ly ? ly : iy;
+                iz = iz > lz ? lz : iz;
+                out[kk] = lab[(size_t)ix + sy * (size_t)iy + sz * (size_t)iz];
+                X += DX;
+                Y += DY;
+                Z += DZ;
+            }
+            continue;
+        }
+        for (uint32_t kk = k0; kk < k1; kk++) {
+            const float t = (float)kk;
+            out[kk] = label_at(v, f0[0] + t * fd[0], f0[1] + t * fd[1], f0[2] + t * fd[2]);
+        }
     }
 }
 
@@ -1459,17 +1558,50 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
                         area_acc *acc)
 {
     const uint32_t n = c->n;
-    uint32_t k = 0;
+    /* the position words of every span's part clear of the volume's border (nearly every
+     * sample), one call of the line sampler for them all, then the rest of the spans (clamped
+     * ends, beyond the volume) sample by sample: the same intervals, positions and bytes as
+     * sample_span alone (SPAN_ALL) */
+    /* spans in line order: the rigid gap before run i is span 2 i, run i span 2 i + 1, the
+     * gap after the last run span 2 run_count; those between first and last need the rest */
+    uint32_t k = 0, first = UINT32_MAX, last = 0;
     for (uint32_t i = 0; i < b->run_count; i++) {
         const sc_bscan_run *r = &b->runs[i];
-        if (k < r->k0) {
-            sample_span(b, vc, k, r->k0, c->f0, c->fd);
+        if (k < r->k0 && !sample_span(b, vc, k, r->k0, c->f0, c->fd, SPAN_WORDS)) {
+            first = first < 2u * i ? first : 2u * i;
+            last = 2u * i;
         }
-        sample_span(b, vc, r->k0, r->k1, r->a, r->b);
+        if (!sample_span(b, vc, r->k0, r->k1, r->a, r->b, SPAN_WORDS)) {
+            first = first < 2u * i + 1u ? first : 2u * i + 1u;
+            last = 2u * i + 1u;
+        }
         k = r->k1;
     }
-    if (k < n) {
-        sample_span(b, vc, k, n, c->f0, c->fd);
+    if (k < n && !sample_span(b, vc, k, n, c->f0, c->fd, SPAN_WORDS)) {
+        first = first < 2u * b->run_count ? first : 2u * b->run_count;
+        last = 2u * b->run_count;
+    }
+    {
+        const vol_regs vr = {vc->vox, vc->lab, vc->stride[1], vc->stride[2], vc->la};
+        vc->line(vr, b->lut_b_fx, n, b->pos_h[0], b->pos_h[1], b->pos_h[2], b->line_out,
+                 b->line_label);
+    }
+    if (first != UINT32_MAX) {
+        const uint32_t i0 = first / 2u;
+        k = i0 > 0u ? b->runs[i0 - 1u].k1 : 0u;
+        for (uint32_t i = i0; i < b->run_count && 2u * i <= last; i++) {
+            const sc_bscan_run *r = &b->runs[i];
+            if (k < r->k0 && 2u * i >= first) {
+                (void)sample_span(b, vc, k, r->k0, c->f0, c->fd, SPAN_REST);
+            }
+            if (2u * i + 1u >= first && 2u * i + 1u <= last) {
+                (void)sample_span(b, vc, r->k0, r->k1, r->a, r->b, SPAN_REST);
+            }
+            k = r->k1;
+        }
+        if (k < n && last == 2u * b->run_count) {
+            (void)sample_span(b, vc, k, n, c->f0, c->fd, SPAN_REST);
+        }
     }
     if (b->def.acoustics != 0u) {
         /* along the beam as it runs now: the labels are this frame's (deformed) ones */
@@ -1490,55 +1622,7 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
     }
     count_labels(b->line_label, n, acc->now_n, acc->now_k);
     /* rest areas: the rigid slice's labels; outside the mesh identical to the above */
-    for (uint32_t i = 0; i < b->run_count; i++) {
-        const uint32_t k0 = b->runs[i].k0, k1 = b->runs[i].k1;
-        float p0[3], p1[3];
-        for (uint32_t d = 0; d < 3u; d++) {
-            p0[d] = c->f0[d] + (float)k0 * c->fd[d];
-            p1[d] = c->f0[d] + (float)(k1 - 1u) * c->fd[d];
-        }
-        if (in_volume(vc, p0) && in_volume(vc, p1)) {
-            /* nearest voxel: 16.16 positions offset by a half */
-            int64_t X = to_fx32(p0[0] + 0.5f), Y = to_fx32(p0[1] + 0.5f), Z = to_fx32(p0[2] + 0.5f);
-            const int64_t DX = to_fx32(c->fd[0]), DY = to_fx32(c->fd[1]), DZ = to_fx32(c->fd[2]);
-            const int64_t lx = (int64_t)v->dim[0] - 1, ly = (int64_t)v->dim[1] - 1,
-                          lz = (int64_t)v->dim[2] - 1;
-            const int64_t m1 = (int64_t)(k1 - 1u - k0);
-            const int64_t xe = X + m1 * DX, ye = Y + m1 * DY, ze = Z + m1 * DZ;
-            if (X >= 0 && xe >= 0 && Y >= 0 && ye >= 0 && Z >= 0 && ze >= 0 &&
-                (X >> 32) <= lx && (xe >> 32) <= lx && (Y >> 32) <= ly && (ye >> 32) <= ly &&
-                (Z >> 32) <= lz && (ze >> 32) <= lz) {
-                /* both ends clear of the clamps, so every position between them is (they are
-                 * linear in kk): the loop below without them, the same labels */
-                for (uint32_t kk = k0; kk < k1; kk++) {
-                    b->line_label[kk] = vc->lab[(size_t)(X >> 32) + vc->stride[1] * (size_t)(Y >> 32) +
-                                                vc->stride[2] * (size_t)(Z >> 32)];
-                    X += DX;
-                    Y += DY;
-                    Z += DZ;
-                }
-                continue;
-            }
-            for (uint32_t kk = k0; kk < k1; kk++) {
-                int64_t ix = X < 0 ? 0 : X >> 32, iy = Y < 0 ? 0 : Y >> 32,
-                        iz = Z < 0 ? 0 : Z >> 32;
-                ix = ix > lx ? lx : ix;
-                iy = iy > ly ? ly : iy;
-                iz = iz > lz ? lz : iz;
-                b->line_label[kk] =
-                    vc->lab[(size_t)ix + vc->stride[1] * (size_t)iy + vc->stride[2] * (size_t)iz];
-                X += DX;
-                Y += DY;
-                Z += DZ;
-            }
-            continue;
-        }
-        for (uint32_t kk = k0; kk < k1; kk++) {
-            const float s = (float)kk;
-            b->line_label[kk] = label_at(v, c->f0[0] + s * c->fd[0], c->f0[1] + s * c->fd[1],
-                                         c->f0[2] + s * c->fd[2]);
-        }
-    }
+    rest_labels(b, vc, v, c);
     count_labels(b->line_label, n, acc->rest_n, acc->rest_k);
     /* the rest reference continues above the face by the margin: tissue the probe has pushed
      * into the image was there at rest (every 4th sample, each counting for 4) */
@@ -1728,6 +1812,8 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
     }
     vc.beyond_gl_per_mm = 255.0f * SC_BSCAN_BEYOND_DB_PER_MM / b->def.dynamic_range_db;
     vc.span = sc_bscan_span_selected();
+    vc.line = sc_bscan_line_selected();
+    vc.words = sc_bscan_words_selected();
     vc.sy32 = volume->dim[0];
     vc.sz32 = volume->dim[0] * volume->dim[1];
     area_acc acc;

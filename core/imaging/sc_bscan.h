@@ -237,6 +237,9 @@ typedef struct sc_bscan {
     sc_bscan_run runs[SC_MAX_SCAN_SAMPLES];
     uint8_t line_label[SC_MAX_SCAN_SAMPLES];
     uint8_t line_out[SC_MAX_SCAN_SAMPLES];
+    /* the line's sampling positions, one 32-bit word per axis and sample (sc_bscan_kern.h's
+     * line sampler: one call per line), padded to a multiple of 8 */
+    SC_ALIGN_HOT uint32_t pos_h[3][SC_MAX_SCAN_SAMPLES + 8u];
     sc_acoustics acou; /* tables of def.acoustic for this geometry and range */
     sc_bscan_status status;
 } sc_bscan;

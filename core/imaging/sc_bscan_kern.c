@@ -15,6 +15,53 @@ void sc_bscan_span_generic(const vol_regs v, const int64_t *restrict lut_b_fx, u
     }
 }
 
+void sc_bscan_line_generic(const vol_regs v, const int64_t *restrict lut_b_fx, uint32_t n,
+                           const uint32_t *restrict hx, const uint32_t *restrict hy,
+                           const uint32_t *restrict hz, uint8_t *restrict out,
+                           uint8_t *restrict lab_out)
+{
+    for (uint32_t k = 0; k < n; k++) {
+        sc_bscan_sample_h(v, lut_b_fx, k, hx[k], hy[k], hz[k], out, lab_out);
+    }
+}
+
+sc_bscan_line_fn sc_bscan_line_selected(void)
+{
+#if defined(SC_SIMD_X86_64_V3_BUILT)
+    if (sc_simd_selected() != SC_SIMD_GENERIC) {
+        return sc_bscan_line_x86_64_v3;
+    }
+#endif
+    return sc_bscan_line_generic;
+}
+
+void sc_bscan_words_generic(uint32_t *restrict hx, uint32_t *restrict hy, uint32_t *restrict hz,
+                            uint32_t k0, uint32_t k1, int64_t X, int64_t Y, int64_t Z, int64_t DX,
+                            int64_t DY, int64_t DZ)
+{
+    X += SC_W_HALF;
+    Y += SC_W_HALF;
+    Z += SC_W_HALF;
+    for (uint32_t k = k0; k < k1; k++) {
+        hx[k] = (uint32_t)((uint64_t)X >> SC_POS_SHIFT);
+        hy[k] = (uint32_t)((uint64_t)Y >> SC_POS_SHIFT);
+        hz[k] = (uint32_t)((uint64_t)Z >> SC_POS_SHIFT);
+        X += DX;
+        Y += DY;
+        Z += DZ;
+    }
+}
+
+sc_bscan_words_fn sc_bscan_words_selected(void)
+{
+#if defined(SC_SIMD_X86_64_V3_BUILT)
+    if (sc_simd_selected() != SC_SIMD_GENERIC) {
+        return sc_bscan_words_x86_64_v3;
+    }
+#endif
+    return sc_bscan_words_generic;
+}
+
 sc_bscan_span_fn sc_bscan_span_selected(void)
 {
 #if defined(SC_SIMD_X86_64_V3_BUILT)

@@ -65,6 +65,83 @@ static inline void sc_bscan_sample_fx(const vol_regs v, const int64_t *restrict 
                            : (sum >= ((int64_t)255 << 26) ? 255 : (sum >> 26)));
 }
 
+/* The position word of one axis as the sampler reads it: (P + SC_W_HALF) >> (32 - SC_W_BITS) for
+ * the 32.32 position P (in [0, xmax]): the voxel index << SC_W_BITS | the weight. The volume's
+ * axes are below 2^22 voxels (SC_MAX_VOLUME_DIM), so it fits 32 bits. */
+#define SC_POS_SHIFT (32 - SC_W_BITS)
+
+/* One sample from its position words (hx, hy, hz): the same arithmetic as sc_bscan_sample_fx
+ * on the position they come from, so the same bytes. */
+static inline void sc_bscan_sample_h(const vol_regs v, const int64_t *restrict lut_b_fx,
+                                     uint32_t k, uint32_t hx, uint32_t hy, uint32_t hz,
+                                     uint8_t *restrict out, uint8_t *restrict lab_out)
+{
+    const int32_t tx = (int32_t)(hx & (SC_W_ONE - 1));
+    const int32_t ty = (int32_t)(hy & (SC_W_ONE - 1));
+    const int32_t tz = (int32_t)(hz & (SC_W_ONE - 1));
+    const size_t base = (size_t)(hx >> SC_W_BITS) + v.sy * (size_t)(hy >> SC_W_BITS) +
+                        v.sz * (size_t)(hz >> SC_W_BITS);
+    const uint8_t *r00 = v.vox + base, *r10 = r00 + v.sy, *r01 = r00 + v.sz, *r11 = r01 + v.sy;
+    const int32_t c00 = r00[0] * SC_W_ONE + tx * (r00[1] - r00[0]);
+    const int32_t c10 = r10[0] * SC_W_ONE + tx * (r10[1] - r10[0]);
+    const int32_t c01 = r01[0] * SC_W_ONE + tx * (r01[1] - r01[0]);
+    const int32_t c11 = r11[0] * SC_W_ONE + tx * (r11[1] - r11[0]);
+    const int32_t c0 = (c00 * SC_W_ONE + ty * (c10 - c00) + SC_W_ONE / 2) >> SC_W_BITS;
+    const int32_t c1 = (c01 * SC_W_ONE + ty * (c11 - c01) + SC_W_ONE / 2) >> SC_W_BITS;
+    const int32_t ifx = (c0 * SC_W_ONE + tz * (c1 - c0) + SC_W_ONE / 2) >> SC_W_BITS;
+    uint8_t label = (uint8_t)SC_LABEL_MUSCLE;
+    if (v.lab != NULL) {
+        label = v.lab[base + (size_t)(tx >> (SC_W_BITS - 1)) + (ty >= SC_W_ONE / 2 ? v.sy : 0u) +
+                      (tz >= SC_W_ONE / 2 ? v.sz : 0u)];
+    }
+    lab_out[k] = label;
+    const int64_t sum = v.la * (int64_t)ifx + lut_b_fx[k];
+    out[k] = (uint8_t)(label == (uint8_t)SC_LABEL_OUTSIDE || sum < ((int64_t)1 << 26)
+                           ? 0
+                           : (sum >= ((int64_t)255 << 26) ? 255 : (sum >> 26)));
+}
+
+/* Samples [0, n) of a whole line from their position words h[0][k], h[1][k], h[2][k] (the
+ * caller steps each span's positions exactly as the span sampler does, so the same bytes; a
+ * sample the caller does otherwise has any valid words, e.g. 0, and is overwritten after).
+ * The arrays are readable up to n rounded up to 8. One call per line instead of one per span
+ * (a mesh run is one tet crossed: about 5 samples). */
+typedef void (*sc_bscan_line_fn)(const vol_regs v, const int64_t *restrict lut_b_fx, uint32_t n,
+                                 const uint32_t *restrict hx, const uint32_t *restrict hy,
+                                 const uint32_t *restrict hz, uint8_t *restrict out,
+                                 uint8_t *restrict lab_out);
+
+void sc_bscan_line_generic(const vol_regs v, const int64_t *restrict lut_b_fx, uint32_t n,
+                           const uint32_t *restrict hx, const uint32_t *restrict hy,
+                           const uint32_t *restrict hz, uint8_t *restrict out,
+                           uint8_t *restrict lab_out);
+#if defined(SC_SIMD_X86_64_V3_BUILT)
+void sc_bscan_line_x86_64_v3(const vol_regs v, const int64_t *restrict lut_b_fx, uint32_t n,
+                             const uint32_t *restrict hx, const uint32_t *restrict hy,
+                             const uint32_t *restrict hz, uint8_t *restrict out,
+                             uint8_t *restrict lab_out);
+#endif
+
+/* The selected variant's line sampler (sc_simd_selected()). */
+sc_bscan_line_fn sc_bscan_line_selected(void);
+
+/* The position words h[d][k] of samples [k0, k1) at 32.32 positions (X, Y, Z) + (k - k0)
+ * (DX, DY, DZ), every one inside [0, xmax] of its axis: exactly the positions the span sampler
+ * steps. A variant may write the words of up to 7 samples past k1 (the arrays are padded; a
+ * later span overwrites them). */
+typedef void (*sc_bscan_words_fn)(uint32_t *restrict hx, uint32_t *restrict hy,
+                                  uint32_t *restrict hz, uint32_t k0, uint32_t k1, int64_t X,
+                                  int64_t Y, int64_t Z, int64_t DX, int64_t DY, int64_t DZ);
+void sc_bscan_words_generic(uint32_t *restrict hx, uint32_t *restrict hy, uint32_t *restrict hz,
+                            uint32_t k0, uint32_t k1, int64_t X, int64_t Y, int64_t Z, int64_t DX,
+                            int64_t DY, int64_t DZ);
+#if defined(SC_SIMD_X86_64_V3_BUILT)
+void sc_bscan_words_x86_64_v3(uint32_t *restrict hx, uint32_t *restrict hy,
+                              uint32_t *restrict hz, uint32_t k0, uint32_t k1, int64_t X,
+                              int64_t Y, int64_t Z, int64_t DX, int64_t DY, int64_t DZ);
+#endif
+sc_bscan_words_fn sc_bscan_words_selected(void);
+
 /* Samples [k0, k1) at 32.32 positions (X, Y, Z) + (k - k0) (DX, DY, DZ), every one inside
  * [0, xmax] of its axis (checked by the caller at both ends); out[k], lab_out[k] written. The
  * volume has fewer than 2^31 voxels (SC_MAX_VOLUME_VOXELS). */

@@ -184,6 +184,112 @@ void sc_bscan_span_x86_64_v3(const vol_regs v, const int64_t *restrict lut_b_fx,
         lanes_step(&lz);
     }
 }
+
+/* 8 position words of one axis from x + HALF + j d (j = 0..7), 64-bit lanes shifted and packed */
+static inline __m256i words8(__m256i p0, __m256i p1)
+{
+    return pack_lo32(_mm256_srli_epi64(p0, SC_LOW_BITS), _mm256_srli_epi64(p1, SC_LOW_BITS));
+}
+
+void sc_bscan_words_x86_64_v3(uint32_t *restrict hx, uint32_t *restrict hy,
+                              uint32_t *restrict hz, uint32_t k0, uint32_t k1, int64_t X,
+                              int64_t Y, int64_t Z, int64_t DX, int64_t DY, int64_t DZ)
+{
+    __m256i x0 = _mm256_add_epi64(_mm256_set1_epi64x(X + SC_W_HALF),
+                                  _mm256_setr_epi64x(0, DX, 2 * DX, 3 * DX));
+    __m256i y0 = _mm256_add_epi64(_mm256_set1_epi64x(Y + SC_W_HALF),
+                                  _mm256_setr_epi64x(0, DY, 2 * DY, 3 * DY));
+    __m256i z0 = _mm256_add_epi64(_mm256_set1_epi64x(Z + SC_W_HALF),
+                                  _mm256_setr_epi64x(0, DZ, 2 * DZ, 3 * DZ));
+    const __m256i dx4 = _mm256_set1_epi64x(4 * DX), dy4 = _mm256_set1_epi64x(4 * DY),
+                  dz4 = _mm256_set1_epi64x(4 * DZ);
+    for (uint32_t k = k0; k < k1; k += 8u) {
+        const __m256i x1 = _mm256_add_epi64(x0, dx4), y1 = _mm256_add_epi64(y0, dy4),
+                      z1 = _mm256_add_epi64(z0, dz4);
+        _mm256_storeu_si256((__m256i *)(void *)(hx + k), words8(x0, x1));
+        _mm256_storeu_si256((__m256i *)(void *)(hy + k), words8(y0, y1));
+        _mm256_storeu_si256((__m256i *)(void *)(hz + k), words8(z0, z1));
+        x0 = _mm256_add_epi64(x1, dx4);
+        y0 = _mm256_add_epi64(y1, dy4);
+        z0 = _mm256_add_epi64(z1, dz4);
+    }
+}
+
+void sc_bscan_line_x86_64_v3(const vol_regs v, const int64_t *restrict lut_b_fx, uint32_t n,
+                             const uint32_t *restrict hx, const uint32_t *restrict hy,
+                             const uint32_t *restrict hz, uint8_t *restrict out,
+                             uint8_t *restrict lab_out)
+{
+    const __m256i wmask = _mm256_set1_epi32(SC_W_ONE - 1);
+    const __m256i half = _mm256_set1_epi32(SC_W_ONE / 2 - 1);
+    const __m256i vsy = _mm256_set1_epi32((int32_t)v.sy);
+    const __m256i vsz = _mm256_set1_epi32((int32_t)v.sz);
+    const __m256i vsyz2 = _mm256_set1_epi32((int32_t)(v.sy + v.sz) - 2);
+    const __m256i la = _mm256_set1_epi64x(v.la);
+    const __m256i outside = _mm256_set1_epi32(SC_LABEL_OUTSIDE);
+    const __m256i three = _mm256_set1_epi32(3);
+    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    const int *vox = (const int *)(const void *)v.vox;
+    const int *labp = (const int *)(const void *)v.lab;
+    for (uint32_t k = 0; k < n; k += 8u) {
+        const uint32_t r = n - k < 8u ? n - k : 8u;
+        const __m256i m = _mm256_cmpgt_epi32(_mm256_set1_epi32((int32_t)r), lane);
+        const __m256i px = _mm256_loadu_si256((const __m256i *)(const void *)(hx + k));
+        const __m256i py = _mm256_loadu_si256((const __m256i *)(const void *)(hy + k));
+        const __m256i pz = _mm256_loadu_si256((const __m256i *)(const void *)(hz + k));
+        const __m256i tx = _mm256_and_si256(px, wmask);
+        const __m256i ty = _mm256_and_si256(py, wmask);
+        const __m256i tz = _mm256_and_si256(pz, wmask);
+        const __m256i base = _mm256_add_epi32(
+            _mm256_add_epi32(_mm256_srli_epi32(px, SC_W_BITS),
+                             _mm256_mullo_epi32(_mm256_srli_epi32(py, SC_W_BITS), vsy)),
+            _mm256_mullo_epi32(_mm256_srli_epi32(pz, SC_W_BITS), vsz));
+        const __m256i z = _mm256_setzero_si256();
+        const __m256i g00 = _mm256_mask_i32gather_epi32(z, vox, base, m, 1);
+        const __m256i g10 = _mm256_mask_i32gather_epi32(z, vox, _mm256_add_epi32(base, vsy), m, 1);
+        const __m256i g01 = _mm256_mask_i32gather_epi32(z, vox, _mm256_add_epi32(base, vsz), m, 1);
+        const __m256i g11 =
+            _mm256_mask_i32gather_epi32(z, vox, _mm256_add_epi32(base, vsyz2), m, 1);
+        const __m256i c00 = pair_level(g00, 0, tx), c10 = pair_level(g10, 0, tx);
+        const __m256i c01 = pair_level(g01, 0, tx), c11 = pair_level(g11, 16, tx);
+        const __m256i c0 = lerp(c00, c10, ty), c1 = lerp(c01, c11, ty);
+        const __m256i ifx = lerp(c0, c1, tz);
+        __m256i label;
+        if (labp != NULL) {
+            const __m256i li = _mm256_add_epi32(
+                _mm256_add_epi32(base, _mm256_srli_epi32(tx, SC_W_BITS - 1)),
+                _mm256_add_epi32(_mm256_and_si256(_mm256_cmpgt_epi32(ty, half), vsy),
+                                 _mm256_and_si256(_mm256_cmpgt_epi32(tz, half), vsz)));
+            const __m256i at = _mm256_max_epi32(_mm256_sub_epi32(li, three), z);
+            const __m256i g = _mm256_mask_i32gather_epi32(z, labp, at, m, 1);
+            label = _mm256_and_si256(
+                _mm256_srlv_epi32(g, _mm256_slli_epi32(_mm256_sub_epi32(li, at), 3)),
+                _mm256_set1_epi32(0xff));
+        } else {
+            label = _mm256_set1_epi32(SC_LABEL_MUSCLE);
+        }
+        const __m256i d_lo =
+            display4(_mm256_cvtepu32_epi64(_mm256_castsi256_si128(ifx)), la, lut_b_fx + k,
+                     _mm256_cvtepi32_epi64(_mm256_castsi256_si128(m)));
+        const __m256i d_hi =
+            display4(_mm256_cvtepu32_epi64(_mm256_extracti128_si256(ifx, 1)), la,
+                     lut_b_fx + k + 4, _mm256_cvtepi32_epi64(_mm256_extracti128_si256(m, 1)));
+        const __m256i sel = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
+        const __m256i disp = _mm256_blend_epi32(_mm256_permutevar8x32_epi32(d_lo, sel),
+                                                _mm256_permutevar8x32_epi32(d_hi, sel), 0xf0);
+        const __m256i shown = _mm256_andnot_si256(_mm256_cmpeq_epi32(label, outside), disp);
+        if (r == 8u) {
+            store_bytes(out + k, shown);
+            store_bytes(lab_out + k, label);
+        } else {
+            uint8_t t[16];
+            store_bytes(t, shown);
+            store_bytes(t + 8, label);
+            memcpy(out + k, t, r);
+            memcpy(lab_out + k, t + 8, r);
+        }
+    }
+}
 #else
 typedef int sc_bscan_kern_x86_64_v3_unused; /* ISO C: a translation unit is not empty */
 #endif

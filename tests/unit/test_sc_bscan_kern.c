@@ -106,6 +106,74 @@ static void test_variants_agree(void **state)
     assert_true(tried >= 1u);
 }
 
+/* The line sampler from position words (one call per line) against the span sampler on the
+ * same spans, and every variant's words and line sampler against the generic ones: random lines
+ * made of random spans (lengths 1..40, every direction, up to both ends of every axis). */
+static uint32_t g_h[3][N + 8];
+static uint32_t g_hv[3][N + 8];
+
+static void test_line_sampler_equals_span_sampler(void **state)
+{
+    (void)state;
+    fill();
+    const int64_t xm[3] = {((int64_t)(NX - 1) << 32) - 1 - SC_W_HALF,
+                           ((int64_t)(NY - 1) << 32) - 1 - SC_W_HALF,
+                           ((int64_t)(NZ - 1) << 32) - 1 - SC_W_HALF};
+    const sc_simd keep = sc_simd_selected();
+    const sc_simd best = sc_cpu_best_simd();
+    uint32_t lines = 0;
+    for (uint32_t it = 0; it < 600u; it++) {
+        const vol_regs v = {g_vox, it % 3u == 0u ? NULL : g_lab, NX, (size_t)NX * NY,
+                            it % 2u == 0u ? 65536 : 12 * 65536};
+        const uint32_t n = 1u + rnd() % N;
+        uint8_t o1[N], l1[N], o2[N], l2[N];
+        /* the reference: span by span */
+        uint32_t k = 0;
+        memset(g_h, 0, sizeof g_h);
+        while (k < n) {
+            uint32_t len = 1u + rnd() % 40u;
+            len = len > n - k ? n - k : len;
+            int64_t p0[3], p1[3], d[3];
+            for (int a = 0; a < 3; a++) {
+                p0[a] = pos(xm[a]);
+                p1[a] = pos(xm[a]);
+                d[a] = len > 1u ? (p1[a] - p0[a]) / (int64_t)(len - 1u) : 0;
+            }
+            sc_bscan_span_generic(v, g_lut, k, k + len, p0[0], p0[1], p0[2], d[0], d[1], d[2], o1,
+                                  l1);
+            sc_bscan_words_generic(g_h[0], g_h[1], g_h[2], k, k + len, p0[0], p0[1], p0[2], d[0],
+                                   d[1], d[2]);
+            for (int s = 0; s < (int)SC_SIMD_COUNT; s++) {
+                if (!sc_simd_built((sc_simd)s) || s > (int)best) {
+                    continue;
+                }
+                assert_int_equal(sc_simd_select((sc_simd)s), SC_OK);
+                memset(g_hv, 0xa5, sizeof g_hv);
+                sc_bscan_words_selected()(g_hv[0], g_hv[1], g_hv[2], k, k + len, p0[0], p0[1],
+                                          p0[2], d[0], d[1], d[2]);
+                for (int a = 0; a < 3; a++) {
+                    assert_memory_equal(&g_h[a][k], &g_hv[a][k], len * sizeof(uint32_t));
+                }
+            }
+            k += len;
+        }
+        for (int s = 0; s < (int)SC_SIMD_COUNT; s++) {
+            if (!sc_simd_built((sc_simd)s) || s > (int)best) {
+                continue;
+            }
+            assert_int_equal(sc_simd_select((sc_simd)s), SC_OK);
+            memset(o2, 0x5a, sizeof o2);
+            memset(l2, 0x5a, sizeof l2);
+            sc_bscan_line_selected()(v, g_lut, n, g_h[0], g_h[1], g_h[2], o2, l2);
+            assert_memory_equal(o1, o2, n);
+            assert_memory_equal(l1, l2, n);
+        }
+        lines++;
+    }
+    (void)sc_simd_select(keep);
+    assert_int_equal(lines, 600u);
+}
+
 /* The generic sampler against the formula: a voxel centre gives the voxel, the midpoint of two
  * gives their mean rounded, the label is the nearest voxel's. */
 static void test_generic_values(void **state)
@@ -138,6 +206,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_variants_agree),
+        cmocka_unit_test(test_line_sampler_equals_span_sampler),
         cmocka_unit_test(test_generic_values),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -7,6 +7,9 @@
  *                    the engine's contact case (bench_contact.c): a host-simulated engine
  *                    presses a built case (default neck-ijv from the build's cases folder) and
  *                    the deformed mesh at the deepest point of the press script is imaged
+ *        bench_bscan contact-walker [cases_dir] [case] [frames] [acoustics|no-acoustics]
+ *        bench_bscan contact-hold [cases_dir] [case] [frames]
+ *                    for callgrind: walker frames / whole engine frames (bench_contact.h)
  * Prints a table; run it from a Release build (build/release).
  */
 #define _POSIX_C_SOURCE 200809L
@@ -322,8 +325,22 @@ int main(int argc, char **argv)
     }
     if (argc > 1 && strcmp(argv[1], "contact-walker") == 0) {
         const int n = argc > 4 ? atoi(argv[4]) : 10;
+        const int acou = argc > 5 ? (strcmp(argv[5], "acoustics") == 0
+                                         ? 1
+                                         : (strcmp(argv[5], "no-acoustics") == 0 ? 0 : -2))
+                                  : -1;
+        if (acou == -2) {
+            fprintf(stderr, "bench_bscan: contact-walker: acoustics or no-acoustics, not %s\n",
+                    argv[5]);
+            return 2;
+        }
         return bench_contact_walker(argc > 2 ? argv[2] : SC_DEFAULT_CASES_DIR,
-                                    argc > 3 ? argv[3] : "neck-ijv", n > 0 ? n : 10);
+                                    argc > 3 ? argv[3] : "neck-ijv", n > 0 ? n : 10, acou);
+    }
+    if (argc > 1 && strcmp(argv[1], "contact-hold") == 0) {
+        const int n = argc > 4 ? atoi(argv[4]) : 10;
+        return bench_contact_hold(argc > 2 ? argv[2] : SC_DEFAULT_CASES_DIR,
+                                  argc > 3 ? argv[3] : "neck-ijv", n > 0 ? n : 10);
     }
     const char *dir = argc > 1 ? argv[1] : "bscan_png";
     const int frames = argc > 2 ? atoi(argv[2]) : 40;

@@ -259,10 +259,15 @@ __attribute__((noinline)) void bench_contact_walker_frames(int frames)
     }
 }
 
-int bench_contact_walker(const char *cases_dir, const char *case_name, int frames)
+int bench_contact_walker(const char *cases_dir, const char *case_name, int frames, int acoustics)
 {
     if (bench_contact_setup(cases_dir, case_name, -1, 8.0f, 2.0) != SC_OK) {
         return 1;
+    }
+    if (acoustics >= 0) { /* the acoustics as asked, else the engine's setting for the case */
+        sc_bscan_def d = g_rig.engine.bscan.def;
+        d.acoustics = (uint32_t)(acoustics != 0);
+        (void)sc_bscan_set_def(&g_rig.engine.bscan, &d);
     }
     const sc_engine *e = &g_rig.engine;
     const uint32_t rel0 = e->bscan.status.walk_relocations;
@@ -287,5 +292,40 @@ int bench_contact_walker(const char *cases_dir, const char *case_name, int frame
            "fold relocations %u per frame, image hash %08x, areas hash %08x\n",
            case_name, frames, e->bscan.def.mapper, e->bscan.def.acoustics,
            (e->bscan.status.walk_relocations - rel0) / (uint32_t)(frames > 0 ? frames : 1), h, ha);
+    return 0;
+}
+
+__attribute__((noinline)) void bench_contact_hold_frames(int frames)
+{
+    const uint64_t t0 = g_rig.clock.now_ns - (uint64_t)(1.55e9);
+    for (int i = 0; i < frames; i++) {
+        const uint64_t release = sc_engine_next_release_ns(&g_rig.engine);
+        (void)sc_emu_feed(&g_emu, release - t0, send_peer, &g_rig.peer);
+        sc_engine_step(&g_rig.engine, NULL);
+    }
+}
+
+int bench_contact_hold(const char *cases_dir, const char *case_name, int frames)
+{
+    if (bench_contact_setup(cases_dir, case_name, -1, 8.0f, 1.55) != SC_OK) {
+        return 1;
+    }
+    frames = frames > 50 ? 50 : frames; /* the hold at the bottom lasts to t = 2.45 s */
+    bench_contact_hold_frames(frames);
+    sc_engine_status st;
+    sc_engine_get_status(&g_rig.engine, &st);
+    /* the host simulator's display: every complete frame's image hash so far (folded) and the
+     * colour Doppler lines' hash: a change of the imaging code must keep them */
+    const sc_hs_display *hd = &g_rig.display;
+    uint64_t hi = 0;
+    for (uint32_t i = 0; i < hd->hash_count; i++) {
+        hi = (hi ^ hd->hashes[i]) * 0x100000001b3ull;
+    }
+    printf("contact-hold: %s, %d whole frames of the hold, contact %u, vein ratio %.4f, state hash "
+           "%016llx, images hash %016llx (%u frames), colour hash %016llx (%llu lines)\n",
+           case_name, frames, st.probe_contact, (double)st.vein_area_ratio,
+           (unsigned long long)sc_engine_state_hash(&g_rig.engine), (unsigned long long)hi,
+           hd->hash_count, (unsigned long long)hd->colour_hash,
+           (unsigned long long)hd->colour_lines);
     return 0;
 }

@@ -20,9 +20,19 @@ int bench_contact_run(const char *cases_dir, const char *case_name, int method, 
 /* For instruction counts: the engine's walker imaging (the engine's settings) of the deepest
  * point, `frames` times inside bench_contact_walker_frames, nothing else timed or run after it:
  *   valgrind --tool=callgrind --toggle-collect=bench_contact_walker_frames bench_bscan
- *   contact-walker CASES CASE N   (the collected instructions / N: one walker frame).
+ *   contact-walker CASES CASE N [acoustics|no-acoustics]   (the collected instructions / N:
+ *   one walker frame; the acoustics as the engine runs the case unless asked).
  * Returns 0, or 1 when the case cannot be loaded. */
-int bench_contact_walker(const char *cases_dir, const char *case_name, int frames);
+int bench_contact_walker(const char *cases_dir, const char *case_name, int frames, int acoustics);
 void bench_contact_walker_frames(int frames);
+
+/* For instruction counts of whole frames: the engine run to the hold at the bottom of the press
+ * (t = 1.55 s), then `frames` engine steps (rx + physics + imaging + status + state stream +
+ * control, the host simulator's display included) inside bench_contact_hold_frames:
+ *   valgrind --tool=callgrind --toggle-collect=bench_contact_hold_frames bench_bscan
+ *   contact-hold CASES CASE N   (the collected instructions / N: one whole frame).
+ * Prints the state hash after the frames. Returns 0, or 1 when the case cannot be loaded. */
+int bench_contact_hold(const char *cases_dir, const char *case_name, int frames);
+void bench_contact_hold_frames(int frames);
 
 #endif
