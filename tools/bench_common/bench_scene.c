@@ -2,10 +2,12 @@
 #include "bench_scene.h"
 
 #include <errno.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
+#include "sc_cpu.h"
 #include "sc_err.h"
 #include "sc_labels.h"
 #include "sc_material.h"
@@ -15,6 +17,15 @@ const char *const bench_method_name[BENCH_METHODS] = {"msds", "fem", "corot"};
 
 const uint32_t bench_default_mesh[BENCH_DEFAULT_MESHES][3] = {
     {20, 10, 10}, {24, 12, 12}, {28, 14, 14}, {32, 16, 16}, {48, 24, 24}, {64, 32, 32}};
+
+void bench_select_kernels(const char *prog)
+{
+    if (sc_cpu_select_simd() != SC_OK) {
+        fprintf(stderr, "%s: SONOCOMP_SIMD not available here, using %s\n", prog,
+                sc_simd_name(sc_simd_selected()));
+    }
+    printf("kernels: %s\n", sc_simd_name(sc_simd_selected()));
+}
 
 static uint64_t clock_ns(clockid_t id)
 {

@@ -40,6 +40,10 @@ int bench_opts_parse(bench_opts *o, const char *a, const char *v);
 #define BENCH_DEFAULT_MESHES 6
 extern const uint32_t bench_default_mesh[BENCH_DEFAULT_MESHES][3];
 
+/* Select the kernel variant as sonocomp does (platform/linux/sc_cpu.h: the best this CPU runs,
+ * or SONOCOMP_SIMD) and print it ("kernels: NAME"); prog names the program in a refusal. */
+void bench_select_kernels(const char *prog);
+
 /* clocks, ns: CLOCK_MONOTONIC, the process's and the calling thread's CPU time */
 uint64_t bench_now_ns(void);
 uint64_t bench_cpu_ns(void);

@@ -667,6 +667,7 @@ int main(int argc, char **argv)
     if (prc != 0) {
         return prc;
     }
+    bench_select_kernels("bench-paper"); /* the engine's variant, as sonocomp selects it */
     if (mkparent(o.csv) != 0) {
         fprintf(stderr, "bench-paper: cannot create the folder of %s\n", o.csv);
         return 1;
