@@ -339,6 +339,7 @@ static int rigid_motions_pinned(const sc_grid *g)
  * every node's values its own (the serial loops' bits); the loaded test is an OR per range and
  * the solution's sum of squares is summed per SC_GRID_SUM_BLOCK nodes and added in block order
  * (one block up to 32x16x16: the serial sum). */
+#define SC_GRID_NODE_RANGES ((SC_MAX_NODES + SC_GRID_POOL_RANGE - 1u) / SC_GRID_POOL_RANGE)
 typedef struct step_job {
     sc_grid *g;
     const sc_mesh *m;
@@ -347,7 +348,7 @@ typedef struct step_job {
     const uint8_t *kinematic;
     float dt, dta, warm, pull, cm, ck;
     int release;
-    uint8_t loaded[(SC_MAX_NODES + SC_GRID_POOL_RANGE - 1u) / SC_GRID_POOL_RANGE];
+    uint8_t loaded[SC_GRID_NODE_RANGES];
     float vsum[SC_GRID_SUM_BLOCKS];
 } step_job;
 
@@ -452,7 +453,7 @@ void sc_grid_begin(sc_grid *g, const sc_mesh *m, const sc_nodes *n, float dt_s, 
      * the flags) */
     sc_pool_run(g->pool, job_loaded, &j, ranges);
     int loaded = 0;
-    for (uint32_t r = 0; r < ranges; r++) {
+    for (uint32_t r = 0; r < ranges && r < SC_GRID_NODE_RANGES; r++) {
         loaded |= j.loaded[r];
     }
     sc_pool_run(g->pool, job_flags, &j, ranges);
@@ -554,7 +555,7 @@ int sc_grid_solve(sc_grid *g, sc_nodes *n, float dt_s, float beta_s, float alpha
     const uint32_t blocks = job_ranges(g, SC_GRID_SUM_BLOCK);
     sc_pool_run(g->pool, job_vsum, &j, blocks);
     float vsum = j.vsum[0];
-    for (uint32_t b = 1; b < blocks; b++) {
+    for (uint32_t b = 1; b < blocks && b < SC_GRID_SUM_BLOCKS; b++) {
         vsum += j.vsum[b];
     }
     if (!isfinite(vsum)) {
