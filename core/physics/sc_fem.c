@@ -217,6 +217,47 @@ void sc_fem_step(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s, uint32_t 
     sc_fem_step_kinematic(f, m, n, dt_s, cg_iterations, NULL);
 }
 
+/* the linear step's r0 loops over a range of SC_GRID_POOL_RANGE nodes */
+typedef struct r0_job {
+    sc_grid *g;
+    float dt, ck;
+} r0_job;
+
+static void r0_span(const sc_grid *g, uint32_t r, uint32_t *i0, uint32_t *i1)
+{
+    const uint32_t h = SC_GRID_HEAD, end = h + g->node_end;
+    *i0 = h + r * SC_GRID_POOL_RANGE;
+    *i1 = *i0 + SC_GRID_POOL_RANGE < end ? *i0 + SC_GRID_POOL_RANGE : end;
+}
+
+/* p = dt (x - X) + ck v0 */
+static void job_r0_p(void *arg, uint32_t r)
+{
+    const r0_job *j = (const r0_job *)arg;
+    sc_grid *g = j->g;
+    uint32_t i0, i1;
+    r0_span(g, r, &i0, &i1);
+    for (uint32_t c = 0; c < 3u; c++) {
+        for (uint32_t i = i0; i < i1; i++) {
+            g->p[c][i] = j->dt * (g->x[c][i] - g->x0[c][i]) + j->ck * g->v[c][i];
+        }
+    }
+}
+
+/* r -= q */
+static void job_r0_r(void *arg, uint32_t r)
+{
+    const r0_job *j = (const r0_job *)arg;
+    sc_grid *g = j->g;
+    uint32_t i0, i1;
+    r0_span(g, r, &i0, &i1);
+    for (uint32_t c = 0; c < 3u; c++) {
+        for (uint32_t i = i0; i < i1; i++) {
+            g->r[c][i] -= g->q[c][i];
+        }
+    }
+}
+
 void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
                            uint32_t cg_iterations, const uint8_t *kinematic)
 {
@@ -232,19 +273,13 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
     const int corotated = f->def.corotated != 0u;
     const sc_grid_fem_in in = element_in(f, corotated);
     if (!corotated && f->rest_k && k->fem_below(g, &in) == 0u) {
-        /* linear, the rest K in place: r -= K (dt (x - X) + ck v0), one mat-vec */
-        const uint32_t h = SC_GRID_HEAD, end = h + g->node_end;
-        for (uint32_t c = 0; c < 3u; c++) {
-            for (uint32_t i = h; i < end; i++) {
-                g->p[c][i] = dt_s * (g->x[c][i] - g->x0[c][i]) + ck * g->v[c][i];
-            }
-        }
+        /* linear, the rest K in place: r -= K (dt (x - X) + ck v0), one mat-vec; the
+         * element-wise loops and the mat-vec on the pool (every node its own: the same bits) */
+        r0_job j = {g, dt_s, ck};
+        const uint32_t ranges = (g->node_end + SC_GRID_POOL_RANGE - 1u) / SC_GRID_POOL_RANGE;
+        sc_pool_run(g->pool, job_r0_p, &j, ranges);
         k->matvec(g, 0.0f, 1.0f);
-        for (uint32_t c = 0; c < 3u; c++) {
-            for (uint32_t i = h; i < end; i++) {
-                g->r[c][i] -= g->q[c][i];
-            }
-        }
+        sc_pool_run(g->pool, job_r0_r, &j, ranges);
         f->stats.degenerate_tets = 0u;
     } else {
         sc_grid_clear(g, SC_GRID_CLEAR_DIAG | SC_GRID_CLEAR_BLOCKS);

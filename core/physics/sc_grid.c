@@ -335,31 +335,63 @@ static int rigid_motions_pinned(const sc_grid *g)
     return 1;
 }
 
-void sc_grid_begin(sc_grid *g, const sc_mesh *m, const sc_nodes *n, float dt_s, float beta_s,
-                   float alpha_per_s, const uint8_t *kinematic)
+/* The step's node loops on the worker pool (sc_grid.h): ranges of SC_GRID_POOL_RANGE nodes,
+ * every node's values its own (the serial loops' bits); the loaded test is an OR per range and
+ * the solution's sum of squares is summed per SC_GRID_SUM_BLOCK nodes and added in block order
+ * (one block up to 32x16x16: the serial sum). */
+#define SC_GRID_NODE_RANGES ((SC_MAX_NODES + SC_GRID_POOL_RANGE - 1u) / SC_GRID_POOL_RANGE)
+typedef struct step_job {
+    sc_grid *g;
+    const sc_mesh *m;
+    const sc_nodes *n;
+    sc_nodes *out;
+    const uint8_t *kinematic;
+    float dt, dta, warm, pull, cm, ck;
+    int release;
+    uint8_t loaded[SC_GRID_NODE_RANGES];
+    float vsum[SC_GRID_SUM_BLOCKS];
+} step_job;
+
+static uint32_t job_ranges(const sc_grid *g, uint32_t size)
 {
-    SC_ASSERT(g != NULL && m != NULL && n != NULL && g->node_count == m->node_count);
-    SC_ASSERT(isfinite(dt_s) && dt_s > 0.0f && isfinite(beta_s) && beta_s >= 0.0f &&
-              isfinite(alpha_per_s) && alpha_per_s >= 0.0f);
-    const uint32_t nn = g->node_count, h = SC_GRID_HEAD;
-    const float dta = dt_s * alpha_per_s;
-    /* unloaded: no kinematic node and no external force (the probe is off the skin); the release
-     * warm start needs the rest state to be the only unloaded equilibrium (checked below, after
-     * the flags) */
+    return (g->node_count + size - 1u) / size;
+}
+
+static void job_span(const step_job *j, uint32_t r, uint32_t size, uint32_t *i0, uint32_t *i1)
+{
+    *i0 = r * size;
+    *i1 = *i0 + size < j->g->node_count ? *i0 + size : j->g->node_count;
+}
+
+/* loaded: a kinematic node or an external force that does not vanish at rest */
+static void job_loaded(void *arg, uint32_t r)
+{
+    step_job *j = (step_job *)arg;
+    uint32_t i0, i1;
+    job_span(j, r, SC_GRID_POOL_RANGE, &i0, &i1);
+    const sc_nodes *n = j->n;
     int loaded = 0;
-    for (uint32_t i = 0; i < nn && !loaded; i++) {
-        loaded = (kinematic != NULL && kinematic[i] != 0u) ||
-                 (g->forces_vanish_at_rest == 0u &&
+    for (uint32_t i = i0; i < i1 && !loaded; i++) {
+        loaded = (j->kinematic != NULL && j->kinematic[i] != 0u) ||
+                 (j->g->forces_vanish_at_rest == 0u &&
                   (nonzero(n->fx[i]) || nonzero(n->fy[i]) || nonzero(n->fz[i])));
     }
-    const float warm = beta_s / (beta_s + dt_s);
-    const float pull = -1.0f / (beta_s + dt_s);
-    for (uint32_t i = 0; i < nn; i++) {
+    j->loaded[r] = (uint8_t)loaded;
+}
+
+static void job_flags(void *arg, uint32_t r)
+{
+    step_job *j = (step_job *)arg;
+    sc_grid *g = j->g;
+    uint32_t i0, i1;
+    job_span(j, r, SC_GRID_POOL_RANGE, &i0, &i1);
+    const uint32_t h = SC_GRID_HEAD;
+    for (uint32_t i = i0; i < i1; i++) {
         uint8_t con = 0u;
-        const uint8_t fixed = m->node_fixed[i];
+        const uint8_t fixed = j->m->node_fixed[i];
         if (fixed == SC_MESH_FIXED_ALL || g->used[i] == 0u) {
             con = 1u;
-        } else if (kinematic != NULL && kinematic[i] != 0u) {
+        } else if (j->kinematic != NULL && j->kinematic[i] != 0u) {
             con = 2u;
         } else if (fixed != 0u) {
             const uint32_t axes = SC_MESH_ROLLER_X | SC_MESH_ROLLER_Y | SC_MESH_ROLLER_Z;
@@ -367,12 +399,20 @@ void sc_grid_begin(sc_grid *g, const sc_mesh *m, const sc_nodes *n, float dt_s, 
         }
         g->con[h + i] = con;
     }
-    const int release = !loaded && rigid_motions_pinned(g);
-    g->stats.unloaded_steps += release ? 1u : 0u;
+}
+
+static void job_start(void *arg, uint32_t r)
+{
+    step_job *j = (step_job *)arg;
+    sc_grid *g = j->g;
+    const sc_nodes *n = j->n;
+    uint32_t i0, i1;
+    job_span(j, r, SC_GRID_POOL_RANGE, &i0, &i1);
+    const uint32_t h = SC_GRID_HEAD;
     const float *const nv[3] = {n->vx, n->vy, n->vz};
     const float *const nx[3] = {n->x, n->y, n->z};
     const float *const nf[3] = {n->fx, n->fy, n->fz};
-    for (uint32_t i = 0; i < nn; i++) {
+    for (uint32_t i = i0; i < i1; i++) {
         const uint8_t con = g->con[h + i];
         for (uint32_t c = 0; c < 3u; c++) {
             const float xc = nx[c][i];
@@ -382,12 +422,44 @@ void sc_grid_begin(sc_grid *g, const sc_mesh *m, const sc_nodes *n, float dt_s, 
             if (con == 2u) {
                 v0 = nv[c][i]; /* kinematic: moves with its velocity */
             } else if (!held) {
-                v0 = release ? pull * (xc - g->x0[c][h + i]) : warm * nv[c][i];
+                v0 = j->release ? j->pull * (xc - g->x0[c][h + i]) : j->warm * nv[c][i];
             }
             g->v[c][h + i] = v0;
-            g->r[c][h + i] = dt_s * nf[c][i] - dta * g->mass[h + i] * v0;
+            g->r[c][h + i] = j->dt * nf[c][i] - j->dta * g->mass[h + i] * v0;
         }
     }
+}
+
+void sc_grid_begin(sc_grid *g, const sc_mesh *m, const sc_nodes *n, float dt_s, float beta_s,
+                   float alpha_per_s, const uint8_t *kinematic)
+{
+    SC_ASSERT(g != NULL && m != NULL && n != NULL && g->node_count == m->node_count);
+    SC_ASSERT(isfinite(dt_s) && dt_s > 0.0f && isfinite(beta_s) && beta_s >= 0.0f &&
+              isfinite(alpha_per_s) && alpha_per_s >= 0.0f);
+    step_job j;
+    j.g = g;
+    j.m = m;
+    j.n = n;
+    j.out = NULL;
+    j.kinematic = kinematic;
+    j.dt = dt_s;
+    j.dta = dt_s * alpha_per_s;
+    j.warm = beta_s / (beta_s + dt_s);
+    j.pull = -1.0f / (beta_s + dt_s);
+    j.cm = j.ck = 0.0f;
+    const uint32_t ranges = job_ranges(g, SC_GRID_POOL_RANGE);
+    /* unloaded: no kinematic node and no external force (the probe is off the skin); the release
+     * warm start needs the rest state to be the only unloaded equilibrium (checked below, after
+     * the flags) */
+    sc_pool_run(g->pool, job_loaded, &j, ranges);
+    int loaded = 0;
+    for (uint32_t r = 0; r < ranges && r < SC_GRID_NODE_RANGES; r++) {
+        loaded |= j.loaded[r];
+    }
+    sc_pool_run(g->pool, job_flags, &j, ranges);
+    j.release = !loaded && rigid_motions_pinned(g);
+    g->stats.unloaded_steps += j.release ? 1u : 0u;
+    sc_pool_run(g->pool, job_start, &j, ranges);
 }
 
 void sc_grid_clear(sc_grid *g, uint32_t which)
@@ -403,48 +475,94 @@ void sc_grid_clear(sc_grid *g, uint32_t which)
     }
 }
 
+static void job_precond(void *arg, uint32_t r)
+{
+    step_job *j = (step_job *)arg;
+    sc_grid *g = j->g;
+    uint32_t i0, i1;
+    job_span(j, r, SC_GRID_POOL_RANGE, &i0, &i1);
+    const uint32_t h = SC_GRID_HEAD;
+    static const uint32_t diag_entry[3] = {0u, 3u, 5u};
+    for (uint32_t i = i0; i < i1; i++) {
+        const uint8_t con = g->con[h + i];
+        for (uint32_t c = 0; c < 3u; c++) {
+            const float a = j->cm * g->mass[h + i] + j->ck * g->d[diag_entry[c]][h + i];
+            const int free_dof = con == 0u || (con >= 0x80u && (con & (2u << c)) == 0u);
+            g->pc[c][h + i] = (free_dof && a > 0.0f) ? 1.0f / a : 0.0f;
+        }
+    }
+}
+
+/* the solution's sum of squares over a block, components then nodes (the serial loop's order) */
+static void job_vsum(void *arg, uint32_t b)
+{
+    step_job *j = (step_job *)arg;
+    const sc_grid *g = j->g;
+    uint32_t i0, i1;
+    job_span(j, b, SC_GRID_SUM_BLOCK, &i0, &i1);
+    const uint32_t h = SC_GRID_HEAD;
+    float vsum = 0.0f;
+    for (uint32_t c = 0; c < 3u; c++) {
+        for (uint32_t i = i0; i < i1; i++) {
+            vsum += g->v[c][h + i] * g->v[c][h + i];
+        }
+    }
+    j->vsum[b] = vsum;
+}
+
+static void job_finish(void *arg, uint32_t r)
+{
+    step_job *j = (step_job *)arg;
+    const sc_grid *g = j->g;
+    uint32_t i0, i1;
+    job_span(j, r, SC_GRID_POOL_RANGE, &i0, &i1);
+    const uint32_t h = SC_GRID_HEAD;
+    float *const nv[3] = {j->out->vx, j->out->vy, j->out->vz};
+    float *const nx[3] = {j->out->x, j->out->y, j->out->z};
+    for (uint32_t c = 0; c < 3u; c++) {
+        for (uint32_t i = i0; i < i1; i++) {
+            const float v = g->v[c][h + i];
+            nv[c][i] = v;
+            nx[c][i] = g->x[c][h + i] + j->dt * v;
+        }
+    }
+}
+
 int sc_grid_solve(sc_grid *g, sc_nodes *n, float dt_s, float beta_s, float alpha_per_s,
                   uint32_t cg_iterations)
 {
     SC_ASSERT(g != NULL && n != NULL);
     SC_ASSERT(cg_iterations >= 1u && cg_iterations <= SC_PHYS_ITERATIONS_MAX);
-    const uint32_t nn = g->node_count, h = SC_GRID_HEAD;
     const float cm = 1.0f + dt_s * alpha_per_s;
     const float ck = dt_s * beta_s + dt_s * dt_s;
+    step_job j;
+    j.g = g;
+    j.m = NULL;
+    j.n = NULL;
+    j.out = n;
+    j.kinematic = NULL;
+    j.dt = dt_s;
+    j.cm = cm;
+    j.ck = ck;
+    const uint32_t ranges = job_ranges(g, SC_GRID_POOL_RANGE);
     /* Jacobi preconditioner, zero on Dirichlet DOFs (projects the CG onto the free DOFs) */
-    static const uint32_t diag_entry[3] = {0u, 3u, 5u};
-    for (uint32_t i = 0; i < nn; i++) {
-        const uint8_t con = g->con[h + i];
-        for (uint32_t c = 0; c < 3u; c++) {
-            const float a = cm * g->mass[h + i] + ck * g->d[diag_entry[c]][h + i];
-            const int free_dof = con == 0u || (con >= 0x80u && (con & (2u << c)) == 0u);
-            g->pc[c][h + i] = (free_dof && a > 0.0f) ? 1.0f / a : 0.0f;
-        }
-    }
+    sc_pool_run(g->pool, job_precond, &j, ranges);
     sc_grid_cg_out out;
     sc_grid_kern_selected()->cg(g, cm, ck, cg_iterations, &out);
     g->stats.cg_iterations_run = out.iterations;
     g->stats.residual_ratio = (out.rz0 > 0.0f && out.rz >= 0.0f) ? sqrtf(out.rz / out.rz0) : 0.0f;
     /* refuse a non-finite solution: the shared state stays as it was */
-    float vsum = 0.0f;
-    for (uint32_t c = 0; c < 3u; c++) {
-        for (uint32_t i = 0; i < nn; i++) {
-            vsum += g->v[c][h + i] * g->v[c][h + i];
-        }
+    const uint32_t blocks = job_ranges(g, SC_GRID_SUM_BLOCK);
+    sc_pool_run(g->pool, job_vsum, &j, blocks);
+    float vsum = j.vsum[0];
+    for (uint32_t b = 1; b < blocks && b < SC_GRID_SUM_BLOCKS; b++) {
+        vsum += j.vsum[b];
     }
     if (!isfinite(vsum)) {
         g->stats.unstable_steps++;
         return SC_ERR_PHYS_UNSTABLE;
     }
-    float *const nv[3] = {n->vx, n->vy, n->vz};
-    float *const nx[3] = {n->x, n->y, n->z};
-    for (uint32_t c = 0; c < 3u; c++) {
-        for (uint32_t i = 0; i < nn; i++) {
-            const float v = g->v[c][h + i];
-            nv[c][i] = v;
-            nx[c][i] = g->x[c][h + i] + dt_s * v;
-        }
-    }
+    sc_pool_run(g->pool, job_finish, &j, ranges);
     return SC_OK;
 }
 

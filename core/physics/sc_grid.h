@@ -99,6 +99,16 @@ _Static_assert((SC_GRID_ROW / 16u) % 2u == 1u, "row stride an odd multiple of 16
 _Static_assert(SC_GRID_POOL_RANGE % SC_GRID_CHUNK == 0u && SC_GRID_SUM_BLOCK % 16u == 0u,
                "pool ranges and sum blocks are whole chunks and whole partial-sum groups");
 
+/* The cell passes (FEM assembly, the MSDS's volume terms) on the worker pool: the cell origins
+ * are cut into ranges of SC_GRID_ASM_SPAN origins (whole cell blocks), each with its own block
+ * buffer; the even ranges run first (at the same time: two ranges apart, their corner sets do not
+ * meet, since SC_GRID_ASM_SPAN > nx ny + nx + SC_GRID_CELL_BLOCK), then the odd ones. A node on
+ * the seam after an odd range takes the next (even) range's sums before the odd one's, so that
+ * order is part of what makes a state hash, the number of workers is not; a mesh of one range
+ * (cell origins up to SC_GRID_ASM_SPAN: up to 32x16x16) sums exactly as the serial loop did. */
+#define SC_GRID_ASM_SPAN 8192u
+#define SC_GRID_ASM_RANGES ((SC_MAX_NODES + SC_GRID_ASM_SPAN - 1u) / SC_GRID_ASM_SPAN)
+
 /* cells per assembly block (a multiple of every variant's vector width); part of what makes
  * a state hash, so it is the same on every target (the MCU's SRAM sets it: the buffer is
  * 234 x 16 floats, 15 KB; 32 measured no faster on x86-64) */
@@ -108,6 +118,10 @@ _Static_assert(SC_GRID_POOL_RANGE % SC_GRID_CHUNK == 0u && SC_GRID_SUM_BLOCK % 1
 /* buffer rows of a cell: 8 template corners x (6 diagonal + 3 residual), then the 18 template
  * edge slots x 9 */
 #define SC_GRID_BUF_ROWS (8u * 9u + 18u * 9u)
+_Static_assert(SC_GRID_ASM_SPAN % SC_GRID_CELL_BLOCK == 0u &&
+                   SC_GRID_ASM_SPAN > SC_MAX_MESH_NX * SC_MAX_MESH_NY + SC_MAX_MESH_NX +
+                                          SC_GRID_CELL_BLOCK,
+               "assembly ranges are whole cell blocks, and two ranges apart write apart");
 
 /* what a target of a cell is, where it lives and where its block comes from (sc_grid_init) */
 typedef struct sc_grid_target {
@@ -152,7 +166,8 @@ typedef struct sc_grid {
      * (lumen pressures, sc_lumen.h): they do not keep the release warm start off (the owner
      * sets it before sc_grid_begin; 0 after sc_grid_init) */
     uint8_t forces_vanish_at_rest;
-    const sc_pool_dev *pool; /* workers of the CG (NULL: serial); sc_grid_init sets NULL */
+    const sc_pool_dev *pool; /* workers of the CG and the assembly (NULL: serial); sc_grid_init
+                              * sets NULL */
 
     /* ---- hot: matrix rows (node t at SC_GRID_HEAD + t) ---- */
     SC_ALIGN_HOT float d[6][SC_GRID_ROW];
@@ -173,8 +188,9 @@ typedef struct sc_grid {
     SC_ALIGN_HOT int32_t cell_ok[SC_GRID_ROW];  /* -1: a cell has this origin */
     uint8_t con[SC_GRID_ROW]; /* this step: 1 fixed, 2 kinematic, 0 free, 0x80 | roller bits */
     uint8_t used[SC_MAX_NODES]; /* node belongs to at least one tet */
-    /* ---- scratch of the cell kernels: one block of cells, rows of SC_GRID_CELL_BLOCK ---- */
-    SC_ALIGN_HOT float buf[SC_GRID_BUF_ROWS][SC_GRID_CELL_BLOCK];
+    /* ---- scratch of the cell kernels: one block of cells per assembly range, rows of
+     * SC_GRID_CELL_BLOCK (one range, 15 KB, on the MCU's limits) ---- */
+    SC_ALIGN_HOT float buf[SC_GRID_ASM_RANGES][SC_GRID_BUF_ROWS][SC_GRID_CELL_BLOCK];
 } sc_grid;
 
 /* The FEM's element data for the cell kernel (sc_fem.c fills it at init). Tet q of the cell with

@@ -2,7 +2,10 @@
  * for every worker count. The host simulator's pool (platform/hostsim/sc_hs_pool.h) runs the
  * ranges a pool of W workers hands out, worker by worker, the last worker first: a job whose
  * result depended on which worker ran which range, or on their order, changes the hash. The
- * mesh, 40 x 16 x 16 nodes (10,240), has two of the CG's sum blocks and ten mat-vec ranges. */
+ * mesh, 40 x 16 x 16 nodes (10,240), has two of the CG's sum blocks and ten mat-vec ranges, and
+ * two ranges of the cell passes (sc_grid.h: SC_GRID_ASM_SPAN); 40 x 16 x 28 (17,920 nodes) has
+ * three, so a seam where the even range's sums come before the odd one's. The springs' passes
+ * run on the pool at every size. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -26,13 +29,15 @@ typedef enum run_kind { RUN_MSDS, RUN_FEM, RUN_FEM_COROTATED, RUN_KINDS } run_ki
 
 /* a press and a lift on the scene, `workers` 0: no pool (NULL), else the host pool of that
  * many workers; returns the state hash and the ranges the pool ran */
+static uint32_t g_nz = 16u; /* the mesh is 40 x 16 x g_nz */
+
 static uint64_t scripted_run_on(run_kind kind, uint32_t workers, const sc_pool_dev *thread_pool,
                                 uint64_t *ranges_run)
 {
     sc_test_scene_params p = sc_test_scene_default_params();
     p.nx = 40u;
     p.ny = 16u;
-    p.nz = 16u;
+    p.nz = g_nz;
     sc_test_scene_build(&g_scene, &p);
     sc_tissue_def d =
         sc_test_scene_tissue_def(&g_scene, kind == RUN_MSDS ? SC_TISSUE_MSDS : SC_TISSUE_FEM);
@@ -80,6 +85,32 @@ static void state_hash_is_the_same_for_1_2_3_and_4_workers(void **state)
             assert_true(ranges > 0u); /* the solver did go through the pool */
             assert_true(h == serial);
         }
+    }
+}
+
+/* Three ranges of the cell passes (40 x 16 x 28): 1, 2 and 4 host-pool workers give the serial
+ * hash; the pool runs more ranges than on the smaller mesh (the cell passes' and the springs'
+ * jobs scale with the mesh). */
+static void three_cell_ranges_give_the_same_hash_for_1_2_and_4_workers(void **state)
+{
+    (void)state;
+    static const char *const names[RUN_KINDS] = {"MSDS", "FEM linear", "FEM corotated"};
+    for (int k = 0; k < (int)RUN_KINDS; k++) {
+        uint64_t ranges = 0u, small_ranges = 0u;
+        g_nz = 16u;
+        (void)scripted_run((run_kind)k, 1u, &small_ranges);
+        g_nz = 28u;
+        const uint64_t serial = scripted_run((run_kind)k, 0u, &ranges);
+        for (uint32_t w = 1u; w <= 4u; w *= 2u) {
+            const uint64_t h = scripted_run((run_kind)k, w, &ranges);
+            print_message("%s 40x16x28, %u worker(s): state hash %016llx (%llu ranges; 40x16x16: "
+                          "%llu)\n",
+                          names[k], (unsigned)w, (unsigned long long)h, (unsigned long long)ranges,
+                          (unsigned long long)small_ranges);
+            assert_true(ranges > small_ranges);
+            assert_true(h == serial);
+        }
+        g_nz = 16u;
     }
 }
 
@@ -135,6 +166,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(host_pool_runs_every_range_once),
         cmocka_unit_test(state_hash_is_the_same_for_1_2_3_and_4_workers),
+        cmocka_unit_test(three_cell_ranges_give_the_same_hash_for_1_2_and_4_workers),
         cmocka_unit_test(linux_pool_threads_give_the_serial_state_hash),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -45,6 +45,7 @@
 
 #include "bench_bullet.h"
 #include "bench_chart.h"
+#include "bench_scene.h"
 #include "sc_bscan.h"
 #include "sc_collider.h"
 #include "sc_err.h"
@@ -55,24 +56,22 @@
 #include "sc_tissue.h"
 #include "sc_udp_display.h"
 
-#define MAX_LIST    8
-#define MAX_FRAMES  1000
-#define MAX_REPEATS 50
-
 static sc_tissue g_t;
 static sc_test_scene g_scene;
 static sc_bscan g_bscan;
 
-typedef enum method { M_MSDS = 0, M_FEM, M_COROT, M_COUNT, M_BULLET = M_COUNT } method;
+/* the solvers of bench_scene.h, then Bullet */
+typedef enum method {
+    M_MSDS = BENCH_MSDS,
+    M_FEM = BENCH_FEM,
+    M_COROT = BENCH_COROT,
+    M_COUNT = BENCH_METHODS,
+    M_BULLET = M_COUNT
+} method;
 static const char *const k_method_name[M_COUNT + 1] = {"msds", "fem", "corot", "bullet"};
 
 typedef struct opts {
-    int frames, repeats;
-    uint32_t workers[MAX_LIST];
-    int nworkers;
-    uint32_t mesh[MAX_LIST][3];
-    int nmesh;
-    int method_on[M_COUNT];
+    bench_opts b;
     int bullet;
     const char *sink; /* "png", "none", "udp:HOST:PORT" */
     const char *png_dir, *csv, *png, *png_cpu;
@@ -88,55 +87,7 @@ typedef struct row {
     uint64_t hash;
 } row;
 
-static row g_rows[MAX_LIST][M_COUNT + 1][MAX_LIST]; /* mesh, method, workers index */
-
-static uint64_t now_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
-}
-
-static uint64_t cpu_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
-}
-
-/* the calling thread's CPU time: the B-scan runs on the frame thread alone */
-static uint64_t thread_cpu_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
-}
-
-static int cmp_u64(const void *a, const void *b)
-{
-    const uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return (x > y) - (x < y);
-}
-
-static int cmp_d(const void *a, const void *b)
-{
-    const double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* median in ms of n nanosecond samples (sorts v) */
-static double median_ms(uint64_t *v, int n)
-{
-    qsort(v, (size_t)n, sizeof v[0], cmp_u64);
-    return (n % 2) ? (double)v[n / 2] / 1e6 : (double)(v[n / 2 - 1] + v[n / 2]) / 2e6;
-}
-
-/* median of n doubles (sorts v) */
-static double median_d(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof v[0], cmp_d);
-    return (n % 2) ? v[n / 2] : (v[n / 2 - 1] + v[n / 2]) / 2.0;
-}
+static row g_rows[BENCH_MAX_LIST][M_COUNT + 1][BENCH_MAX_LIST]; /* mesh, method, workers index */
 
 static int usage(void)
 {
@@ -145,17 +96,6 @@ static int usage(void)
             "[--meshes 20x10x10,...] [--methods msds,fem,corot] [--sink png|none|udp:HOST:PORT] "
             "[--png-dir DIR] [--bullet on|off] [--csv FILE] [--png FILE] [--png-cpu FILE]\n");
     return 2;
-}
-
-static int parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out, char **end)
-{
-    errno = 0;
-    const unsigned long v = strtoul(s, end, 10);
-    if (errno || *end == s || s[0] == '-' || s[0] == '+' || s[0] == ' ' || v < lo || v > hi) {
-        return -1;
-    }
-    *out = (uint32_t)v;
-    return 0;
 }
 
 /* "udp:HOST:PORT" -> host (into buf) and port; 0 or -1 */
@@ -170,7 +110,7 @@ static int parse_udp(const char *s, char *host, size_t hostn, uint16_t *port)
     }
     char *end = NULL;
     uint32_t p;
-    if (parse_u32(colon + 1, 1u, 65535u, &p, &end) || *end) {
+    if (bench_parse_u32(colon + 1, 1u, 65535u, &p, &end) || *end) {
         return -1;
     }
     memcpy(host, h, (size_t)(colon - h));
@@ -182,18 +122,8 @@ static int parse_udp(const char *s, char *host, size_t hostn, uint16_t *port)
 static int parse_args(int argc, char **argv, opts *o)
 {
     memset(o, 0, sizeof *o);
-    o->frames = 20;
-    o->repeats = 5;
-    o->workers[0] = 1u;
-    o->workers[1] = 2u;
-    o->nworkers = 2;
-    static const uint32_t def_mesh[6][3] = {{20, 10, 10}, {24, 12, 12}, {28, 14, 14},
-                                            {32, 16, 16}, {48, 24, 24}, {64, 32, 32}};
-    for (int i = 0; i < 6; i++) {
-        memcpy(o->mesh[i], def_mesh[i], sizeof def_mesh[i]);
-    }
-    o->nmesh = 6;
-    o->method_on[M_MSDS] = o->method_on[M_FEM] = 1;
+    static const int msds_fem[BENCH_METHODS] = {1, 1, 0};
+    bench_opts_default(&o->b, 20, msds_fem);
     o->bullet = 1;
     o->sink = "png";
     o->png_dir = "out/bench-paper/frames";
@@ -206,70 +136,14 @@ static int parse_args(int argc, char **argv, opts *o)
             return usage();
         }
         const char *v = argv[++i];
-        char *end = NULL;
-        uint32_t u;
-        if (strcmp(a, "--frames") == 0) {
-            if (parse_u32(v, 1u, MAX_FRAMES, &u, &end) || *end) {
-                return usage();
-            }
-            o->frames = (int)u;
-        } else if (strcmp(a, "--repeats") == 0) {
-            if (parse_u32(v, 1u, MAX_REPEATS, &u, &end) || *end) {
-                return usage();
-            }
-            o->repeats = (int)u;
-        } else if (strcmp(a, "--workers") == 0) {
-            o->nworkers = 0;
-            const char *s = v;
-            if (!*s) {
-                return usage();
-            }
-            while (*s) {
-                if (o->nworkers == MAX_LIST ||
-                    parse_u32(s, 1u, SC_POOL_LINUX_MAX_WORKERS, &u, &end)) {
-                    return usage();
-                }
-                o->workers[o->nworkers++] = u;
-                if (*end && *end != ',') {
-                    return usage();
-                }
-                s = *end == ',' ? end + 1 : end;
-            }
-        } else if (strcmp(a, "--meshes") == 0) {
-            o->nmesh = 0;
-            const char *s = v;
-            if (!*s) {
-                return usage();
-            }
-            while (*s) {
-                if (o->nmesh == MAX_LIST) {
-                    return usage();
-                }
-                uint32_t *d = o->mesh[o->nmesh];
-                const uint32_t maxd[3] = {SC_MAX_MESH_NX, SC_MAX_MESH_NY, SC_MAX_MESH_NZ};
-                for (int k = 0; k < 3; k++) {
-                    if (parse_u32(s, 2u, maxd[k], &d[k], &end) || (k < 2 && *end != 'x')) {
-                        return usage();
-                    }
-                    s = k < 2 ? end + 1 : end;
-                }
-                o->nmesh++;
-                if (*s == ',') {
-                    s++;
-                } else if (*s) {
-                    return usage();
-                }
-            }
-        } else if (strcmp(a, "--methods") == 0) {
-            int any = 0;
-            for (int m = 0; m < M_COUNT; m++) {
-                o->method_on[m] = strstr(v, k_method_name[m]) != NULL;
-                any |= o->method_on[m];
-            }
-            if (!any) {
-                return usage();
-            }
-        } else if (strcmp(a, "--sink") == 0) {
+        const int c = bench_opts_parse(&o->b, a, v);
+        if (c < 0) {
+            return usage();
+        }
+        if (c > 0) {
+            continue;
+        }
+        if (strcmp(a, "--sink") == 0) {
             char host[256];
             uint16_t port;
             if (strcmp(v, "png") != 0 && strcmp(v, "none") != 0 &&
@@ -431,15 +305,6 @@ static void sink_close(sink *s)
 
 /* ---- ours ----------------------------------------------------------------------------- */
 
-static void build_scene(const uint32_t mesh[3])
-{
-    sc_test_scene_params p = sc_test_scene_default_params();
-    p.nx = mesh[0];
-    p.ny = mesh[1];
-    p.nz = mesh[2];
-    sc_test_scene_build(&g_scene, &p);
-}
-
 static void csv_row(FILE *csv, const uint32_t mesh[3], uint32_t nodes, uint32_t tets, int m,
                     uint32_t w, int run, int frames, double step, double cpu, double coll,
                     double sampl, double out, double disp, double sampl_cpu, double out_cpu)
@@ -461,21 +326,10 @@ static void csv_row(FILE *csv, const uint32_t mesh[3], uint32_t nodes, uint32_t 
 static int bench_ours(const uint32_t mesh[3], method m, const sc_pool_dev *pool, uint32_t w,
                       const opts *o, row *out, FILE *csv)
 {
-    build_scene(mesh);
-    sc_tissue_def d =
-        sc_test_scene_tissue_def(&g_scene, m == M_MSDS ? SC_TISSUE_MSDS : SC_TISSUE_FEM);
-    d.skin_enabled = 0u;
-    d.fem.corotated = m == M_COROT ? 1u : 0u;
-    sc_material_table mat;
-    sc_material_table_default(&mat);
-    int rc = sc_tissue_build_begin(&g_t, &d, &g_scene.vol, &mat, SC_LABEL_FAT);
+    sc_pose pose;
+    sc_collider_grid g;
+    int rc = bench_scene_press(&g_t, &g_scene, mesh, (bench_method)m, pool, &pose, &g);
     if (rc != SC_OK) {
-        return rc;
-    }
-    sc_tissue_set_pool(&g_t, pool);
-    while ((rc = sc_tissue_build_step(&g_t)) == SC_OK) {
-    }
-    if (rc != 1) {
         return rc;
     }
     const sc_bscan_def bd = sc_bscan_default_def();
@@ -483,51 +337,42 @@ static int bench_ours(const uint32_t mesh[3], method m, const sc_pool_dev *pool,
         (rc = sc_bscan_attach_mesh(&g_bscan, &g_t.mesh)) != SC_OK) {
         return rc;
     }
-    for (int f = 0; f < 30; f++) {
-        const sc_pose q = sc_test_scene_probe(&g_scene, -0.5f + 3.5f * (float)(f + 1) / 30.0f);
-        (void)sc_tissue_step(&g_t, &q);
-    }
-    const sc_pose pose = sc_test_scene_probe(&g_scene, 3.0f);
     const sc_xform to_volume = sc_xform_from_pose(&pose);
-    const sc_collider_grid g = {
-        g_t.mesh.nx,
-        g_t.mesh.ny,
-        g_t.mesh.nz,
-        {g_t.mesh.origin_mm[0], g_t.mesh.origin_mm[1], g_t.mesh.origin_mm[2]},
-        {g_t.mesh.cell_mm[0], g_t.mesh.cell_mm[1], g_t.mesh.cell_mm[2]}};
     static sc_contact_set cs;
-    static uint64_t st[MAX_FRAMES], cp[MAX_FRAMES], co[MAX_FRAMES], sa[MAX_FRAMES],
-        ou[MAX_FRAMES], wo[MAX_FRAMES], sac[MAX_FRAMES], ouc[MAX_FRAMES];
-    double r_step[MAX_REPEATS], r_cpu[MAX_REPEATS], r_coll[MAX_REPEATS], r_sampl[MAX_REPEATS],
-        r_out[MAX_REPEATS], r_with[MAX_REPEATS], r_sac[MAX_REPEATS], r_ouc[MAX_REPEATS];
+    static uint64_t st[BENCH_MAX_FRAMES], cp[BENCH_MAX_FRAMES], co[BENCH_MAX_FRAMES],
+        sa[BENCH_MAX_FRAMES], ou[BENCH_MAX_FRAMES], wo[BENCH_MAX_FRAMES], sac[BENCH_MAX_FRAMES],
+        ouc[BENCH_MAX_FRAMES];
+    double r_step[BENCH_MAX_REPEATS], r_cpu[BENCH_MAX_REPEATS], r_coll[BENCH_MAX_REPEATS],
+        r_sampl[BENCH_MAX_REPEATS], r_out[BENCH_MAX_REPEATS], r_with[BENCH_MAX_REPEATS],
+        r_sac[BENCH_MAX_REPEATS], r_ouc[BENCH_MAX_REPEATS];
     static uint32_t frame_no;
-    for (int r = 0; r < o->repeats; r++) {
-        for (int f = 0; f < o->frames; f++) {
-            const uint64_t c0 = cpu_ns();
-            const uint64_t t0 = now_ns();
+    for (int r = 0; r < o->b.repeats; r++) {
+        for (int f = 0; f < o->b.frames; f++) {
+            const uint64_t c0 = bench_cpu_ns();
+            const uint64_t t0 = bench_now_ns();
             rc = sc_tissue_step(&g_t, &pose);
-            const uint64_t t1 = now_ns();
-            cp[f] = cpu_ns() - c0;
+            const uint64_t t1 = bench_now_ns();
+            cp[f] = bench_cpu_ns() - c0;
             if (rc != SC_OK) {
                 return rc;
             }
             sc_collider_detect(&g_t.collider, &g, g_t.nodes.x, g_t.nodes.y, g_t.nodes.z,
                                g_t.mesh.node_fixed, g_t.stats.max_disp_mm, &cs);
-            const uint64_t c2 = thread_cpu_ns();
-            const uint64_t t2 = now_ns();
+            const uint64_t c2 = bench_thread_cpu_ns();
+            const uint64_t t2 = bench_now_ns();
             const int contact = g_t.stats.contacts > 0u;
-            rc = sc_bscan_frame(&g_bscan, &g_t.mesh, &g_t.nodes, &g_scene.vol, &to_volume,
-                                contact, &k_null_dev, frame_no);
-            const uint64_t t3 = now_ns();
-            const uint64_t c3 = thread_cpu_ns();
+            rc = sc_bscan_frame(&g_bscan, &g_t.mesh, &g_t.nodes, &g_scene.vol, &to_volume, contact,
+                                &k_null_dev, frame_no);
+            const uint64_t t3 = bench_now_ns();
+            const uint64_t c3 = bench_thread_cpu_ns();
             if (rc != SC_OK) {
                 return rc;
             }
             /* frame numbers cycle over 8 so the PNG sink overwrites 8 files */
-            rc = sc_bscan_frame(&g_bscan, &g_t.mesh, &g_t.nodes, &g_scene.vol, &to_volume,
-                                contact, &g_sink.dev, frame_no % 8u);
-            const uint64_t t4 = now_ns();
-            ouc[f] = thread_cpu_ns() - c3;
+            rc = sc_bscan_frame(&g_bscan, &g_t.mesh, &g_t.nodes, &g_scene.vol, &to_volume, contact,
+                                &g_sink.dev, frame_no % 8u);
+            const uint64_t t4 = bench_now_ns();
+            ouc[f] = bench_thread_cpu_ns() - c3;
             sac[f] = c3 - c2;
             frame_no++;
             /* a sink still busy with the last frame (the PNG writer) or a link down is the
@@ -541,36 +386,36 @@ static int bench_ours(const uint32_t mesh[3], method m, const sc_pool_dev *pool,
             ou[f] = t4 - t3;
             wo[f] = st[f] + ou[f];
         }
-        r_step[r] = median_ms(st, o->frames);
-        r_cpu[r] = median_ms(cp, o->frames);
-        r_coll[r] = median_ms(co, o->frames);
-        r_sampl[r] = median_ms(sa, o->frames);
-        r_out[r] = median_ms(ou, o->frames);
-        r_with[r] = median_ms(wo, o->frames);
-        r_sac[r] = median_ms(sac, o->frames);
-        r_ouc[r] = median_ms(ouc, o->frames);
-        csv_row(csv, mesh, g_t.mesh.node_count, g_t.mesh.tet_count, (int)m, w, r, o->frames,
+        r_step[r] = bench_median_ms(st, o->b.frames);
+        r_cpu[r] = bench_median_ms(cp, o->b.frames);
+        r_coll[r] = bench_median_ms(co, o->b.frames);
+        r_sampl[r] = bench_median_ms(sa, o->b.frames);
+        r_out[r] = bench_median_ms(ou, o->b.frames);
+        r_with[r] = bench_median_ms(wo, o->b.frames);
+        r_sac[r] = bench_median_ms(sac, o->b.frames);
+        r_ouc[r] = bench_median_ms(ouc, o->b.frames);
+        csv_row(csv, mesh, g_t.mesh.node_count, g_t.mesh.tet_count, (int)m, w, r, o->b.frames,
                 r_step[r], r_cpu[r], r_coll[r], r_sampl[r], r_out[r], g_t.stats.max_disp_mm,
                 r_sac[r], r_ouc[r]);
     }
     out->valid = 1;
     out->nodes = g_t.mesh.node_count;
     out->tets = g_t.mesh.tet_count;
-    out->step = median_d(r_step, o->repeats);
+    out->step = bench_median_d(r_step, o->b.repeats);
     out->step_min = r_step[0];
-    out->step_max = r_step[o->repeats - 1];
-    qsort(r_cpu, (size_t)o->repeats, sizeof r_cpu[0], cmp_d);
+    out->step_max = r_step[o->b.repeats - 1];
+    qsort(r_cpu, (size_t)o->b.repeats, sizeof r_cpu[0], bench_cmp_d);
     out->cpu = r_cpu[0]; /* the least disturbed run, as bench-scale */
-    qsort(r_sac, (size_t)o->repeats, sizeof r_sac[0], cmp_d);
-    qsort(r_ouc, (size_t)o->repeats, sizeof r_ouc[0], cmp_d);
+    qsort(r_sac, (size_t)o->b.repeats, sizeof r_sac[0], bench_cmp_d);
+    qsort(r_ouc, (size_t)o->b.repeats, sizeof r_ouc[0], bench_cmp_d);
     out->sampl_cpu = r_sac[0];
     out->out_cpu = r_ouc[0];
-    out->coll = median_d(r_coll, o->repeats);
-    out->sampl = median_d(r_sampl, o->repeats);
-    out->out = median_d(r_out, o->repeats);
-    out->with_out = median_d(r_with, o->repeats);
+    out->coll = bench_median_d(r_coll, o->b.repeats);
+    out->sampl = bench_median_d(r_sampl, o->b.repeats);
+    out->out = bench_median_d(r_out, o->b.repeats);
+    out->with_out = bench_median_d(r_with, o->b.repeats);
     out->with_min = r_with[0];
-    out->with_max = r_with[o->repeats - 1];
+    out->with_max = r_with[o->b.repeats - 1];
     out->disp_mm = g_t.stats.max_disp_mm;
     out->hash = sc_tissue_state_hash(&g_t);
     return 0;
@@ -582,7 +427,11 @@ static int bench_bullet(const uint32_t mesh[3], const opts *o, row *out, FILE *c
 {
     /* our mesh (nodes, tets, fixed nodes) from a build of the scene: the MSDS build's mesh
      * phase is the same for every method */
-    build_scene(mesh);
+    sc_test_scene_params p = sc_test_scene_default_params();
+    p.nx = mesh[0];
+    p.ny = mesh[1];
+    p.nz = mesh[2];
+    sc_test_scene_build(&g_scene, &p);
     sc_tissue_def d = sc_test_scene_tissue_def(&g_scene, SC_TISSUE_MSDS);
     d.skin_enabled = 0u;
     sc_material_table mat;
@@ -616,28 +465,28 @@ static int bench_bullet(const uint32_t mesh[3], const opts *o, row *out, FILE *c
         bb_step(s);
     }
     bb_set_probe(s, 3.0f);
-    static uint64_t st[MAX_FRAMES], cp[MAX_FRAMES];
-    double r_step[MAX_REPEATS], r_cpu[MAX_REPEATS];
-    for (int r = 0; r < o->repeats; r++) {
-        for (int f = 0; f < o->frames; f++) {
-            const uint64_t c0 = cpu_ns();
-            const uint64_t t0 = now_ns();
+    static uint64_t st[BENCH_MAX_FRAMES], cp[BENCH_MAX_FRAMES];
+    double r_step[BENCH_MAX_REPEATS], r_cpu[BENCH_MAX_REPEATS];
+    for (int r = 0; r < o->b.repeats; r++) {
+        for (int f = 0; f < o->b.frames; f++) {
+            const uint64_t c0 = bench_cpu_ns();
+            const uint64_t t0 = bench_now_ns();
             bb_step(s);
-            st[f] = now_ns() - t0;
-            cp[f] = cpu_ns() - c0;
+            st[f] = bench_now_ns() - t0;
+            cp[f] = bench_cpu_ns() - c0;
         }
-        r_step[r] = median_ms(st, o->frames);
-        r_cpu[r] = median_ms(cp, o->frames);
-        csv_row(csv, mesh, sm->node_count, sm->tet_count, M_BULLET, 1u, r, o->frames, r_step[r],
+        r_step[r] = bench_median_ms(st, o->b.frames);
+        r_cpu[r] = bench_median_ms(cp, o->b.frames);
+        csv_row(csv, mesh, sm->node_count, sm->tet_count, M_BULLET, 1u, r, o->b.frames, r_step[r],
                 r_cpu[r], 0.0, 0.0, 0.0, bb_max_disp_mm(s), 0.0, 0.0);
     }
     out->valid = 1;
     out->nodes = sm->node_count;
     out->tets = sm->tet_count;
-    out->step = median_d(r_step, o->repeats);
+    out->step = bench_median_d(r_step, o->b.repeats);
     out->step_min = r_step[0];
-    out->step_max = r_step[o->repeats - 1];
-    qsort(r_cpu, (size_t)o->repeats, sizeof r_cpu[0], cmp_d);
+    out->step_max = r_step[o->b.repeats - 1];
+    qsort(r_cpu, (size_t)o->b.repeats, sizeof r_cpu[0], bench_cmp_d);
     out->cpu = r_cpu[0];
     out->disp_mm = bb_max_disp_mm(s);
     out->coll = out->sampl = out->out = out->with_out = -1.0;
@@ -678,11 +527,11 @@ static void print_tables(const opts *o)
     printf("%-9s %6s %7s %-6s %2s %9s %21s %8s %8s %9s %9s %8s %8s %7s | %s\n", "mesh", "nodes",
            "tets", "method", "w", "step wall", "spread", "step cpu", "coll", "sampl wal",
            "sampl cpu", "out wall", "out cpu", "disp mm", "paper ms");
-    for (int mi = 0; mi < o->nmesh; mi++) {
+    for (int mi = 0; mi < o->b.nmesh; mi++) {
         double pms, pfe, a, b, c, dd;
-        paper_figures(o->mesh[mi], &pms, &pfe, &a, &b, &c, &dd);
+        paper_figures(o->b.mesh[mi], &pms, &pfe, &a, &b, &c, &dd);
         for (int m = 0; m <= M_COUNT; m++) {
-            for (int wi = 0; wi < o->nworkers; wi++) {
+            for (int wi = 0; wi < o->b.nworkers; wi++) {
                 const row *r = &g_rows[mi][m][wi];
                 if (!r->valid) {
                     continue;
@@ -695,16 +544,16 @@ static void print_tables(const opts *o)
                 if (m == M_BULLET) {
                     printf("%2ux%2ux%2u  %6u %7u %-6s %2u %9.3f %9.3f..%9.3f %8.3f %8s %9s %9s "
                            "%8s %8s %7.2f | %s\n",
-                           o->mesh[mi][0], o->mesh[mi][1], o->mesh[mi][2], r->nodes, r->tets,
+                           o->b.mesh[mi][0], o->b.mesh[mi][1], o->b.mesh[mi][2], r->nodes, r->tets,
                            k_method_name[m], 1u, r->step, r->step_min, r->step_max, r->cpu, "-",
                            "-", "-", "-", "-", r->disp_mm, pbuf);
                 } else {
                     printf("%2ux%2ux%2u  %6u %7u %-6s %2u %9.3f %9.3f..%9.3f %8.3f %8.3f %9.3f "
                            "%9.3f %8.3f %8.3f %7.2f | %s\n",
-                           o->mesh[mi][0], o->mesh[mi][1], o->mesh[mi][2], r->nodes, r->tets,
-                           k_method_name[m], (unsigned)o->workers[wi], r->step, r->step_min,
-                           r->step_max, r->cpu, r->coll, r->sampl, r->sampl_cpu, r->out,
-                           r->out_cpu, r->disp_mm, pbuf);
+                           o->b.mesh[mi][0], o->b.mesh[mi][1], o->b.mesh[mi][2], r->nodes, r->tets,
+                           k_method_name[m], (unsigned)o->b.workers[wi], r->step, r->step_min,
+                           r->step_max, r->cpu, r->coll, r->sampl, r->sampl_cpu, r->out, r->out_cpu,
+                           r->disp_mm, pbuf);
                 }
             }
         }
@@ -713,14 +562,13 @@ static void print_tables(const opts *o)
            "(step + B-scan into the %s sink); wall: median [slowest .. fastest run]; cpu: from "
            "the CPU times of Table I)\n",
            o->sink);
-    printf("%-9s %-6s %2s %9s %19s %9s %19s %9s %9s | %s\n", "mesh", "method", "w",
-           "no out", "spread", "with out", "spread", "no out cpu", "out cpu",
-           "paper no vis (vis)");
-    for (int mi = 0; mi < o->nmesh; mi++) {
+    printf("%-9s %-6s %2s %9s %19s %9s %19s %9s %9s | %s\n", "mesh", "method", "w", "no out",
+           "spread", "with out", "spread", "no out cpu", "out cpu", "paper no vis (vis)");
+    for (int mi = 0; mi < o->b.nmesh; mi++) {
         double pms, pfe, no, vis, nof, visf;
-        paper_figures(o->mesh[mi], &pms, &pfe, &no, &vis, &nof, &visf);
+        paper_figures(o->b.mesh[mi], &pms, &pfe, &no, &vis, &nof, &visf);
         for (int m = 0; m < M_COUNT; m++) {
-            for (int wi = 0; wi < o->nworkers; wi++) {
+            for (int wi = 0; wi < o->b.nworkers; wi++) {
                 const row *r = &g_rows[mi][m][wi];
                 if (!r->valid) {
                     continue;
@@ -733,11 +581,10 @@ static void print_tables(const opts *o)
                 }
                 printf("%2ux%2ux%2u  %-6s %2u %9.1f %8.1f..%8.1f %9.1f %8.1f..%8.1f %10.1f %9.1f "
                        "| %s\n",
-                       o->mesh[mi][0], o->mesh[mi][1], o->mesh[mi][2], k_method_name[m],
-                       (unsigned)o->workers[wi], 1000.0 / r->step, 1000.0 / r->step_max,
+                       o->b.mesh[mi][0], o->b.mesh[mi][1], o->b.mesh[mi][2], k_method_name[m],
+                       (unsigned)o->b.workers[wi], 1000.0 / r->step, 1000.0 / r->step_max,
                        1000.0 / r->step_min, 1000.0 / r->with_out, 1000.0 / r->with_max,
-                       1000.0 / r->with_min, 1000.0 / r->cpu, 1000.0 / (r->cpu + r->out_cpu),
-                       pbuf);
+                       1000.0 / r->with_min, 1000.0 / r->cpu, 1000.0 / (r->cpu + r->out_cpu), pbuf);
             }
         }
     }
@@ -747,28 +594,28 @@ static void print_tables(const opts *o)
 static int write_chart(const opts *o, int cpu, const char *path)
 {
     static chart c;
-    static char gname[MAX_LIST][16], sname[CHART_MAX_SERIES][24];
+    _Static_assert(BENCH_MAX_LIST <= CHART_MAX_GROUPS, "a chart group per mesh");
+    static char gname[BENCH_MAX_LIST][16], sname[CHART_MAX_SERIES][24];
     memset(&c, 0, sizeof c);
     c.title = cpu ? "FIG. 9: SOFT-TISSUE STEP, CPU MS PER FRAME (ALL WORKERS), LOG SCALE"
                   : "FIG. 9: SOFT-TISSUE STEP, WALL MS PER FRAME (MEDIAN), LOG SCALE";
     c.y_label = "MS PER FRAME";
     c.y_min = 0.01;
     c.y_max = 1000.0;
-    c.groups = o->nmesh;
-    static const uint8_t pal[CHART_MAX_SERIES][3] = {{31, 119, 180}, {120, 170, 220},
-                                                     {214, 39, 40},  {240, 140, 140},
-                                                     {148, 103, 189}, {44, 160, 44},
-                                                     {90, 90, 90},   {180, 180, 180}};
+    c.groups = o->b.nmesh;
+    static const uint8_t pal[CHART_MAX_SERIES][3] = {
+        {31, 119, 180},  {120, 170, 220}, {214, 39, 40}, {240, 140, 140},
+        {148, 103, 189}, {44, 160, 44},   {90, 90, 90},  {180, 180, 180}};
     int ns = 0;
     int map_m[CHART_MAX_SERIES], map_w[CHART_MAX_SERIES];
     for (int m = 0; m < M_COUNT; m++) {
-        for (int wi = 0; wi < o->nworkers && o->method_on[m]; wi++) {
+        for (int wi = 0; wi < o->b.nworkers && o->b.method_on[m]; wi++) {
             if (ns < CHART_MAX_SERIES - 3) {
                 map_m[ns] = m;
                 map_w[ns] = wi;
                 snprintf(sname[ns], sizeof sname[ns], "%s %uW",
                          m == M_MSDS ? "MSDS" : (m == M_FEM ? "FEM" : "COROT FEM"),
-                         (unsigned)o->workers[wi]);
+                         (unsigned)o->b.workers[wi]);
                 ns++;
             }
         }
@@ -785,9 +632,9 @@ static int write_chart(const opts *o, int cpu, const char *path)
         c.series_name[s] = sname[s];
         memcpy(c.series_rgb[s], pal[(s < paper_s) ? s : (CHART_MAX_SERIES - 2 + s - paper_s)], 3);
     }
-    for (int mi = 0; mi < o->nmesh; mi++) {
-        snprintf(gname[mi], sizeof gname[mi], "%ux%ux%u", o->mesh[mi][0], o->mesh[mi][1],
-                 o->mesh[mi][2]);
+    for (int mi = 0; mi < o->b.nmesh; mi++) {
+        snprintf(gname[mi], sizeof gname[mi], "%ux%ux%u", o->b.mesh[mi][0], o->b.mesh[mi][1],
+                 o->b.mesh[mi][2]);
         c.group_name[mi] = gname[mi];
         for (int s = 0; s < ns; s++) {
             c.value[mi][s] = -1.0;
@@ -801,7 +648,7 @@ static int write_chart(const opts *o, int cpu, const char *path)
                 cpu ? g_rows[mi][M_BULLET][0].cpu : g_rows[mi][M_BULLET][0].step;
         }
         double pms, pfe, a, b, cc, dd;
-        paper_figures(o->mesh[mi], &pms, &pfe, &a, &b, &cc, &dd);
+        paper_figures(o->b.mesh[mi], &pms, &pfe, &a, &b, &cc, &dd);
         c.value[mi][paper_s] = pms;
         c.value[mi][paper_s + 1] = pfe;
     }
@@ -820,6 +667,7 @@ int main(int argc, char **argv)
     if (prc != 0) {
         return prc;
     }
+    bench_select_kernels("bench-paper"); /* the engine's variant, as sonocomp selects it */
     if (mkparent(o.csv) != 0) {
         fprintf(stderr, "bench-paper: cannot create the folder of %s\n", o.csv);
         return 1;
@@ -840,17 +688,17 @@ int main(int argc, char **argv)
         printf("bench-paper: Bullet was not found at configure time (libbullet-dev): its rows "
                "are left out\n");
     }
-    printf("bench-paper: %d runs x %d frames per row, wall clock; sink %s\n", o.repeats,
-           o.frames, o.sink);
+    printf("bench-paper: %d runs x %d frames per row, wall clock; sink %s\n", o.b.repeats,
+           o.b.frames, o.sink);
     int status = 0;
-    for (int mi = 0; mi < o.nmesh && status == 0; mi++) {
+    for (int mi = 0; mi < o.b.nmesh && status == 0; mi++) {
         for (int m = 0; m < M_COUNT; m++) {
-            if (!o.method_on[m]) {
+            if (!o.b.method_on[m]) {
                 continue;
             }
             uint64_t ref_hash = 0u;
-            for (int wi = 0; wi < o.nworkers; wi++) {
-                const uint32_t w = o.workers[wi];
+            for (int wi = 0; wi < o.b.nworkers; wi++) {
+                const uint32_t w = o.b.workers[wi];
                 static sc_pool_linux lp;
                 sc_pool_dev dev = {0};
                 if (w > 1u && sc_pool_linux_start(&lp, w, 0, 200u, &dev) != 0) {
@@ -859,34 +707,35 @@ int main(int argc, char **argv)
                     break;
                 }
                 row *r = &g_rows[mi][m][wi];
-                const int rc = bench_ours(o.mesh[mi], (method)m, w > 1u ? &dev : NULL, w, &o, r,
-                                          csv);
+                const int rc =
+                    bench_ours(o.b.mesh[mi], (method)m, w > 1u ? &dev : NULL, w, &o, r, csv);
                 if (w > 1u) {
                     sc_pool_linux_stop(&lp);
                 }
                 if (rc != 0) {
-                    fprintf(stderr, "bench-paper: %ux%ux%u %s: %s\n", o.mesh[mi][0],
-                            o.mesh[mi][1], o.mesh[mi][2], k_method_name[m], sc_err_name(rc));
+                    fprintf(stderr, "bench-paper: %ux%ux%u %s: %s\n", o.b.mesh[mi][0],
+                            o.b.mesh[mi][1], o.b.mesh[mi][2], k_method_name[m], sc_err_name(rc));
                     status = 1;
                     break;
                 }
                 if (wi == 0) {
                     ref_hash = r->hash;
                 } else if (r->hash != ref_hash) {
-                    fprintf(stderr, "bench-paper: %ux%ux%u %s: %u workers end in another state "
-                                    "than %u\n",
-                            o.mesh[mi][0], o.mesh[mi][1], o.mesh[mi][2], k_method_name[m],
-                            (unsigned)w, (unsigned)o.workers[0]);
+                    fprintf(stderr,
+                            "bench-paper: %ux%ux%u %s: %u workers end in another state "
+                            "than %u\n",
+                            o.b.mesh[mi][0], o.b.mesh[mi][1], o.b.mesh[mi][2], k_method_name[m],
+                            (unsigned)w, (unsigned)o.b.workers[0]);
                     status = 1;
                 }
                 printf("  %ux%ux%u %s %uw: step %.3f ms (%.3f..%.3f), with output %.3f ms\n",
-                       o.mesh[mi][0], o.mesh[mi][1], o.mesh[mi][2], k_method_name[m],
+                       o.b.mesh[mi][0], o.b.mesh[mi][1], o.b.mesh[mi][2], k_method_name[m],
                        (unsigned)w, r->step, r->step_min, r->step_max, r->with_out);
                 fflush(stdout);
             }
         }
         if (o.bullet && bb_available() && status == 0) {
-            const int rc = bench_bullet(o.mesh[mi], &o, &g_rows[mi][M_BULLET][0], csv);
+            const int rc = bench_bullet(o.b.mesh[mi], &o, &g_rows[mi][M_BULLET][0], csv);
             if (rc != 0) {
                 status = 1;
             }
