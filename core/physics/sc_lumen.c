@@ -216,8 +216,16 @@ int sc_lumen_init(sc_lumen *l, const sc_mesh *m, const sc_material_table *mat)
     }
     for (uint32_t k = 0; k < l->count; k++) {
         sc_lumen_vessel *v = &l->v[k];
-        /* a lumen with no solid around it (the whole box) is bounded by its own law only */
-        const float c = isfinite(emin[k]) ? 2.0f * (1.0f + numin[k]) / emin[k] : 0.0f;
+        /* the lumen's volume stiffness against its own pressure: the hole in the softest
+         * material around (plane strain, mu_min = E / (2 (1 + nu))) in parallel with the
+         * lumen's own tets (their plane-strain bulk modulus lambda + mu = E / (2 (1 + nu)
+         * (1 - 2 nu)), the least they resist a uniform area change); c is its inverse */
+        const sc_material *fill = &mat->row[v->label];
+        const float k_fill =
+            fill->e_pa / (2.0f * (1.0f + fill->poisson) * (1.0f - 2.0f * fill->poisson));
+        const float k_hole = isfinite(emin[k]) ? emin[k] / (2.0f * (1.0f + numin[k])) : 0.0f;
+        /* a lumen with nothing solid in or around it is bounded by its own law only */
+        const float c = k_fill + k_hole > 0.0f ? 1.0f / (k_fill + k_hole) : 0.0f;
         v->theta = 1.0f / (1.0f + v->bulk_pa * c);
     }
     sc_lumen_reset(l);
