@@ -161,6 +161,8 @@ typedef struct sc_msds {
     SC_ALIGN_HOT float l0_mm[SC_MSDS_FAMILIES][SC_MAX_NODES];
     SC_ALIGN_HOT float mass_kg[SC_MAX_NODES];
     SC_ALIGN_HOT float inv_mass[SC_MAX_NODES];      /* 1e3 / m (mm/s^2 per N); 0: fixed node */
+    uint8_t roller[SC_MAX_NODES]; /* explicit: the held axes of a node on rollers (the mesh's
+                                     SC_MESH_ROLLER_* bits; 0: free, or fixed by inv_mass 0) */
     SC_ALIGN_HOT float ksum_n_per_mm[SC_MAX_NODES]; /* sum of spring k at each node */
     SC_ALIGN_HOT float phys_mass_kg[SC_MAX_NODES];  /* density x volume / 4 per tet corner */
     SC_ALIGN_HOT float fx[SC_MAX_NODES];            /* scratch: net force of the current step, N */
