@@ -72,7 +72,7 @@
  * family's far-end pass into the next, 512-bit or 256-bit vectors for x86-64-v4: the springs
  * are bound by their loads and stores more than by their arithmetic.
  * Memory (N = SC_MAX_NODES, T = SC_MAX_TETS): springs 72 B, masses/sums 24 B, scratch 24 B,
- * cells 44 B per node; per tet 24 B (k, V0, nodes: load time and energy only):
+ * cells 44 B, roller axes 1 B per node; per tet 24 B (k, V0, nodes: load time and energy only):
  * sizeof(sc_msds) about 2.2 MB at 8,192 nodes.
  *
  * Thread rules: one writer. Never allocates, never calls the OS. Deterministic (fixed loop
