@@ -96,6 +96,9 @@ void sc_lumen_reset(sc_lumen *l)
         l->v[k].p_pa = 0.0f;
         l->v[k].drive_pa = 0.0f;
         l->v[k].v_mm3 = l->v[k].v0_mm3;
+        for (uint32_t i = 0; i < SC_LUMEN_SLICES; i++) {
+            l->v[k].s_p[i] = 0.0f;
+        }
     }
     l->heart_phase = 0.0f;
     l->resp_phase = 0.0f;
@@ -134,6 +137,87 @@ static uint32_t fill_sweep(sc_lumen *l, const sc_mesh *m, uint8_t lab, uint8_t i
         }
     }
     return added;
+}
+
+static const float *rest_axis(const sc_mesh *m, uint32_t axis)
+{
+    return axis == 0u ? m->rest_x : axis == 1u ? m->rest_y : m->rest_z;
+}
+
+/* the section of vessel v that tet t (of v) lies in: its rest centroid's slab along the axis */
+static uint32_t slice_of(const sc_lumen_vessel *v, const sc_mesh *m, uint32_t t)
+{
+    if (v->slices <= 1u) {
+        return 0u;
+    }
+    const float *r = rest_axis(m, v->axis);
+    const uint32_t *tv = m->tet[t];
+    const float c = 0.25f * (r[tv[0]] + r[tv[1]] + r[tv[2]] + r[tv[3]]);
+    const float u = (c - v->lo_mm) / v->slab_mm;
+    if (!(u > 0.0f)) {
+        return 0u;
+    }
+    const uint32_t i = (uint32_t)u;
+    return i < v->slices ? i : v->slices - 1u;
+}
+
+/* an artery's sections (sc_lumen.h "Sections"): the axis along which its rest extent is the
+ * largest share of the box's, slabs of at least one cell, their rest volumes */
+static void sections(sc_lumen *l, const sc_mesh *m, uint32_t k)
+{
+    sc_lumen_vessel *v = &l->v[k];
+    v->slices = 1u;
+    v->axis = 0u;
+    v->lo_mm = 0.0f;
+    v->slab_mm = 0.0f;
+    for (uint32_t i = 0; i < SC_LUMEN_SLICES; i++) {
+        v->s_v0[i] = 0.0f;
+    }
+    v->s_v0[0] = v->v0_mm3;
+    if (v->kind != (uint8_t)SC_LUMEN_ARTERY || SC_LUMEN_SLICES < 2u) {
+        return;
+    }
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t t = 0; t < m->tet_count; t++) {
+        if (l->region[t] != k + 1u) {
+            continue;
+        }
+        for (uint32_t a = 0; a < 4u; a++) {
+            const uint32_t q = m->tet[t][a];
+            const float p[3] = {m->rest_x[q], m->rest_y[q], m->rest_z[q]};
+            for (uint32_t d = 0; d < 3u; d++) {
+                lo[d] = fminf(lo[d], p[d]);
+                hi[d] = fmaxf(hi[d], p[d]);
+            }
+        }
+    }
+    const uint32_t cnt[3] = {m->nx, m->ny, m->nz};
+    float best = -1.0f;
+    for (uint32_t d = 0; d < 3u; d++) {
+        const float box = m->cell_mm[d] * (float)(cnt[d] - 1u);
+        const float share = box > 0.0f ? (hi[d] - lo[d]) / box : 0.0f;
+        if (share > best) {
+            best = share;
+            v->axis = (uint8_t)d;
+        }
+    }
+    const uint32_t d = v->axis;
+    const float ext = hi[d] - lo[d];
+    const float cells = m->cell_mm[d] > 0.0f ? ext / m->cell_mm[d] : 0.0f;
+    uint32_t n = cells >= (float)SC_LUMEN_SLICES ? SC_LUMEN_SLICES : (uint32_t)(cells + 0.5f);
+    if (n < 2u || !(ext > 0.0f)) {
+        return;
+    }
+    v->slices = (uint8_t)n;
+    v->lo_mm = lo[d];
+    v->slab_mm = ext / (float)n;
+    v->s_v0[0] = 0.0f;
+    for (uint32_t t = 0; t < m->tet_count; t++) {
+        if (l->region[t] == k + 1u) {
+            v->s_v0[slice_of(v, m, t)] +=
+                sc_mesh_tet_volume_mm3(m->rest_x, m->rest_y, m->rest_z, m->tet[t]);
+        }
+    }
 }
 
 int sc_lumen_init(sc_lumen *l, const sc_mesh *m, const sc_material_table *mat)
@@ -216,9 +300,18 @@ int sc_lumen_init(sc_lumen *l, const sc_mesh *m, const sc_material_table *mat)
     }
     for (uint32_t k = 0; k < l->count; k++) {
         sc_lumen_vessel *v = &l->v[k];
-        /* a lumen with no solid around it (the whole box) is bounded by its own law only */
-        const float c = isfinite(emin[k]) ? 2.0f * (1.0f + numin[k]) / emin[k] : 0.0f;
+        /* the lumen's volume stiffness against its own pressure: the hole in the softest
+         * material around (plane strain, mu_min = E / (2 (1 + nu))) in parallel with the
+         * lumen's own tets (their plane-strain bulk modulus lambda + mu = E / (2 (1 + nu)
+         * (1 - 2 nu)), the least they resist a uniform area change); c is its inverse */
+        const sc_material *fill = &mat->row[v->label];
+        const float k_fill =
+            fill->e_pa / (2.0f * (1.0f + fill->poisson) * (1.0f - 2.0f * fill->poisson));
+        const float k_hole = isfinite(emin[k]) ? emin[k] / (2.0f * (1.0f + numin[k])) : 0.0f;
+        /* a lumen with nothing solid in or around it is bounded by its own law only */
+        const float c = k_fill + k_hole > 0.0f ? 1.0f / (k_fill + k_hole) : 0.0f;
         v->theta = 1.0f / (1.0f + v->bulk_pa * c);
+        sections(l, m, k);
     }
     sc_lumen_reset(l);
     return SC_OK;
@@ -311,37 +404,47 @@ void sc_lumen_apply(sc_lumen *l, const sc_mesh *m, sc_nodes *n)
     }
     l->heart_phase = advance(l->heart_phase, l->drive.heart_rate_bpm, l->frame_s);
     l->resp_phase = advance(l->resp_phase, l->drive.resp_rate_bpm, l->frame_s);
-    float vol[SC_LUMEN_MAX];
-    for (uint32_t k = 0; k < SC_LUMEN_MAX; k++) {
-        vol[k] = 0.0f;
-    }
+    float vol[SC_LUMEN_MAX][SC_LUMEN_SLICES];
+    memset(vol, 0, sizeof vol);
     const uint32_t nt = m->tet_count;
     for (uint32_t t = 0; t < nt; t++) {
         const uint8_t r = l->region[t];
         if (r != 0u) {
-            vol[r - 1u] += sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[t]);
+            vol[r - 1u][slice_of(&l->v[r - 1u], m, t)] +=
+                sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[t]);
         }
     }
-    float press_nmm2[SC_LUMEN_MAX];
+    float press_nmm2[SC_LUMEN_MAX][SC_LUMEN_SLICES];
     for (uint32_t k = 0; k < l->count; k++) {
         sc_lumen_vessel *v = &l->v[k];
-        v->v_mm3 = vol[k];
-        const float s = (v->v0_mm3 - vol[k]) / v->v0_mm3;
         v->drive_pa = sc_lumen_drive_pa(l, v->kind);
-        /* bounded: a lumen squeezed past empty (inverted tets) pushes back no harder than an
-         * empty one, a distension past double its volume pulls no harder than that */
-        const float sc = isfinite(s) ? fminf(fmaxf(s, -1.0f), 1.0f) : 0.0f;
-        const float g = law(v, sc);
-        /* up: relaxed (theta, stable against the tissue's answer); down: at once, so that a
-         * lumen let go (the probe lifted or jumped away) is never over-pressured (the relaxed
-         * fall took 1 / theta frames and blew the lumen up) */
-        v->p_pa = g < v->p_pa ? g : v->p_pa + v->theta * (g - v->p_pa);
-        /* Pa -> N/mm^2; a third of the face's area vector per node */
-        /* a lumen squeezed below half its volume carries less of the drive, none when empty
-         * (no flow through a crushed vessel; fed forward onto a crushed artery the pulse flung
-         * its filler's nodes past the guard's bound at the deepest press) */
-        const float open = sc <= 0.5f ? 1.0f : 2.0f * (1.0f - sc);
-        press_nmm2[k] = (v->p_pa + open * v->drive_pa) * (1.0e-6f / 3.0f);
+        v->v_mm3 = 0.0f;
+        v->p_pa = -INFINITY;
+        for (uint32_t i = 0; i < v->slices; i++) {
+            v->v_mm3 += vol[k][i];
+            if (!(v->s_v0[i] > 0.0f)) {
+                press_nmm2[k][i] = 0.0f; /* an empty section (no tet's centroid in it) */
+                continue;
+            }
+            const float s = (v->s_v0[i] - vol[k][i]) / v->s_v0[i];
+            /* bounded: a lumen squeezed past empty (inverted tets) pushes back no harder than
+             * an empty one, a distension past double its volume pulls no harder than that */
+            const float sc = isfinite(s) ? fminf(fmaxf(s, -1.0f), 1.0f) : 0.0f;
+            const float g = law(v, sc);
+            /* up: relaxed (theta, stable against the tissue's answer); down: at once, so that
+             * a lumen let go (the probe lifted or jumped away) is never over-pressured (the
+             * relaxed fall took 1 / theta frames and blew the lumen up) */
+            float *p = &v->s_p[i];
+            *p = g < *p ? g : *p + v->theta * (g - *p);
+            v->p_pa = fmaxf(v->p_pa, *p);
+            /* a lumen squeezed below half its volume carries less of the drive, none when
+             * empty (no flow through a crushed vessel; fed forward onto a crushed artery the
+             * pulse flung its filler's nodes past the guard's bound at the deepest press) */
+            const float open = sc <= 0.5f ? 1.0f : 2.0f * (1.0f - sc);
+            /* Pa -> N/mm^2; a third of the face's area vector per node */
+            press_nmm2[k][i] = (*p + open * v->drive_pa) * (1.0e-6f / 3.0f);
+        }
+        v->p_pa = isfinite(v->p_pa) ? v->p_pa : 0.0f;
     }
     uint32_t faces = 0;
     for (uint32_t t = 0; t < nt; t++) {
@@ -349,7 +452,7 @@ void sc_lumen_apply(sc_lumen *l, const sc_mesh *m, sc_nodes *n)
         if (r == 0u) {
             continue;
         }
-        const float pk = press_nmm2[r - 1u];
+        const float pk = press_nmm2[r - 1u][slice_of(&l->v[r - 1u], m, t)];
         const uint32_t *tv = m->tet[t];
         if (!(sc_mesh_tet_volume_mm3(n->x, n->y, n->z, tv) > 0.0f)) {
             continue; /* an inverted (crushed) lumen tet: its faces have no outward side */

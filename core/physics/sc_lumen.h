@@ -51,13 +51,27 @@
  * neck phantom); fed forward the wall sees it in the frame it is due and the law answers the
  * volume change with its lag (3% area, 1.5% diameter peak to peak, test_vessel_drive).
  *
+ * Sections (arteries): the law above is a wall's answer to its transmural pressure, and a
+ * wall answers where it is pressed. An artery's blood pressure is the circulation's (the heart
+ * and the whole arterial tree hold it; the segment in the box does not set it by its volume),
+ * so its law is evaluated per section: the lumen is cut across its axis (the mesh axis along
+ * which its rest extent is largest, relative to the box) into up to SC_LUMEN_SLICES slabs of at
+ * least one cell, each with its own volume strain s, relaxed pressure and faces: the section
+ * squeezed most answers with its own strain instead of the lumen's mean. Measured
+ * (test_press_pulse, neck-ijv, MSDS, default mesh, 16 mm, pulse on): the whole lumen's law
+ * answered 4.2-4.4 kPa at the landing, the middle section's 4.3-5.2 kPa (the end sections
+ * 2.6-3.0 kPa), and the artery's least image-area ratio over the holds rose from 0.769 to
+ * 0.783. A vein keeps one section (not tried sectioned: the press sweeps' vein figures are
+ * measured with the whole-lumen law).
+ *
  * Time: the drive's phases advance by frame_s (real seconds per frame, sc_lumen_set_frame_s;
  * the physics' own simulated time per frame is a solver setting, not the clock), so the pulse
  * runs at the set heart rate in the image.
  *
  * Memory: one label byte per tet (region) and SC_LUMEN_MAX vessels in the caller's sc_lumen
- * (SC_MAX_TETS + ~0.5 KB). Never allocates, never calls the OS. Deterministic: fixed loop
- * order over tets, float arithmetic only. Threads: one writer (the tissue step).
+ * (SC_MAX_TETS + ~1.6 KB, of which 1 KB the sections: 8 B per section and vessel; the
+ * Cortex-M7 image grew by 1,408 B with them and sc_msds.roller). Never allocates, never calls
+ * the OS. Deterministic: fixed loop order over tets, float arithmetic only. Threads: one writer (the tissue step).
  */
 #ifndef SC_LUMEN_H
 #define SC_LUMEN_H
@@ -71,6 +85,11 @@
 /* vessels per mesh (regions beyond are left solid filler and counted in sc_lumen.dropped) */
 #ifndef SC_LUMEN_MAX
 #define SC_LUMEN_MAX 8u
+#endif
+
+/* sections per artery along its axis (sc_lumen_vessel.slices; 8 B per section and vessel) */
+#ifndef SC_LUMEN_SLICES
+#define SC_LUMEN_SLICES 16u
 #endif
 
 typedef enum sc_lumen_kind {
@@ -112,8 +131,16 @@ typedef struct sc_lumen_vessel {
     float theta;        /* relaxation of the applied pressure (above) */
     float v0_mm3;       /* rest volume */
     float v_mm3;        /* volume at the start of the last frame */
-    float p_pa;         /* relaxed law pressure g(s) (state) */
+    float p_pa;         /* relaxed law pressure g(s) (state; a sectioned lumen: its largest) */
     float drive_pa;     /* d(t) of the last frame */
+    /* sections (arteries, see "Sections" above): the law per slab of the lumen across its
+     * axis; 1: the whole lumen is one section (veins) */
+    uint8_t slices;
+    uint8_t axis;       /* 0 x, 1 y, 2 z: the axis the lumen runs along */
+    float lo_mm;        /* the lumen's rest extent's start along axis */
+    float slab_mm;      /* section length along axis */
+    float s_v0[SC_LUMEN_SLICES]; /* rest volume per section */
+    float s_p[SC_LUMEN_SLICES];  /* relaxed law pressure per section (state) */
 } sc_lumen_vessel;
 
 typedef struct sc_lumen {

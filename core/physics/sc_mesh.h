@@ -45,8 +45,8 @@ typedef struct sc_mesh {
 } sc_mesh;
 
 /* Per-axis supports (a face on rollers): node_fixed = a combination of these bits holds only
- * those axes of the node (FEM and implicit MSDS; the explicit MSDS, the collider and the
- * skin treat any non-zero node_fixed as a fully fixed node). node_fixed == 1 is fully fixed. */
+ * those axes of the node (FEM, implicit and explicit MSDS; the collider and the skin treat
+ * any non-zero node_fixed as a fully fixed node). node_fixed == 1 is fully fixed. */
 #define SC_MESH_ROLLER_X 2u
 #define SC_MESH_ROLLER_Y 4u
 #define SC_MESH_ROLLER_Z 8u

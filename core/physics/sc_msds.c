@@ -262,11 +262,17 @@ static void compute_mass_scale(sc_msds *s)
     (void)mass_scale_run(s, SC_MSDS_POWER_ITERATIONS);
 }
 
+/* inv_mass 0 on fully fixed nodes; a node on rollers keeps its mass and its held axes in
+ * roller[] (the explicit step zeroes only those components of its velocity, as the implicit
+ * solvers' per-axis constraints do) */
 static void compute_inv_mass(sc_msds *s, const sc_mesh *m)
 {
+    const uint8_t axes = (uint8_t)(SC_MESH_ROLLER_X | SC_MESH_ROLLER_Y | SC_MESH_ROLLER_Z);
     for (uint32_t i = 0; i < s->node_count; i++) {
-        s->inv_mass[i] =
-            (m->node_fixed[i] != 0u || !(s->mass_kg[i] > 0.0f)) ? 0.0f : 1e3f / s->mass_kg[i];
+        const uint8_t f = m->node_fixed[i];
+        const int fixed = (f & SC_MESH_FIXED_ALL) != 0u || (f & axes) == axes;
+        s->inv_mass[i] = (fixed || !(s->mass_kg[i] > 0.0f)) ? 0.0f : 1e3f / s->mass_kg[i];
+        s->roller[i] = fixed ? 0u : (uint8_t)(f & axes);
     }
 }
 

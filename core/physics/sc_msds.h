@@ -72,7 +72,7 @@
  * family's far-end pass into the next, 512-bit or 256-bit vectors for x86-64-v4: the springs
  * are bound by their loads and stores more than by their arithmetic.
  * Memory (N = SC_MAX_NODES, T = SC_MAX_TETS): springs 72 B, masses/sums 24 B, scratch 24 B,
- * cells 44 B per node; per tet 24 B (k, V0, nodes: load time and energy only):
+ * cells 44 B, roller axes 1 B per node; per tet 24 B (k, V0, nodes: load time and energy only):
  * sizeof(sc_msds) about 2.2 MB at 8,192 nodes.
  *
  * Thread rules: one writer. Never allocates, never calls the OS. Deterministic (fixed loop
@@ -161,6 +161,8 @@ typedef struct sc_msds {
     SC_ALIGN_HOT float l0_mm[SC_MSDS_FAMILIES][SC_MAX_NODES];
     SC_ALIGN_HOT float mass_kg[SC_MAX_NODES];
     SC_ALIGN_HOT float inv_mass[SC_MAX_NODES];      /* 1e3 / m (mm/s^2 per N); 0: fixed node */
+    uint8_t roller[SC_MAX_NODES]; /* explicit: the held axes of a node on rollers (the mesh's
+                                     SC_MESH_ROLLER_* bits; 0: free, or fixed by inv_mass 0) */
     SC_ALIGN_HOT float ksum_n_per_mm[SC_MAX_NODES]; /* sum of spring k at each node */
     SC_ALIGN_HOT float phys_mass_kg[SC_MAX_NODES];  /* density x volume / 4 per tet corner */
     SC_ALIGN_HOT float fx[SC_MAX_NODES];            /* scratch: net force of the current step, N */

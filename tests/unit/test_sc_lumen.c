@@ -77,9 +77,13 @@ static void finds_one_vessel_per_tube_with_its_rest_volume(void **state)
                                               k + 1u) -
                           v->v0_mm3) <= 1e-3f * v->v0_mm3);
     }
-    /* the artery (stiffer law) relaxes slower than the vein */
+    /* theta = 1 / (1 + B c), c the lumen's compliance bound: the hole in the softest
+     * material around in parallel with the lumen's own tets. The vein's filler (0.15 kPa)
+     * adds little to the fat around it (B 10 kPa over ~1.35 kPa: ~0.12); the artery's wall
+     * share (30 kPa, nu 0.45: lambda + mu 103 kPa) carries most of its law (B 60 kPa: ~0.63) */
     const uint32_t vi = g_lumen.v[0].label == SC_LABEL_VEIN ? 0u : 1u;
-    assert_true(g_lumen.v[1u - vi].theta < g_lumen.v[vi].theta);
+    assert_true(g_lumen.v[vi].theta > 0.08f && g_lumen.v[vi].theta < 0.2f);
+    assert_true(g_lumen.v[1u - vi].theta > 0.5f && g_lumen.v[1u - vi].theta < 0.8f);
 }
 
 /* push every lumen node by `scale` about the tube's axis (x, z) and return the sum of the radial
