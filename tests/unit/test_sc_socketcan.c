@@ -425,7 +425,7 @@ static void a_command_behind_a_stall_of_poses_is_taken_first_through_the_mailbox
     }
     push_rx(&fk, 0x081, 8, 0, t0 + 3000000000ull, 0); /* a command */
     push_rx(&fk, 0x100, 8, 0, t0 + 3000500000ull, 2); /* a pose; the kernel dropped 2 */
-    push_rx(&fk, 0x099, 8, 0, t0 + 3001000000ull, 0); /* its MAC */
+    push_rx(&fk, 0x089, 8, 0, t0 + 3001000000ull, 0); /* its MAC */
     push_rx(&fk, CAN_ERR_FLAG | CAN_ERR_CRTL, 8, 0, t0 + 3002000000ull, 0);
     fk.rxq[fk.rx_n - 1].data[1] = CAN_ERR_CRTL_RX_WARNING;
 
@@ -436,7 +436,7 @@ static void a_command_behind_a_stall_of_poses_is_taken_first_through_the_mailbox
     const uint64_t t_cmd = fr.ts_ns;
     assert_true(t_cmd != 0u);
     assert_int_equal(sc_can_recv(&dev, &fr), 0);
-    assert_int_equal(fr.id, 0x099);
+    assert_int_equal(fr.id, 0x089);
     assert_int_equal(fr.ts_ns - t_cmd, 1000000u); /* kernel stamps kept, on one base */
     assert_int_equal(sc_can_recv(&dev, &fr), 0);
     assert_true(fr.flags & SC_CAN_FLAG_ERR);

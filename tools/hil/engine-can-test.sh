@@ -61,6 +61,7 @@ sleep 0.3
 kill $cd_pid
 echo "SCENG emu $(tail -n 1 emu.txt)"
 grep -E "frames|misses" engine.txt | head -5 | sed 's/^/SCENG engine /'
+grep "socketcan " engine.txt | sed 's/^/SCENG rxmb /'
 echo "SCENG buslog_begin"
 cat bus.log
 echo "SCENG buslog_end"
@@ -87,6 +88,16 @@ for line in open(sys.argv[1], errors="replace"):
         for k, v in re.findall(r"([\w-]+)=(\d+)", line):
             emu[k] = int(v)
 st = {k: int(v) for k, v in re.findall(r"(\w+)=(-?\d+)", sys.argv[2])}
+# the engine's receive mailboxes in front of the socket (its final report's socketcan line)
+mb = {}
+for line in open(sys.argv[1], errors="replace"):
+    if "SCENG rxmb" in line:
+        for k, pat in (("cmds", r"(\d+) commands,"), ("taken", r"(\d+) stream frames taken"),
+                       ("overwritten", r"(\d+) stream frames overwritten"),
+                       ("refused", r"(\d+) commands refused")):
+            m = re.search(pat, line)
+            if m:
+                mb[k] = int(m.group(1))
 fails = []
 def check(cond, what):
     print(("ok   " if cond else "FAIL ") + what)
@@ -125,6 +136,12 @@ check(st["cmds_authenticated"] == 3,
 check(st["auth_rejected"] == 1 and st["auth_bad_mac"] == 0 and st["auth_stale"] == 0,
       "forged command refused: %d auth rejects (bad MAC %d, stale %d)"
       % (st["auth_rejected"], st["auth_bad_mac"], st["auth_stale"]))
+# the SocketCAN path through the mailboxes: the sync, 2 commands, their 3 MACs and cansend's
+# forged command came through the priority mailbox, none refused
+check(len(mb) == 4, "engine reported its receive mailboxes: %s" % mb)
+check(mb.get("cmds", -1) >= 7 and mb.get("refused", -1) == 0,
+      "command block through the priority mailbox: %d frames, %d refused"
+      % (mb.get("cmds", -1), mb.get("refused", -1)))
 print("engine-can-test: %s" % ("PASS" if not fails else "FAIL (%d)" % len(fails)))
 sys.exit(1 if fails else 0)
 P
