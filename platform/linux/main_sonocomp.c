@@ -989,10 +989,9 @@ int main(int argc, char **argv)
                    cfg.can_interface, (unsigned long long)can.rx_frames,
                    (unsigned long long)can.rx_error_frames, (unsigned)can.rx_unconvertible,
                    (unsigned)can.counters.rx_dropped, (unsigned long long)mc->prio_taken,
-                   (unsigned long long)mc->stream_taken,
-                   (unsigned long long)mc->stream_overwritten,
-                   (unsigned long long)mc->prio_dropped,
-                   (unsigned long long)can_mb.drain_limited, (unsigned)can_mb.drain_max);
+                   (unsigned long long)mc->stream_taken, (unsigned long long)mc->stream_overwritten,
+                   (unsigned long long)mc->prio_dropped, (unsigned long long)can_mb.drain_limited,
+                   (unsigned)can_mb.drain_max);
         }
         if (a.hist_path && write_hist(a.hist_path, e) != 0) {
             fprintf(stderr, "sonocomp: --hist %s: %s\n", a.hist_path, strerror(errno));
