@@ -736,6 +736,7 @@ int main(int argc, char **argv)
     static sc_can_replay replay;
     static sc_udpcan can_udp;
     static sc_can_rxmb_port can_udp_mb; /* a controller's mailboxes in front of the socket */
+    static sc_can_rxmb_port can_mb;     /* the same in front of the SocketCAN socket */
     int can_open = 0, replay_open = 0;
     if (a.can_udp_port && !a.can_replay_path) {
         if (sc_udpcan_open_rx(&can_udp, a.can_udp_port) != 0) {
@@ -792,7 +793,13 @@ int main(int argc, char **argv)
             return EXIT_RUNTIME;
         }
         can_open = 1;
-        hal.can = sc_socketcan_dev(&can);
+        /* the kernel's socket queue is one FIFO too: drained (bounded) at each receive into
+         * the mailboxes, so that after a stall a command does not wait behind the queued
+         * tracker frames and the newest poses win (sc_can_rxmb.h); the kernel's receive
+         * stamps and acceptance filters stay */
+        const sc_can_rxmb_def mbd = sc_can_rxmb_default_def();
+        (void)sc_can_rxmb_port_init(&can_mb, &mbd, sc_socketcan_dev(&can), 4096u);
+        hal.can = sc_can_rxmb_port_dev(&can_mb);
     }
 
     static sc_udp_display udp;
@@ -972,6 +979,19 @@ int main(int argc, char **argv)
                    (unsigned long long)mc->prio_taken, (unsigned long long)mc->stream_taken,
                    (unsigned long long)mc->stream_overwritten,
                    (unsigned long long)mc->prio_dropped);
+        }
+        if (can_open) {
+            const sc_can_rxmb_counters *mc = &can_mb.mb.c;
+            printf("  socketcan       %s: %llu frames, %llu error frames (%u unconvertible, %u "
+                   "dropped by the kernel); mailboxes: %llu commands, %llu stream frames taken, "
+                   "%llu stream frames overwritten by newer ones, %llu commands refused (full), "
+                   "%llu drains stopped at %u frames\n",
+                   cfg.can_interface, (unsigned long long)can.rx_frames,
+                   (unsigned long long)can.rx_error_frames, (unsigned)can.rx_unconvertible,
+                   (unsigned)can.counters.rx_dropped, (unsigned long long)mc->prio_taken,
+                   (unsigned long long)mc->stream_taken, (unsigned long long)mc->stream_overwritten,
+                   (unsigned long long)mc->prio_dropped, (unsigned long long)can_mb.drain_limited,
+                   (unsigned)can_mb.drain_max);
         }
         if (a.hist_path && write_hist(a.hist_path, e) != 0) {
             fprintf(stderr, "sonocomp: --hist %s: %s\n", a.hist_path, strerror(errno));

@@ -130,6 +130,14 @@ static int port_recv(void *ctx, sc_can_frame *out)
     return sc_can_rxmb_take(&p->mb, out);
 }
 
+static int port_filters(void *ctx, const sc_can_filter *filters, size_t count)
+{
+    /* acceptance filters stay the transport's (SocketCAN: the kernel's); frames already in
+     * the mailboxes were accepted under the old ones, as in a controller */
+    const sc_can_rxmb_port *p = ctx;
+    return sc_can_set_filters(&p->src, filters, count);
+}
+
 static int port_state(void *ctx, sc_can_state *st, sc_can_counters *c)
 {
     const sc_can_rxmb_port *p = ctx;
@@ -144,6 +152,7 @@ static int port_state(void *ctx, sc_can_state *st, sc_can_counters *c)
 
 sc_can_dev sc_can_rxmb_port_dev(sc_can_rxmb_port *p)
 {
-    static const sc_can_ops ops = {.send = port_send, .recv = port_recv, .get_state = port_state};
+    static const sc_can_ops ops = {
+        .send = port_send, .recv = port_recv, .set_filters = port_filters, .get_state = port_state};
     return (sc_can_dev){.ops = &ops, .ctx = p};
 }

@@ -1,7 +1,7 @@
 /*
  * sc_can_rxmb.h: a CAN controller's receive mailboxes in front of the engine, for the transports
- * whose own queue is one long FIFO (CAN over UDP: the socket's buffer holds seconds of tracker
- * frames, and a command behind them waits for all of them).
+ * whose own queue is one long FIFO (CAN over UDP, SocketCAN: the socket's buffer holds seconds
+ * of tracker frames, and a command behind them waits for all of them).
  *
  * The platform drains its transport into the mailboxes every frame (sc_can_rxmb_put, nothing is
  * left in the socket), then the engine takes from them (sc_can_rxmb_take) as from a controller:
@@ -78,8 +78,10 @@ uint32_t sc_can_rxmb_depth(const sc_can_rxmb *mb);
 uint32_t sc_can_rxmb_drain(sc_can_rxmb *mb, const sc_can_dev *src, uint32_t max, uint64_t ts_ns);
 
 /* A device with the mailboxes in front of a transport's receive side: each recv drains src
- * (at most drain_max frames) and takes from the mailboxes; send and get_state go to src. For
- * the engine's device when the transport is CAN over UDP (sonocomp --can-udp). */
+ * (at most drain_max frames) and takes from the mailboxes; send, set_filters and get_state go
+ * to src (get_state adds the mailboxes' losses to rx_dropped). The engine's device when the
+ * transport is CAN over UDP (sonocomp --can-udp) or SocketCAN (sonocomp, the kernel's socket
+ * queue being one FIFO too): frames keep the transport's receive stamps. */
 typedef struct sc_can_rxmb_port {
     sc_can_rxmb mb;
     sc_can_dev src;

@@ -16,7 +16,10 @@
  *   frame from two clock reads added the time between the reads to each stamp; a preemption
  *   there, 139 us measured in the HIL VM, put frames 96 us apart out of order, issue #19.)
  * - Kernel drops (SO_RXQ_OVFL) counted in sc_can_counters.rx_dropped.
- * The engine drains at most SC_CAN_RX_BURST_MAX frames per frame through recv (non-blocking).
+ * The engine takes at most SC_CAN_RX_BURST_MAX frames per frame through recv (non-blocking);
+ * sonocomp puts sc_can_rxmb.h's receive mailboxes in front of the node (the socket drained at
+ * each receive, commands first, the newest poses win), so a command never waits behind a
+ * stall's worth of queued tracker frames.
  *
  * Syscalls live behind sc_socketcan_sys (open/filter/recv/send/close/read_clocks), so the logic
  * (frame conversion, error mapping, state, filters, time stamp conversion) is unit-tested with a

@@ -15,9 +15,14 @@ command -v teem-unu >/dev/null || { echo "e2e: teem-unu missing (tools/install-d
 rm -rf "$work" && mkdir -p "$work"
 map=$(/usr/bin/python3 "$src/tests/casebuild/write_e2e_volumes.py" "$work/in")
 "$cb" import --volume "$work/in/nrrd/vol.nrrd" --labels "$work/in/nrrd/lab.nrrd" --label-map "$map" -o "$work/nrrd.scase"
-"$cb" import --volume "$work/in/mha/vol.mhd" --labels "$work/in/mha/lab.mha" -o "$work/mha.scase"
+# (this one with a vessel drive: a DRIV section the engine loads and applies at the case swap)
+"$cb" import --volume "$work/in/mha/vol.mhd" --labels "$work/in/mha/lab.mha" -o "$work/mha.scase" \
+    --heart-rate 90 --pulse-kpa 6 --breathing 18 --venous-swing-kpa 0.3 --valsalva-kpa 5
 "$cb" import --volume "$work/in/dicom" --labels "$work/in/mha/lab.mha" -o "$work/dicom.scase"
 fail=0
+"$cb" info "$work/mha.scase" | grep -q "vessel drive  *heart 90 / min, pulse 6.0 kPa, arterial waveform, breathing 18 / min, venous swing 0.30 kPa, Valsalva 5.0 kPa" ||
+    { echo "e2e: mha: the drive given to import is not in the case" >&2; fail=1; }
+"$cb" info "$work/nrrd.scase" | grep -q "vessel drive  *none" || { echo "e2e: nrrd: a drive nobody asked for" >&2; fail=1; }
 ref=""
 for f in nrrd mha dicom; do
     "$cb" slice "$work/$f.scase" --axis y --labels -o "$work/$f-labels.pgm"

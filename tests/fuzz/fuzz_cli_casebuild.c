@@ -53,6 +53,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         SC_FUZZ_CHECK(finite_all(o.tracker_to_patient.r, 9) &&
                       finite_all(o.tracker_to_patient.t_mm, 3));
         SC_FUZZ_CHECK(!o.has_mesh_box || finite_all(o.mesh_box_mm, 6));
+        /* the vessel drive options: what the case loader accepts (sc_case_drive.h) */
+        SC_FUZZ_CHECK(!o.has_drive || sc_lumen_drive_validate(&o.drive) == SC_OK);
     }
     sc_fuzz_argv_free(&av);
     return 0;
@@ -67,6 +69,8 @@ size_t sc_fuzz_seed(uint32_t i, uint8_t *buf, size_t cap)
         "--registration|1,0,0,0,-1,0,0,0,-1,0,0,0|--calibration|1,0,0,0,1,0,0,0,1,0,0,0",
         "--mesh-box|0,0,0,40,20,30|--description|d|-o|x.scase",
         "--window|nan:inf|--spacing|1e-30|--mesh-nodes|-1,2,2",
+        "--heart-rate|80|--pulse-kpa|5.5|--waveform|sine|--breathing|14|--venous-swing-kpa|0.4",
+        "--valsalva-kpa|12|--heart-rate|19|--breathing|0|--pulse-kpa|nan|--waveform|square",
     };
     return sc_fuzz_argv_seed(lines, sizeof lines / sizeof lines[0], i, buf, cap);
 }

@@ -1,8 +1,9 @@
 /* test_sc_socketcan.c: the SocketCAN node's logic over a fake syscall adapter (this host's
  * kernel has no CAN): frame conversion both ways, error frames -> classes and bus state,
  * kernel filters, FD gating, drop counting, bus-off refusal, and the conversion of the kernel's
- * REALTIME stamps to the MONOTONIC base (order kept, steps found). The real adapter runs in
- * the VM. */
+ * REALTIME stamps to the MONOTONIC base (order kept, steps found), and the node behind the
+ * receive mailboxes as sonocomp runs it (a command queued behind a stall's pose frames comes
+ * first, the newest poses win, everything counted). The real adapter runs in the VM. */
 #include "sc_test.h"
 
 #include <string.h>
@@ -10,16 +11,19 @@
 #include <linux/can.h>
 #include <linux/can/error.h>
 
+#include "sc_can_rxmb.h"
 #include "sc_err.h"
 #include "sc_socketcan.h"
+
+#define FAKE_RXQ 320 /* a stall's worth of queued tracker frames */
 
 typedef struct fake {
     int open_rc;
     int fd_capable;
-    sc_socketcan_raw rxq[8];
-    int rx_fd[8];
-    uint64_t rx_ts[8];
-    uint32_t rx_drops[8];
+    sc_socketcan_raw rxq[FAKE_RXQ];
+    int rx_fd[FAKE_RXQ];
+    uint64_t rx_ts[FAKE_RXQ];
+    uint32_t rx_drops[FAKE_RXQ];
     int rx_n, rx_i;
     sc_socketcan_raw tx[8];
     int tx_fd[8];
@@ -392,6 +396,99 @@ static void open_fails_and_closes_when_the_clocks_cannot_be_read(void **state)
     assert_int_equal(s.handle, -1);
 }
 
+/* sonocomp's SocketCAN device: the node behind the receive mailboxes (sc_can_rxmb_port). The
+ * kernel queue holds a stall's worth of pose frames (300, 3 s of one 100 Hz stream) with a
+ * command, its MAC and an error frame queued behind them: one receive drains the socket, the
+ * command block and the error frame come out first in their order, then the newest 64 poses
+ * in order with their kernel stamps; every frame is counted and the kernel filters still reach
+ * the socket. Without the mailboxes the command would come 300 frames (5 engine frames) late. */
+static void a_command_behind_a_stall_of_poses_is_taken_first_through_the_mailboxes(void **state)
+{
+    (void)state;
+    fake fk = {.open_rc = 5};
+    sc_socketcan s;
+    assert_int_equal(sc_socketcan_open(&s, &fake_sys, &fk, "vcan0"), 0);
+    static sc_can_rxmb_port port;
+    const sc_can_rxmb_def def = sc_can_rxmb_default_def();
+    assert_int_equal(sc_can_rxmb_port_init(&port, &def, sc_socketcan_dev(&s), 4096u), 0);
+    const sc_can_dev dev = sc_can_rxmb_port_dev(&port);
+
+    const sc_can_filter flt = {.id = 0x100, .mask = 0x7FE, .flags = 0};
+    assert_int_equal(sc_can_set_filters(&dev, &flt, 1), 0);
+    assert_int_equal(fk.filt_n, 1);
+    assert_int_equal(fk.filt[0].can_id, 0x100);
+
+    const uint64_t t0 = 1700000000000000000ull; /* REALTIME ns */
+    for (int i = 0; i < 300; i++) {
+        push_rx(&fk, (uint32_t)(0x100 + (i & 1)), 8, 0, t0 + (uint64_t)i * 10000000u, 0);
+        fk.rxq[fk.rx_n - 1].data[0] = (uint8_t)i;
+    }
+    push_rx(&fk, 0x081, 8, 0, t0 + 3000000000ull, 0); /* a command */
+    push_rx(&fk, 0x100, 8, 0, t0 + 3000500000ull, 2); /* a pose; the kernel dropped 2 */
+    push_rx(&fk, 0x089, 8, 0, t0 + 3001000000ull, 0); /* its MAC */
+    push_rx(&fk, CAN_ERR_FLAG | CAN_ERR_CRTL, 8, 0, t0 + 3002000000ull, 0);
+    fk.rxq[fk.rx_n - 1].data[1] = CAN_ERR_CRTL_RX_WARNING;
+
+    sc_can_frame fr;
+    assert_int_equal(sc_can_recv(&dev, &fr), 0);
+    assert_int_equal(fr.id, 0x081);
+    assert_int_equal(fk.rx_i, fk.rx_n); /* the socket drained in one receive */
+    const uint64_t t_cmd = fr.ts_ns;
+    assert_true(t_cmd != 0u);
+    assert_int_equal(sc_can_recv(&dev, &fr), 0);
+    assert_int_equal(fr.id, 0x089);
+    assert_int_equal(fr.ts_ns - t_cmd, 1000000u); /* kernel stamps kept, on one base */
+    assert_int_equal(sc_can_recv(&dev, &fr), 0);
+    assert_true(fr.flags & SC_CAN_FLAG_ERR);
+    assert_true(fr.id & SC_CAN_ERRF_WARNING);
+    /* then the newest 64 stream frames, oldest first: poses 237..299 and the one after the
+     * command */
+    uint64_t prev = 0;
+    for (int i = 0; i < 64; i++) {
+        assert_int_equal(sc_can_recv(&dev, &fr), 0);
+        assert_true(fr.id == 0x100 || fr.id == 0x101);
+        if (i < 63) {
+            assert_int_equal(fr.data[0], (uint8_t)(237 + i));
+        } else {
+            assert_int_equal(fr.ts_ns - t_cmd, 500000u);
+        }
+        assert_true(fr.ts_ns > prev);
+        prev = fr.ts_ns;
+    }
+    assert_int_equal(sc_can_recv(&dev, &fr), SC_ERR_WOULD_BLOCK);
+
+    const sc_can_rxmb_counters *c = &port.mb.c;
+    assert_int_equal(c->put, 304);
+    assert_int_equal(c->prio_taken, 3);
+    assert_int_equal(c->stream_taken, 64);
+    assert_int_equal(c->stream_overwritten, 301 - 64);
+    assert_int_equal(c->prio_dropped, 0);
+    assert_int_equal(c->put, c->prio_taken + c->stream_taken + c->stream_overwritten);
+    assert_int_equal(s.rx_frames, 303);
+    assert_int_equal(s.rx_error_frames, 1);
+    sc_can_state st;
+    sc_can_counters cc;
+    assert_int_equal(sc_can_get_state(&dev, &st, &cc), 0);
+    assert_int_equal(st, SC_CAN_STATE_ERROR_WARNING);
+    assert_int_equal(cc.rx_dropped, 2u + (301u - 64u)); /* the kernel's and the mailboxes' */
+
+    /* a bounded drain: 10 frames at most per receive, the rest stays in the socket */
+    fake fk2 = {.open_rc = 6};
+    sc_socketcan s2;
+    assert_int_equal(sc_socketcan_open(&s2, &fake_sys, &fk2, "vcan0"), 0);
+    static sc_can_rxmb_port port2;
+    assert_int_equal(sc_can_rxmb_port_init(&port2, &def, sc_socketcan_dev(&s2), 10u), 0);
+    const sc_can_dev dev2 = sc_can_rxmb_port_dev(&port2);
+    for (int i = 0; i < 25; i++) {
+        push_rx(&fk2, 0x100, 8, 0, t0 + (uint64_t)i, 0);
+    }
+    assert_int_equal(sc_can_recv(&dev2, &fr), 0);
+    assert_int_equal(fk2.rx_i, 10);
+    assert_int_equal(port2.drain_limited, 1);
+    sc_socketcan_close(&s);
+    sc_socketcan_close(&s2);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -405,6 +502,7 @@ int main(void)
         cmocka_unit_test(kernel_stamps_keep_order_and_distance_when_a_clock_reading_is_preempted),
         cmocka_unit_test(a_realtime_step_reestimates_the_offset_and_is_counted),
         cmocka_unit_test(open_fails_and_closes_when_the_clocks_cannot_be_read),
+        cmocka_unit_test(a_command_behind_a_stall_of_poses_is_taken_first_through_the_mailboxes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -10,6 +10,8 @@
  *                [--depth-axis AX] [--lateral-axis AX] [--label-map V=NAME,...]
  *                [--max-voxels N] [--allow-data-path yes]
  *                [--calibration 12 numbers] [--registration 12 numbers] (row-major R, then t)
+ *                [--heart-rate BPM] [--pulse-kpa KPA] [--waveform arterial|sine]
+ *                [--breathing BPM] [--venous-swing-kpa KPA] [--valsalva-kpa KPA] (DRIV section)
  *   sc-casebuild reconstruct --sequence SEQ.igs.mha -o OUT.scase [--transform NAME]
  *                [--image-to-probe 12 numbers] [--recon-spacing MM] [--splat nearest|trilinear]
  *                [--fill-passes N] [--volume-out V.mha] [import options]
@@ -64,6 +66,11 @@ static int usage(void)
             "               [--allow-data-path yes] (data files outside the header's folder)\n"
             "               [--calibration R00,..,R22,TX,TY,TZ]  (image -> probe, mm)\n"
             "               [--registration R00,..,R22,TX,TY,TZ] (tracker -> patient, mm)\n"
+            "               [--heart-rate BPM] (0 none, 20..250) [--pulse-kpa KPA] (0..20)\n"
+            "               [--waveform arterial|sine] [--breathing BPM] (0 none, 4..60)\n"
+            "               [--venous-swing-kpa KPA] (0..5) [--valsalva-kpa KPA] (0..10)\n"
+            "               (the patient's vessel drive, a DRIV section: the options given\n"
+            "                change the engine's default drive; none given, no DRIV)\n"
             "               (FILE: .mha, .mhd, .nrrd, .nhdr, raw or compressed; .dcm or a DICOM\n"
             "                series folder when built with DCMTK)\n"
             "  sc-casebuild reconstruct --sequence SEQ.igs.mha -o OUT.scase [--transform NAME]\n"
@@ -452,10 +459,75 @@ static int parse_floats(const char *s, float *v, int n)
     return *s == '\0' ? 0 : -1;
 }
 
+/* A drive option's number: the whole string, finite, and 0 (none; when zero_none) or within
+ * [lo, hi] (sc_lumen_drive_validate's ranges, in the option's unit). */
+static int drive_num(const char *opt, const char *s, int zero_none, double lo, double hi,
+                     const char *unit, float *out)
+{
+    char *end;
+    errno = 0;
+    const double v = strtod(s, &end);
+    if (errno || end == s || *end || !isfinite(v) ||
+        !((zero_none && !(v < 0.0) && !(v > 0.0)) || (v >= lo && v <= hi))) {
+        fprintf(stderr, "sc-casebuild: %s '%s': %s%g..%g %s\n", opt, s,
+                zero_none ? "0 (none) or " : "", lo, hi, unit);
+        return -1;
+    }
+    *out = (float)v;
+    return 0;
+}
+
+/* The vessel drive options (the case's DRIV section): 0 taken, 1 not one, 2 bad value (a
+ * message printed). The first one given starts the drive from sc_lumen_drive_default(). */
+static int parse_drive_opt(const char *a, const char *val, sc_import_opts *o)
+{
+    sc_lumen_drive d = o->has_drive ? o->drive : sc_lumen_drive_default();
+    float v = 0.0f;
+    int rc = 0;
+    if (strcmp(a, "--heart-rate") == 0) {
+        rc = drive_num(a, val, 1, 20.0, 250.0, "beats per minute", &d.heart_rate_bpm);
+    } else if (strcmp(a, "--pulse-kpa") == 0) {
+        rc = drive_num(a, val, 0, 0.0, 20.0, "kPa (arterial pulse pressure)", &v);
+        d.pulse_pa = v * 1e3f;
+    } else if (strcmp(a, "--waveform") == 0) {
+        if (strcmp(val, "arterial") != 0 && strcmp(val, "sine") != 0) {
+            fprintf(stderr, "sc-casebuild: --waveform '%s': arterial or sine\n", val);
+            return 2;
+        }
+        d.wave = (uint8_t)(val[0] == 's' ? SC_LUMEN_WAVE_SINE : SC_LUMEN_WAVE_ARTERIAL);
+    } else if (strcmp(a, "--breathing") == 0) {
+        rc = drive_num(a, val, 1, 4.0, 60.0, "breaths per minute", &d.resp_rate_bpm);
+    } else if (strcmp(a, "--venous-swing-kpa") == 0) {
+        rc = drive_num(a, val, 0, 0.0, 5.0, "kPa (venous respiratory swing)", &v);
+        d.resp_pa = v * 1e3f;
+    } else if (strcmp(a, "--valsalva-kpa") == 0) {
+        rc = drive_num(a, val, 0, 0.0, 10.0, "kPa (venous rise in a Valsalva manoeuvre)", &v);
+        d.valsalva_pa = v * 1e3f;
+    } else {
+        return 1;
+    }
+    if (rc != 0) {
+        return 2;
+    }
+    const int vrc = sc_lumen_drive_validate(&d); /* the loader's rules, to the last bit */
+    if (vrc != SC_OK) {
+        fprintf(stderr, "sc-casebuild: %s '%s': the vessel drive is refused (%s)\n", a, val,
+                sc_err_name(vrc));
+        return 2;
+    }
+    o->drive = d;
+    o->has_drive = 1;
+    return 0;
+}
+
 /* One option of import (also taken by reconstruct): 0 taken, 1 not an import option,
  * 2 bad value (a message printed). */
 static int parse_import_opt(const char *a, const char *val, sc_import_opts *o, const char **out)
 {
+    const int drc = parse_drive_opt(a, val, o);
+    if (drc != 1) {
+        return drc;
+    }
     if (strcmp(a, "-o") == 0) {
         *out = val;
     } else if (strcmp(a, "--volume") == 0) {
@@ -583,7 +655,7 @@ static int cmd_import(int argc, char **argv)
         return 1;
     }
     print_import(out, &r);
-    rc = write_case_file(&r.def, NULL, out);
+    rc = write_case_file(&r.def, o.has_drive ? &o.drive : NULL, out);
     sc_import_result_free(&r);
     return rc;
 }
@@ -709,7 +781,7 @@ static int cmd_reconstruct(int argc, char **argv)
         return 1;
     }
     print_import(out, &r);
-    rc = write_case_file(&r.def, NULL, out);
+    rc = write_case_file(&r.def, o.has_drive ? &o.drive : NULL, out);
     sc_import_result_free(&r);
     return rc;
 }

@@ -20,6 +20,7 @@
 
 #include "sc_case.h"
 #include "sc_image.h"
+#include "sc_lumen.h"
 
 /* Ceilings of the readers, checked before anything is allocated or inflated: a header that
  * declares more voxels than max_voxels is refused (the reader holds 8 bytes per voxel, plus
@@ -87,6 +88,12 @@ typedef struct sc_import_opts {
                                   * default: the tracker emulator's frame (Z up out of the body,
                                   * a half turn about x from the case frame, as the phantoms)
                                   * with its origin at the top centre of the mesh box */
+    /* The patient's vessel drive, written as the case's DRIV section (sc_case_drive.h) when
+     * has_drive: sc-casebuild's drive options start from sc_lumen_drive_default() and change
+     * what they name. 0: no DRIV (the engine keeps the drive it has). sc_import_case ignores
+     * both; the writer takes them. */
+    int has_drive;
+    sc_lumen_drive drive;
 } sc_import_opts;
 
 typedef struct sc_import_result {
