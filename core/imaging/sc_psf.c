@@ -10,8 +10,9 @@
 #define SC_PSF_TB        0.8825f /* Gaussian time-bandwidth product of -6 dB widths, 4 ln2 / pi */
 #define SC_PSF_FWHM_SIG  2.3548f /* FWHM / sigma of a Gaussian */
 #define SC_PSF_DOF       7.1f    /* depth of field of a focused aperture, lambda F^2 units */
-#define SC_PSF_LOG_BIAS  2.5068f /* dB: E[10 log10 I] below 10 log10 E[I], I exponential */
 #define SC_PSF_DB_LOG2   3.0103f /* 10 log10(2) */
+/* uniform in [-1, 1) from 16 bits; I and Q of variance 1/2 each (E|s|^2 = 1) need sqrt 1.5 */
+#define SC_PSF_U16 (1.2247449f / 32768.0f)
 
 sc_psf_def sc_psf_default_def(void)
 {
@@ -41,7 +42,7 @@ static void gauss_taps(float sigma, uint32_t h, float *w)
 
 static uint32_t half_of(float sigma, uint32_t most)
 {
-    const float h = ceilf(2.5f * sigma);
+    const float h = ceilf(2.0f * sigma); /* the Gaussian to 2 sigma: 95 % of its area */
     return h < 1.0f ? 1u : (h > (float)most ? most : (uint32_t)h);
 }
 
@@ -100,12 +101,26 @@ int sc_psf_setup(sc_psf *p, const sc_psf_def *def, const sc_scan_def *scan,
         p->widths.lateral_fwhm_mm[b] = w;
         p->widths.band_depth_mm[b] = z;
     }
+    /* the taps per sample (0 beyond its band's half-width), for straight loops over a line */
+    p->lat_max = 1u;
+    for (uint32_t b = 0; b < SC_PSF_BANDS; b++) {
+        p->lat_max = p->lat_half[b] > p->lat_max ? p->lat_half[b] : p->lat_max;
+    }
+    memset(p->lat_wk, 0, sizeof p->lat_wk);
+    for (uint32_t b = 0; b < SC_PSF_BANDS; b++) {
+        const uint32_t off = p->lat_max - p->lat_half[b];
+        for (uint32_t j = 0; j <= 2u * p->lat_half[b]; j++) {
+            for (uint32_t k = p->band_k0[b]; k < p->band_k0[b + 1u]; k++) {
+                p->lat_wk[off + j][k] = p->lat_w[b][j];
+            }
+        }
+    }
     /* grey <-> amplitude: grey 255 + (255 / R) 20 log10 A */
     for (uint32_t g = 0; g < 256u; g++) {
         p->amp[g] = powf(10.0f, ((float)g - 255.0f) * dynamic_range_db / (255.0f * 20.0f));
     }
     p->out_a = 255.0f * SC_PSF_DB_LOG2 / dynamic_range_db;
-    p->out_b = 255.0f + 255.0f * SC_PSF_LOG_BIAS / dynamic_range_db;
+    p->out_b = 255.0f;
     /* lattice: one sample deep, one line wide (at the focus), the slice in elevation */
     const float pitch_f = curved ? (scan->radius_mm + focus_mm) * geom->line_pitch : geom->line_pitch;
     p->cell_mm[0] = pitch_f > 1e-3f ? pitch_f : 1e-3f;
@@ -134,31 +149,44 @@ static inline uint32_t mix32(uint32_t x)
     return x;
 }
 
+/* A cell's 32 random bits: the lattice index spread by odd constants, then one multiply-xorshift
+ * round (neighbouring cells come out uncorrelated; test_sc_psf checks the statistics). */
 static inline uint32_t cell_hash(int32_t ix, int32_t iy, int32_t iz, uint32_t seed)
 {
-    return mix32((uint32_t)ix * 0x8da6b343u ^ (uint32_t)iy * 0xd8163841u ^
-                 (uint32_t)iz * 0xcb1ab31fu ^ seed);
+    uint32_t x = ((uint32_t)ix * 0x9e3779b1u) ^ ((uint32_t)iy * 0x85ebca77u) ^
+                 ((uint32_t)iz * 0xc2b2ae3du) ^ seed;
+    x ^= x >> 15;
+    x *= 0x2c1b3c6du;
+    x ^= x >> 12;
+    return x;
 }
 
-/* uniform in [-1, 1) from 16 bits; I and Q of variance 1/2 each (E|s|^2 = 1) need sqrt 1.5 */
-#define SC_PSF_U16 (1.2247449f / 32768.0f)
+
+/* floor for |x| < 2^31 without a library call (SSE2 has no floor instruction) */
+static inline int32_t floor_i32(float x)
+{
+    const int32_t i = (int32_t)x;
+    return i - ((float)i > x ? 1 : 0);
+}
 
 void sc_psf_span(sc_psf *p, uint32_t k0, uint32_t k1, const float a[3], const float b[3])
 {
     const uint32_t seed = mix32(p->def.seed);
     const float ci0 = p->cell_inv[0], ci1 = p->cell_inv[1], ci2 = p->cell_inv[2];
     float *sre = p->sre + SC_PSF_MAX_AX_HALF, *sim = p->sim + SC_PSF_MAX_AX_HALF;
-    for (uint32_t k = k0; k < k1 && k < p->samples_n; k++) {
+    k1 = k1 < p->samples_n ? k1 : p->samples_n;
+    for (uint32_t k = k0; k < k1; k++) {
         const float s = (float)k;
         const float X = (a[0] + s * b[0]) * ci0, Y = (a[1] + s * b[1]) * ci1,
                     Z = (a[2] + s * b[2]) * ci2;
-        const float fy = floorf(Y);
-        const int32_t ix = (int32_t)floorf(X), iy = (int32_t)fy, iz = (int32_t)floorf(Z);
-        const float f = Y - fy;
+        const int32_t ix = floor_i32(X), iy = floor_i32(Y), iz = floor_i32(Z);
+        const float f = Y - (float)iy;
         const uint32_t h0 = cell_hash(ix, iy, iz, seed), h1 = cell_hash(ix, iy + 1, iz, seed);
-        /* linear along y at unit variance */
+        /* linear along y at unit variance: 1 / sqrt(w0^2 + w1^2) = 1 / sqrt(0.5 + 2u),
+         * u = (f - 1/2)^2 in [0, 1/4], by the quadratic through u = 0, 1/8, 1/4 (< 0.6 %) */
         const float w1 = f, w0 = 1.0f - f;
-        const float nrm = SC_PSF_U16 / sqrtf(w0 * w0 + w1 * w1);
+        const float u = (f - 0.5f) * (f - 0.5f);
+        const float nrm = SC_PSF_U16 * (1.4142136f + u * (-2.4953f + u * 3.3539f));
         const float r0 = (float)((int32_t)(h0 & 0xffffu) - 32768),
                     q0 = (float)((int32_t)(h0 >> 16) - 32768);
         const float r1 = (float)((int32_t)(h1 & 0xffffu) - 32768),
@@ -178,17 +206,18 @@ void sc_psf_line_in(sc_psf *p, uint32_t l, const uint8_t *grey)
         sre[k] *= A;
         sim[k] *= A;
     }
-    float *ore = p->re[slot], *oim = p->im[slot];
-    const float *w = p->ax_w;
+    float *restrict ore = p->re[slot], *restrict oim = p->im[slot];
     for (uint32_t k = 0; k < n; k++) {
-        float r = 0.0f, q = 0.0f;
-        const float *xr = sre + k - h, *xq = sim + k - h;
-        for (uint32_t j = 0; j <= 2u * h; j++) {
-            r += w[j] * xr[j];
-            q += w[j] * xq[j];
+        ore[k] = 0.0f;
+        oim[k] = 0.0f;
+    }
+    for (uint32_t j = 0; j <= 2u * h; j++) { /* tap by tap: straight loops over k */
+        const float wj = p->ax_w[j];
+        const float *restrict xr = sre + j - h, *restrict xq = sim + j - h;
+        for (uint32_t k = 0; k < n; k++) {
+            ore[k] += wj * xr[k];
+            oim[k] += wj * xq[k];
         }
-        ore[k] = r;
-        oim[k] = q;
     }
     for (uint32_t k = 0; k < n; k++) { /* the next line's spans fill it again */
         sre[k] = 0.0f;
@@ -226,33 +255,40 @@ static inline float fast_log2(float x)
     return e + (-0.34484843f * m + 2.02466578f) * m - 1.67487759f;
 }
 
-void sc_psf_line_out(const sc_psf *p, uint32_t m, uint8_t *out)
+void sc_psf_line_out(sc_psf *p, uint32_t m, uint8_t *out)
 {
-    const uint32_t slot = m % SC_PSF_RING;
+    const uint32_t slot = m % SC_PSF_RING, n = p->samples_n;
     const uint8_t *tis = p->tissue[slot], *hk = p->hooked[slot];
     const int32_t last = (int32_t)p->lines_n - 1;
-    const float *pr[SC_PSF_RING], *pq[SC_PSF_RING];
-    for (uint32_t b = 0; b < SC_PSF_BANDS; b++) {
-        const uint32_t k0 = p->band_k0[b], k1 = p->band_k0[b + 1u], h = p->lat_half[b];
-        const float *w = p->lat_w[b];
-        for (uint32_t j = 0; j <= 2u * h; j++) {
-            int32_t ln = (int32_t)m + (int32_t)j - (int32_t)h;
-            ln = ln < 0 ? 0 : (ln > last ? last : ln); /* the edge line repeated */
-            const uint32_t s = (uint32_t)ln % SC_PSF_RING;
-            pr[j] = p->re[s];
-            pq[j] = p->im[s];
+    float *restrict r = p->sre, *restrict q = p->sim; /* scratch: the line going in is done */
+    const uint32_t h = p->lat_max;
+    for (uint32_t k = 0; k < n; k++) {
+        r[k] = 0.0f;
+        q[k] = 0.0f;
+    }
+    for (uint32_t j = 0; j <= 2u * h; j++) { /* tap by tap, each sample its depth's weight */
+        int32_t ln = (int32_t)m + (int32_t)j - (int32_t)h;
+        ln = ln < 0 ? 0 : (ln > last ? last : ln); /* the edge line repeated */
+        const uint32_t s = (uint32_t)ln % SC_PSF_RING;
+        const float *restrict wj = p->lat_wk[j];
+        const float *restrict xr = p->re[s], *restrict xq = p->im[s];
+        for (uint32_t k = 0; k < n; k++) {
+            r[k] += wj[k] * xr[k];
+            q[k] += wj[k] * xq[k];
         }
-        for (uint32_t k = k0; k < k1; k++) {
-            float r = 0.0f, q = 0.0f;
-            for (uint32_t j = 0; j <= 2u * h; j++) {
-                r += w[j] * pr[j][k];
-                q += w[j] * pq[j][k];
-            }
-            const float e2 = r * r + q * q + 1e-30f;
-            float g = p->out_a * fast_log2(e2) + p->out_b;
-            g = g < 0.0f ? 0.0f : (g > 255.0f ? 255.0f : g);
-            const uint8_t v = tis[k] == 0u ? 0u : (uint8_t)(g + 0.5f);
-            out[k] = hk[k] != tis[k] ? hk[k] : v;
-        }
+    }
+    const float oa = p->out_a, ob = p->out_b + 0.5f;
+    for (uint32_t k = 0; k < n; k++) { /* envelope, log compression: straight float */
+        const float e2 = r[k] * r[k] + q[k] * q[k] + 1e-30f;
+        const float g = oa * fast_log2(e2) + ob;
+        r[k] = g < 0.0f ? 0.0f : (g > 255.0f ? 255.0f : g);
+    }
+    for (uint32_t k = 0; k < n; k++) {
+        const uint8_t v = tis[k] == 0u ? 0u : (uint8_t)(int32_t)r[k];
+        out[k] = hk[k] != tis[k] ? hk[k] : v;
+    }
+    for (uint32_t k = 0; k < n; k++) { /* the next line's spans fill them again */
+        r[k] = 0.0f;
+        q[k] = 0.0f;
     }
 }

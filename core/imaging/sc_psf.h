@@ -18,17 +18,17 @@
  *    w_rx = lambda F (F = focus / aperture), w_tx(z) = w_rx sqrt(1 + ((z - focus) / z_R)^2) with
  *    z_R half the depth of field 7.1 lambda F^2, two-way w = (w_tx^-2 + w_rx^-2)^-1/2: narrowest
  *    at the focus (w_rx / sqrt 2), w_rx far from it.
- * The envelope |I + jQ| is log-compressed back to grey (with the Rayleigh log bias of 2.51 dB
- * given back, so a uniform region keeps its mean grey): fully developed speckle, mean / std of
- * the envelope 1.91. Pixels at 0 (air) stay 0. What a line hook (colour Doppler, the needle)
+ * The envelope |I + jQ| is log-compressed back to grey: fully developed speckle, mean / std of
+ * the envelope 1.91; the mean intensity is the volume's (so the mean of the log image lies
+ * 2.51 dB below the voxel's grey, as with the phantom builder's baked speckle). Pixels at 0 (air) stay 0. What a line hook (colour Doppler, the needle)
  * drew stays as it drew it.
  *
  * Lateral convolution needs the lines beside: the pass holds SC_PSF_RING lines in flight and a
  * line leaves SC_PSF_MAX_LAT_HALF lines after it was computed (sc_psf_line_ready); the frame
  * still streams every line in order.
  *
- * Memory: the caller's sc_psf (SC_PSF_RING lines of I, Q and two grey planes: about 66 KiB
- * with 512 samples). Never allocates, never calls the OS. Deterministic (float32, fixed order,
+ * Memory: the caller's sc_psf (SC_PSF_RING lines of I, Q, two grey planes and the taps'
+ * weights per sample: about 93 KiB with 512 samples). Never allocates, never calls the OS. Deterministic (float32, fixed order,
  * hashed scatterers). Threads: one writer. Compile-time switch SC_BSCAN_PSF (config/sc_config.h).
  */
 #ifndef SC_PSF_H
@@ -71,6 +71,8 @@ typedef struct sc_psf {
     uint32_t band_k0[SC_PSF_BANDS + 1u];
     uint32_t lat_half[SC_PSF_BANDS];
     float lat_w[SC_PSF_BANDS][SC_PSF_RING];
+    uint32_t lat_max;                                       /* largest half-width */
+    _Alignas(64) float lat_wk[SC_PSF_RING][SC_MAX_SCAN_SAMPLES]; /* tap j's weight per sample */
     float amp[256];      /* grey -> linear amplitude */
     float out_a, out_b;  /* grey = out_a log2(|z|^2) + out_b */
     float cell_mm[3];    /* scatterer lattice cell */
@@ -114,8 +116,9 @@ void sc_psf_line_hooked(sc_psf *p, uint32_t l, const uint8_t *grey);
  * after the last line of a frame until it answers -1 to flush. O(1). */
 int32_t sc_psf_line_ready(const sc_psf *p, uint32_t last_in, uint32_t next_out);
 
-/* Line m's speckled grey into out (samples_n bytes): lateral convolution and envelope.
- * O(samples * lateral taps). */
-void sc_psf_line_out(const sc_psf *p, uint32_t m, uint8_t *out);
+/* Line m's speckled grey into out (samples_n bytes): lateral convolution and envelope (uses
+ * the span scratch: call between sc_psf_line_in and the next line's spans). O(samples *
+ * lateral taps). */
+void sc_psf_line_out(sc_psf *p, uint32_t m, uint8_t *out);
 
 #endif /* SC_PSF_H */
