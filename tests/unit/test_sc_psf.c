@@ -310,6 +310,78 @@ static void bad_psf_settings_are_rejected(void **state)
     assert_int_equal(sc_bscan_init(&g_b, &d), SC_ERR_RANGE);
 }
 
+/* The field lives in the rest configuration: tissue slid 4 line pitches sideways under the probe
+ * (a mesh over the image, every node moved) carries its speckle along: the deformed image's line
+ * l is the rest image's line l - 4, and no longer its own line l. */
+static sc_mesh g_mesh;
+static sc_nodes g_nodes;
+
+static float shifted_correlation(const float *a, const float *b, window w, uint32_t shift)
+{
+    double sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
+    uint32_t n = 0;
+    for (uint32_t l = w.l0; l < w.l1; l++) {
+        for (uint32_t k = w.k0; k < w.k1; k++) {
+            const double x = a[l * SAMPLES + k], y = b[(l - shift) * SAMPLES + k];
+            sa += x;
+            sb += y;
+            saa += x * x;
+            sbb += y * y;
+            sab += x * y;
+            n++;
+        }
+    }
+    const double ca = saa / n - (sa / n) * (sa / n), cb = sbb / n - (sb / n) * (sb / n);
+    return (float)((sab / n - (sa / n) * (sb / n)) / sqrt(ca * cb));
+}
+
+static void image_mesh(const sc_bscan_def *d, float *env)
+{
+    assert_int_equal(sc_bscan_init(&g_b, d), SC_OK);
+    assert_int_equal(sc_bscan_attach_mesh(&g_b, &g_mesh), SC_OK);
+    sc_hs_display_init(&g_disp);
+    const sc_display_dev dev = sc_hs_display_dev(&g_disp);
+    const sc_xform probe = sc_xform_identity();
+    assert_int_equal(sc_bscan_frame(&g_b, &g_mesh, &g_nodes, &g_vol, &probe, 1, &dev, 1u), SC_OK);
+    for (uint32_t i = 0; i < LINES * SAMPLES; i++) {
+        const float g = (float)g_disp.last[i];
+        env[i] = powf(10.0f, (g - 255.0f) * RANGE_DB / (255.0f * 20.0f));
+    }
+}
+
+static void speckle_moves_with_the_tissue(void **state)
+{
+    (void)state;
+    volume_setup();
+    sc_mesh_def md = sc_mesh_default_def();
+    md.nx = 12u;
+    md.ny = 3u;
+    md.nz = 10u;
+    md.origin_mm[0] = -28.0f;
+    md.origin_mm[1] = -4.0f;
+    md.origin_mm[2] = -2.0f;
+    md.size_mm[0] = 56.0f;
+    md.size_mm[1] = 8.0f;
+    md.size_mm[2] = 44.0f;
+    assert_int_equal(sc_mesh_build(&g_mesh, &md), SC_OK);
+    sc_nodes_reset_to_rest(&g_nodes, &g_mesh);
+    const sc_bscan_def d = psf_def();
+    image_mesh(&d, g_env);
+    const float dx = 4.0f * WIDTH_MM / (float)LINES;
+    for (uint32_t i = 0; i < g_mesh.node_count; i++) {
+        g_nodes.x[i] += dx;
+    }
+    image_mesh(&d, g_env2);
+    const window w = depth_window(5.0f, 35.0f);
+    const float moved = shifted_correlation(g_env2, g_env, w, 4u);
+    const float still = shifted_correlation(g_env2, g_env, w, 0u);
+    print_message("tissue slid 4 lines: correlation with the rest image moved along %.3f, in "
+                  "place %.3f\n",
+                  (double)moved, (double)still);
+    assert_true(moved > 0.9f);
+    assert_true(still < 0.3f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -317,6 +389,7 @@ int main(void)
         cmocka_unit_test(tilted_probe_keeps_speckle_long_across_its_beam),
         cmocka_unit_test(speckle_is_fixed_in_tissue_and_decorrelates_out_of_plane),
         cmocka_unit_test(line_hook_drawing_survives_the_pass),
+        cmocka_unit_test(speckle_moves_with_the_tissue),
         cmocka_unit_test(bad_psf_settings_are_rejected),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
