@@ -158,16 +158,16 @@ static uint8_t label_at(const scene *s, float x, float y, float z, uint8_t *feat
         return SC_LABEL_FAT; /* carotid sheath and loose connective tissue */
     }
     /* groin: iliopsoas lateral (oblique medial border), pectineus medial, deep muscle */
-    /* the borders undulate gently (no straight edge shows in the image) */
-    if (x > 10.0f - 0.3f * (z - 12.0f) + 0.7f * sinf(z / 2.7f + y / 9.0f) &&
-        z > fb + 1.0f + 0.3f * sinf(x / 3.1f)) {
+    /* the borders undulate (about 1 mm over 7-16 mm) so no straight edge shows in the image */
+    if (x > 10.0f - 0.3f * (z - 12.0f) + 1.2f * sinf(z / 1.9f + y / 9.0f) &&
+        z > fb + 1.0f + 0.8f * sinf(x / 2.3f)) {
         return SC_LABEL_MUSCLE;
     }
-    if (x < -12.0f + 0.2f * (z - 20.0f) + 0.6f * sinf(z / 3.3f + 1.0f + y / 8.0f) &&
-        z > 20.0f + 0.8f * sinf(x / 4.3f)) {
+    if (x < -12.0f + 0.2f * (z - 20.0f) + 1.1f * sinf(z / 2.1f + 1.0f + y / 8.0f) &&
+        z > 20.0f + 1.2f * sinf(x / 2.6f)) {
         return SC_LABEL_MUSCLE;
     }
-    if (z > 27.0f + 1.5f * sinf(x / 10.0f)) {
+    if (z > 27.0f + 1.5f * sinf(x / 10.0f) + 0.6f * sinf(x / 2.4f + y / 6.0f)) {
         return SC_LABEL_MUSCLE;
     }
     return SC_LABEL_FAT;
