@@ -143,6 +143,12 @@ _Static_assert((1u << SC_SPRINGS_HASH_BITS) >= 2u * SC_MAX_SPRINGS,
 #endif
 
 /* ---- B-scan synthesis (sc_bscan) --------------------------------------------------------- */
+/* Speckle from a scatterer field and the beam's PSF (core/imaging/sc_psf.h): its lines in
+ * flight cost 13 x SC_MAX_SCAN_SAMPLES x 10 B (66 KiB at 512 samples, 16.6 KiB at the MCU's
+ * 128); 0 leaves it out (sc_bscan_def.psf = 1 is then rejected). */
+#ifndef SC_BSCAN_PSF
+#define SC_BSCAN_PSF 1
+#endif
 /* Image regions of the paper's fast path (section IV: R = 32 measured best). */
 #ifndef SC_BSCAN_REGIONS_DEFAULT
 #define SC_BSCAN_REGIONS_DEFAULT 32u

@@ -786,6 +786,10 @@ static int swap_case(sc_engine *e, uint32_t slot)
     bd.scan.image_to_probe = e->sw.c.image_to_probe;
     /* the case says whether its volume holds the acoustics or the engine adds them */
     bd.acoustics = (e->sw.c.imaging_flags & SC_CASE_IMAGING_ENGINE_ACOUSTICS) != 0u ? 1u : 0u;
+    /* and whether the engine forms the speckle (an MCU build without SC_BSCAN_PSF shows the
+     * volume's mean echogenicity) */
+    bd.psf = SC_BSCAN_PSF && (e->sw.c.imaging_flags & SC_CASE_IMAGING_ENGINE_SPECKLE) != 0u ? 1u
+                                                                                           : 0u;
     bd.scan.depth_mm = case_imaging_depth_mm(e, &e->sw.c, &bd.scan);
     /* a method command during the build applies to the new tissue too */
     int rc = sc_tissue_set_method(&e->tissue[slot], e->def.tissue.method);

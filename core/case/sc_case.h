@@ -94,7 +94,10 @@ _Static_assert(SC_CASE_INFO_SIZE == 1024u, "INFO payload size");
                                                attenuation, interfaces and TGC along the beam
                                                (sc_acoustics.h); clear: the volume holds them
                                                (real-patient volumes) */
-#define SC_CASE_IMAGING_KNOWN            SC_CASE_IMAGING_ENGINE_ACOUSTICS
+#define SC_CASE_IMAGING_ENGINE_SPECKLE   2u /* the voxels hold mean echogenicity without speckle:
+                                               the engine forms it from its scatterer field and
+                                               the beam's PSF (sc_psf.h) */
+#define SC_CASE_IMAGING_KNOWN (SC_CASE_IMAGING_ENGINE_ACOUSTICS | SC_CASE_IMAGING_ENGINE_SPECKLE)
 
 /* GRID usable imaging depth (f32 at GRID offset 12, formerly reserved zero, so older files read
  * as "not stated"): how deep below the skin the image stays on the case's data, mm; 0: not

@@ -51,6 +51,8 @@ sc_bscan_def sc_bscan_default_def(void)
                                  a press into (the appliance's 64x32x32 boxes are 30-45 mm) */
     d.acoustics = 0u;
     d.acoustic = sc_acoustics_default_def();
+    d.psf = 0u;
+    d.psf_def = sc_psf_default_def();
     return d;
 }
 
@@ -76,7 +78,8 @@ static int check_def(const sc_bscan_def *d)
     if (d->mapper >= (uint32_t)SC_BSCAN_MAP_COUNT || d->regions_n < 1u ||
         d->regions_n > SC_BSCAN_MAX_REGIONS || !db_ok(d->gain_db, -60.0f, 60.0f) ||
         !db_ok(d->dynamic_range_db, 10.0f, 120.0f) || !db_ok(d->volume_range_db, 10.0f, 120.0f) ||
-        !db_ok(d->rest_margin_mm, 0.0f, 60.0f) || d->acoustics > 1u || !(d->focus_mm > 0.0f) ||
+        !db_ok(d->rest_margin_mm, 0.0f, 60.0f) || d->acoustics > 1u ||
+        d->psf > (SC_BSCAN_PSF ? 1u : 0u) || !(d->focus_mm > 0.0f) ||
         d->focus_mm > 300.0f) {
         return SC_ERR_RANGE;
     }
@@ -128,6 +131,15 @@ int sc_bscan_set_def(sc_bscan *b, const sc_bscan_def *def)
     if (rc != SC_OK) {
         return rc;
     }
+#if SC_BSCAN_PSF
+    if (def->psf != 0u) {
+        rc = sc_psf_setup(&b->psf, &def->psf_def, &def->scan, &g_new, def->focus_mm,
+                          def->acoustic.frequency_mhz, def->dynamic_range_db);
+        if (rc != SC_OK) {
+            return rc;
+        }
+    }
+#endif
     b->acou = acou;
     b->geom = g_new;
     b->def = *def;
@@ -1553,6 +1565,41 @@ static void rest_labels(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
     }
 }
 
+static int emit_line(sc_bscan *b, const sc_display_dev *disp, uint32_t frame_no, uint32_t l,
+                     int rc);
+
+#if SC_BSCAN_PSF
+/* The speckle pass's input (sc_psf.h): the line's rest positions, span by span, and its grey. */
+static void psf_line_in(sc_bscan *b, const frame_ctx *c)
+{
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < b->run_count; i++) {
+        const sc_bscan_run *r = &b->runs[i];
+        if (k < r->k0) {
+            sc_psf_span(&b->psf, k, r->k0, c->f0, c->fd);
+        }
+        sc_psf_span(&b->psf, r->k0, r->k1, r->a, r->b);
+        k = r->k1;
+    }
+    sc_psf_span(&b->psf, k, c->n, c->f0, c->fd);
+    sc_psf_line_in(&b->psf, c->line, b->line_out);
+}
+
+/* After line l: hand the hook's drawing over, emit the lines whose neighbours are all in. */
+static int psf_emit(sc_bscan *b, const sc_display_dev *disp, uint32_t frame_no, uint32_t l,
+                    uint32_t *next_out, int rc)
+{
+    sc_psf_line_hooked(&b->psf, l, b->line_out);
+    int32_t m;
+    while ((m = sc_psf_line_ready(&b->psf, l, *next_out)) >= 0) {
+        sc_psf_line_out(&b->psf, (uint32_t)m, b->line_out);
+        rc = emit_line(b, disp, frame_no, (uint32_t)m, rc);
+        (*next_out)++;
+    }
+    return rc;
+}
+#endif
+
 /* The whole line: mesh runs at their rest positions, the gaps rigid; then label areas. */
 static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, const frame_ctx *c,
                         area_acc *acc)
@@ -1607,6 +1654,11 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
         /* along the beam as it runs now: the labels are this frame's (deformed) ones */
         sc_acoustics_line(&b->acou, b->line_label, b->line_out, n);
     }
+#if SC_BSCAN_PSF
+    if (b->def.psf != 0u) {
+        psf_line_in(b, c);
+    }
+#endif
     if (b->line_hook != NULL) {
         /* the labels are still this frame's (deformed) ones here */
         const sc_bscan_line_view lv = {
@@ -1819,6 +1871,13 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
     area_acc acc;
     memset(&acc, 0, sizeof acc);
     uint32_t active_n = 0;
+    uint32_t psf_next = 0;
+    (void)psf_next;
+#if SC_BSCAN_PSF
+    if (b->def.psf != 0u) {
+        sc_psf_frame_begin(&b->psf, volume->spacing_mm);
+    }
+#endif
     for (uint32_t l = 0; l < lines; l++) {
         c.line = l;
         c.ox = b->geom.start_x_mm[l];
@@ -1854,6 +1913,12 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
             }
         }
         sample_line(b, &vc, volume, &c, &acc);
+#if SC_BSCAN_PSF
+        if (b->def.psf != 0u) {
+            rc = psf_emit(b, display, frame_no, l, &psf_next, rc);
+            continue;
+        }
+#endif
         rc = emit_line(b, display, frame_no, l, rc);
     }
     /* areas: sum over pixels of the pixel area, from counts (exact integers) */

@@ -63,6 +63,7 @@
 #include "sc_labels.h"
 #include "sc_mesh.h"
 #include "sc_pose.h"
+#include "sc_psf.h"
 #include "sc_scan_geom.h"
 #include "sc_volume.h"
 
@@ -96,6 +97,10 @@ typedef struct sc_bscan_def {
                                   0: the volume already holds them (real-patient volumes, the baked
                                   phantoms) */
     sc_acoustics_def acoustic; /* per-label table, frequency, TGC reference */
+    uint32_t psf;              /* 1: speckle from the rest-configuration scatterer field and the
+                                  beam's point spread (sc_psf.h; needs SC_BSCAN_PSF); 0: the
+                                  volume's own texture */
+    sc_psf_def psf_def;        /* pulse bandwidth, aperture, slice thickness, seed */
 } sc_bscan_def;
 
 /* Labels whose area the compression measure follows (all labels are counted). */
@@ -241,6 +246,9 @@ typedef struct sc_bscan {
      * line sampler: one call per line), padded to a multiple of 8 */
     SC_ALIGN_HOT uint32_t pos_h[3][SC_MAX_SCAN_SAMPLES + 8u];
     sc_acoustics acou; /* tables of def.acoustic for this geometry and range */
+#if SC_BSCAN_PSF
+    sc_psf psf; /* speckle pass: kernels and the lines in flight */
+#endif
     sc_bscan_status status;
 } sc_bscan;
 

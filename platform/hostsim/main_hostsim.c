@@ -108,7 +108,7 @@ static void usage(FILE *f)
             "  --call normal|dvt[@T_S]  the trainee's call (CmdAssessment, signed with the bench\n"
             "                       key) at T_S (default 0.5 s before the end)\n"
             "  --every N            write every N-th frame as PNG (default 6; 0: none)\n"
-            "  --png-size WxH       PNG raster (default 480x640)\n"
+            "  --png-size WxH       PNG canvas (default 480x640); a PNG is the image's box in it\n"
             "  --frame-raw FILE     also write the deepest-compression frame as a raw frame file\n"
             "  --quiet              no per-second progress\n"
             "  --live               release frames at wall-clock time (the engine keeps the\n"
@@ -519,7 +519,7 @@ static int write_frame_png(const options *o, sc_scanconv *conv, uint8_t *raster,
     if (d->colour_lines > 0u && d->last_info.frame_no == d->info.frame_no) {
         /* colour Doppler of the same frame: RGB, the colour plane packed to the image stride */
         static int8_t colour[SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES];
-        uint8_t *rgb = malloc(3u * (size_t)conv->width * conv->height);
+        uint8_t *rgb = malloc(3u * (size_t)conv->cap_w * conv->cap_h); /* fit: width <= cap_w */
         if (rgb != NULL) {
             const uint32_t n = d->last_info.samples;
             for (uint32_t l = 0; l < d->last_info.lines; l++) {
@@ -877,6 +877,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "sc-hostsim: out of memory\n");
         return 1;
     }
+    sc_scanconv_set_fit(&conv, 1); /* the PNG is the image's box: no black band below it */
     static uint8_t deepest[SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES];
     sc_display_frame_info deepest_info = {0};
     float min_vein = 2.0f, artery_at_min = -1.0f, deepest_z = -1e30f;

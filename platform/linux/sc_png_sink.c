@@ -243,6 +243,7 @@ int sc_png_sink_open(sc_png_sink **out, const sc_png_sink_def *def)
         free(s);
         return SC_ERR_IO;
     }
+    sc_scanconv_set_fit(&s->conv, 1); /* a PNG is the image's box: no black band below it */
     pthread_mutex_init(&s->lock, NULL);
     pthread_cond_init(&s->cond, NULL);
     if (pthread_create(&s->thread, NULL, writer_main, s) != 0) {

@@ -22,7 +22,7 @@ typedef struct sc_png_sink sc_png_sink;
 
 typedef struct sc_png_sink_def {
     const char *dir;     /* must exist */
-    uint32_t width_px;   /* raster; 0: 512 */
+    uint32_t width_px;   /* canvas; 0: 512 (a file is the image's box in it) */
     uint32_t height_px;  /* 0: 512 */
     uint32_t every_n;    /* write every n-th frame (by frame number); 0 or 1: all */
     uint32_t max_frames; /* stop writing after this many files; 0: no limit */

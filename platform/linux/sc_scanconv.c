@@ -14,9 +14,51 @@ int sc_scanconv_init(sc_scanconv *c, uint32_t width, uint32_t height)
     if (!c->lut) {
         return -1;
     }
-    c->width = width;
-    c->height = height;
+    c->width = c->cap_w = width;
+    c->height = c->cap_h = height;
     return 0;
+}
+
+void sc_scanconv_set_fit(sc_scanconv *c, int on)
+{
+    c->fit = on != 0;
+    c->valid = 0;
+    if (!c->fit) {
+        c->width = c->cap_w;
+        c->height = c->cap_h;
+    }
+}
+
+/* The image's physical box (mm): linear width x depth; curvilinear the fan's bounding box. */
+static void image_box_mm(const sc_display_frame_info *g, double *w_mm, double *h_mm)
+{
+    const double d_mm = g->depth_mm > 0.0f ? g->depth_mm : 1.0;
+    if (g->geometry_id == 1u) {
+        const double r0 = g->radius_mm > 0.0f ? g->radius_mm : 0.0;
+        const double r1 = r0 + d_mm;
+        const double half = (g->width_mm > 0.0f ? g->width_mm : 60.0) * M_PI / 360.0;
+        *w_mm = 2.0 * r1 * sin(half);
+        *h_mm = r1 - r0 * cos(half);
+    } else {
+        *w_mm = g->width_mm > 0.0f ? g->width_mm : 1.0;
+        *h_mm = d_mm;
+    }
+}
+
+static uint32_t fit_side(double mm, double s, uint32_t cap)
+{
+    const double px = floor(mm / s + 1e-6);
+    return px < 1.0 ? 1u : (px > (double)cap ? cap : (uint32_t)px);
+}
+
+void sc_scanconv_fit_size(const sc_display_frame_info *info, uint32_t cap_w, uint32_t cap_h,
+                          uint32_t *w, uint32_t *h)
+{
+    double w_mm, h_mm;
+    image_box_mm(info, &w_mm, &h_mm);
+    const double s = fmax(w_mm / cap_w, h_mm / cap_h); /* mm per pixel in the canvas */
+    *w = fit_side(w_mm, s, cap_w);
+    *h = fit_side(h_mm, s, cap_h);
 }
 
 void sc_scanconv_free(sc_scanconv *c)
@@ -112,6 +154,9 @@ void sc_scanconv_render_colour(sc_scanconv *c, const sc_display_frame_info *info
 static void ensure_lut(sc_scanconv *c, const sc_display_frame_info *info, uint32_t stride)
 {
     if (!c->valid || c->stride != stride || !same_geom(&c->geom, info)) {
+        if (c->fit) {
+            sc_scanconv_fit_size(info, c->cap_w, c->cap_h, &c->width, &c->height);
+        }
         if (info->geometry_id == 1u) {
             build_sector(c, info, stride);
         } else {
@@ -126,16 +171,7 @@ static void ensure_lut(sc_scanconv *c, const sc_display_frame_info *info, uint32
 void sc_scanconv_render(sc_scanconv *c, const sc_display_frame_info *info, const uint8_t *image,
                         uint32_t stride, uint8_t *out)
 {
-    if (!c->valid || c->stride != stride || !same_geom(&c->geom, info)) {
-        if (info->geometry_id == 1u) {
-            build_sector(c, info, stride);
-        } else {
-            build_linear(c, info, stride);
-        }
-        c->geom = *info;
-        c->stride = stride;
-        c->valid = 1;
-    }
+    ensure_lut(c, info, stride);
     const size_t n = (size_t)c->width * c->height;
     for (size_t i = 0; i < n; i++) {
         const uint32_t v = c->lut[i];

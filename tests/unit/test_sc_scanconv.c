@@ -198,11 +198,82 @@ static void linear_targets_land_on_their_pixel(void **state)
     sc_scanconv_free(&c);
 }
 
+/* Fit mode (the PNG sinks): a 38 x 39 mm linear image in a 480 x 640 canvas was drawn 480 x 492
+ * with 148 black rows below it; fitted, the raster is the image's box: every row and column
+ * holds image (the background 90), at the canvas's scale, the targets on their pixels. A
+ * curvilinear fan's box: image on the bottom row's centre and, at the face arc's ends, on the top rows. */
+static void fit_raster_is_the_image_box_with_no_black_band(void **state)
+{
+    (void)state;
+    sc_scan_def s = sc_scan_default_def();
+    s.lines_n = 128u;
+    s.samples_n = 400u;
+    s.width_mm = 38.0f;
+    s.depth_mm = 39.0f;
+    const target t[2] = {{-12.0f, 6.0f}, {9.0f, 36.0f}};
+    make_phantom(t, 2);
+    image(&s);
+    static uint8_t big[480u * 640u];
+    sc_scanconv c;
+    assert_int_equal(sc_scanconv_init(&c, 480u, 640u), 0);
+    /* the fixed canvas: black rows below the image */
+    sc_scanconv_render(&c, &g_disp.last_info, g_disp.last, s.samples_n, big);
+    assert_int_equal(big[(size_t)639u * 480u + 240u], 0u);
+    sc_scanconv_set_fit(&c, 1);
+    sc_scanconv_render(&c, &g_disp.last_info, g_disp.last, s.samples_n, big);
+    const float mm_px = fmaxf(38.0f / 480.0f, 39.0f / 640.0f);
+    assert_int_equal(c.width, 480u);
+    assert_int_equal(c.height, (uint32_t)(39.0f / mm_px + 1e-3f));
+    uint32_t w = 0, h = 0;
+    sc_scanconv_fit_size(&g_disp.last_info, 480u, 640u, &w, &h);
+    assert_int_equal(w, c.width);
+    assert_int_equal(h, c.height);
+    for (uint32_t y = 0; y < c.height; y++) {
+        for (uint32_t x = 0; x < c.width; x++) {
+            assert_true(big[(size_t)y * c.width + x] != 0u);
+        }
+    }
+    for (int q = 0; q < 2; q++) {
+        const float px = 0.5f * (float)c.width + t[q].x_mm / mm_px, py = t[q].z_mm / mm_px;
+        float x, y;
+        bright_centroid(big, c.width, c.height, px, py, 12.0f, &x, &y);
+        assert_float_equal(x, px, 1.5f);
+        assert_float_equal(y, py, 1.5f);
+    }
+    /* back to the canvas */
+    sc_scanconv_set_fit(&c, 0);
+    sc_scanconv_render(&c, &g_disp.last_info, g_disp.last, s.samples_n, big);
+    assert_int_equal(c.height, 640u);
+
+    sc_scan_def cs = sc_scan_curvilinear_default_def();
+    cs.lines_n = 128u;
+    cs.samples_n = 400u;
+    cs.radius_mm = 40.0f;
+    cs.sector_deg = 60.0f;
+    cs.depth_mm = 50.0f;
+    make_phantom(t, 0);
+    image(&cs);
+    sc_scanconv_set_fit(&c, 1);
+    sc_scanconv_render(&c, &g_disp.last_info, g_disp.last, cs.samples_n, big);
+    assert_int_equal(c.width, 480u);
+    assert_true(c.height < 640u);
+    const uint32_t last = c.height - 1u;
+    assert_true(big[(size_t)last * c.width + c.width / 2u] != 0u);
+    /* the face arc's ends touch the top rows */
+    uint32_t top_hits = 0;
+    for (uint32_t i = 0; i < 2u * c.width; i++) {
+        top_hits += big[i] != 0u;
+    }
+    assert_true(top_hits > 0u);
+    sc_scanconv_free(&c);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(curvilinear_targets_land_on_their_line_sample_and_pixel),
         cmocka_unit_test(linear_targets_land_on_their_pixel),
+        cmocka_unit_test(fit_raster_is_the_image_box_with_no_black_band),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -217,6 +217,29 @@ static void print_acoustics_row(const sc_xform *probe, int frames)
            mn[0], med[0], mn[1], med[1], mn[1] - mn[0]);
 }
 
+/* The speckle pass (sc_psf.h) on the target case: its cost is the frame with it minus the
+ * frame without it (min of N). */
+static void print_psf_row(const sc_xform *probe, int frames)
+{
+    double med[2], worst[2], mn[2];
+    for (int on = 0; on < 2; on++) {
+        build_mesh(32, 16, 16);
+        scn_deform(&g_mesh, &g_nodes, SCN_DEFORM_DENT, 10.0f);
+        sc_bscan_def d = sc_bscan_default_def();
+        d.psf = (uint32_t)on;
+        if (sc_bscan_init(&g_b, &d) != SC_OK) {
+            printf("psf: not built (SC_BSCAN_PSF 0)\n");
+            return;
+        }
+        sc_bscan_attach_mesh(&g_b, &g_mesh);
+        time_frames(probe, frames, &med[on], &worst[on]);
+        mn[on] = g_last_min;
+    }
+    printf("psf speckle (32x16x16 256x512 walk): off min %.3f / median %.3f ms, on min %.3f / "
+           "median %.3f ms (+%.3f ms min)\n",
+           mn[0], med[0], mn[1], med[1], mn[1] - mn[0]);
+}
+
 /* Colour + pulsed-wave Doppler (sc_doppler.h) on the target case: its cost is the frame with the
  * line hook minus the frame without it, default box (half the lines, 65 % of the depth) and the
  * whole image as box; the probe rolled 20 degrees about x so the vessels (along y) carry colour. */
@@ -376,6 +399,7 @@ int main(int argc, char **argv)
         qsort(t, (size_t)nf, sizeof t[0], cmp_double);
         printf("        same pose, no mesh (rigid): min %.3f, median %.3f ms\n", t[0], t[nf / 2]);
         print_acoustics_row(&probe, frames);
+        print_psf_row(&probe, frames);
         print_doppler_row(frames);
         print_needle_row(&probe, frames);
         return 0;
@@ -431,6 +455,7 @@ int main(int argc, char **argv)
     printf("walk/regions: this engine's mappers (walk = default); rigid: sampling and display "
            "processing alone (mean); paper: Table I volume sampling, quad-core laptop 2012\n");
     print_acoustics_row(&probe, frames);
+    print_psf_row(&probe, frames);
     print_doppler_row(frames);
     print_needle_row(&probe, frames);
 

@@ -2,7 +2,7 @@
  *
  *   sc-casebuild phantom <neck-ijv|femoral|femoral-dvt> -o OUT.scase [--seed N] [--spacing MM]
  *                        [--mesh-nodes NX,NY,NZ] (the same mesh box at another resolution)
- *                        [--acoustics engine|baked]
+ *                        [--acoustics engine|baked] [--speckle engine|baked]
  *   sc-casebuild import --volume V.{mha,mhd,nrrd,nhdr,dcm}|DICOMDIR/ [--labels L.{...}] -o
  * OUT.scase
  *                [--name NAME] [--description TEXT] [--spacing MM] [--window LO:HI]
@@ -56,6 +56,8 @@ static int usage(void)
             "               [--mesh-nodes NX,NY,NZ]  (the phantom's mesh box at this resolution)\n"
             "               [--acoustics engine|baked]  (engine: the engine computes shadows and\n"
             "               enhancement along the beam; baked, the default: in the voxels)\n"
+            "               [--speckle engine|baked]  (engine: the engine forms the speckle from\n"
+            "               its scatterers and the beam's PSF; baked, the default: in the voxels)\n"
             "  sc-casebuild import --volume FILE [--labels FILE] -o OUT.scase [--name NAME]\n"
             "               [--description TEXT] [--spacing MM] [--window LO:HI]\n"
             "               [--mesh-nodes NX,NY,NZ] [--mesh-box X0,Y0,Z0,SX,SY,SZ]\n"
@@ -392,6 +394,13 @@ static int cmd_phantom(int argc, char **argv)
                 return 2;
             }
             pd.engine_acoustics = strcmp(a, "engine") == 0;
+        } else if (strcmp(argv[i], "--speckle") == 0 && i + 1 < argc) {
+            const char *a = argv[++i];
+            if (strcmp(a, "engine") != 0 && strcmp(a, "baked") != 0) {
+                fprintf(stderr, "sc-casebuild: --speckle wants engine or baked, got '%s'\n", a);
+                return 2;
+            }
+            pd.engine_speckle = strcmp(a, "engine") == 0;
         } else if (strcmp(argv[i], "--mesh-nodes") == 0 && i + 1 < argc) {
             const char *val = argv[++i];
             char buf[64];

@@ -152,19 +152,22 @@ static uint8_t label_at(const scene *s, float x, float y, float z, uint8_t *feat
             return SC_LABEL_MUSCLE;
         }
         /* prevertebral / scalene muscle in the depth */
-        if (z > 25.0f + 2.0f * sinf(x / 9.0f)) {
+        if (z > 25.0f + 2.0f * sinf(x / 9.0f) + 0.4f * sinf(x / 2.9f + y / 7.0f)) {
             return SC_LABEL_MUSCLE;
         }
         return SC_LABEL_FAT; /* carotid sheath and loose connective tissue */
     }
     /* groin: iliopsoas lateral (oblique medial border), pectineus medial, deep muscle */
-    if (x > 10.0f - 0.3f * (z - 12.0f) && z > fb + 1.0f) {
+    /* the borders undulate (about 1 mm over 7-16 mm) so no straight edge shows in the image */
+    if (x > 10.0f - 0.3f * (z - 12.0f) + 1.2f * sinf(z / 1.9f + y / 9.0f) &&
+        z > fb + 1.0f + 0.8f * sinf(x / 2.3f)) {
         return SC_LABEL_MUSCLE;
     }
-    if (x < -12.0f + 0.2f * (z - 20.0f) && z > 20.0f) {
+    if (x < -12.0f + 0.2f * (z - 20.0f) + 1.1f * sinf(z / 2.1f + 1.0f + y / 8.0f) &&
+        z > 20.0f + 1.2f * sinf(x / 2.6f)) {
         return SC_LABEL_MUSCLE;
     }
-    if (z > 27.0f + 1.5f * sinf(x / 10.0f)) {
+    if (z > 27.0f + 1.5f * sinf(x / 10.0f) + 0.6f * sinf(x / 2.4f + y / 6.0f)) {
         return SC_LABEL_MUSCLE;
     }
     return SC_LABEL_FAT;
@@ -418,13 +421,30 @@ int sc_phantom_generate(const sc_phantom_def *pd, sc_phantom *out)
     normalize_unit_rms(re, n);
     normalize_unit_rms(im, n);
     normalize_unit_rms(fib, n);
-    /* Rayleigh amplitude, normalised to unit mean square */
+    /* Rayleigh amplitude, normalised to unit mean square; with the engine's speckle the voxels
+     * hold the mean (the engine's scatterers and PSF give the texture) */
     for (size_t i = 0; i < n; i++) {
-        re[i] = sqrtf(0.5f * (re[i] * re[i] + im[i] * im[i]));
+        re[i] = pd->engine_speckle ? 1.0f : sqrtf(0.5f * (re[i] * re[i] + im[i] * im[i]));
     }
 
-    /* 3. echo amplitude per voxel: reflectivity x speckle, plus specular interfaces */
+    /* 3. echo amplitude per voxel: reflectivity x speckle, plus specular interfaces.
+     * Smooth anatomy: a voxel on a boundary (a face neighbour of another label or part) takes
+     * the mean reflectivity of 3 x 3 x 3 points inside it (anti-aliased edges, no voxel
+     * staircase); the fascia (an interface across the beam within fascia_r) is a band of its
+     * own, blurred over about 0.3 mm before it is added, so it runs as a smooth curve. */
     const int fascia_r = (int)lrintf(0.4f / sp) > 0 ? (int)lrintf(0.4f / sp) : 1;
+    float *fas = calloc(n, sizeof(float));
+    if (fas == NULL) {
+        free(labels);
+        free(feats);
+        free(vox);
+        free(re);
+        free(im);
+        free(fib);
+        free(line);
+        return SC_ERR_NO_SPACE;
+    }
+    const size_t sy = dim[0], sz = (size_t)dim[0] * dim[1];
     for (uint32_t k = 0; k < dim[2]; k++) {
         float z = PH_Z0 + sp * (float)k;
         for (uint32_t j = 0; j < dim[1]; j++) {
@@ -433,22 +453,45 @@ int sc_phantom_generate(const sc_phantom_def *pd, sc_phantom *out)
                 float x = PH_X0 + sp * (float)i;
                 size_t idx = i + (size_t)dim[0] * (j + (size_t)dim[1] * k);
                 uint8_t l = labels[idx];
-                float r = reflectivity(&s, l, feats[idx], x, y, z, fib[idx],
-                                       im[idx] > -0.3f ? 1.0f : 0.0f);
+                const float fat_w = im[idx] > -0.3f ? 1.0f : 0.0f;
+                int edge = 0;
+                if (i > 0u && i + 1u < dim[0] && j > 0u && j + 1u < dim[1] && k > 0u &&
+                    k + 1u < dim[2]) {
+                    const size_t nb[6] = {idx - 1u, idx + 1u, idx - sy, idx + sy, idx - sz,
+                                          idx + sz};
+                    for (int q = 0; q < 6 && !edge; q++) {
+                        edge = labels[nb[q]] != l || feats[nb[q]] != feats[idx];
+                    }
+                }
+                float r;
+                if (edge) {
+                    float acc = 0.0f;
+                    for (int c = 0; c < 27; c++) {
+                        const float px = x + sp * ((float)(c % 3) - 1.0f) / 3.0f,
+                                    py = y + sp * ((float)((c / 3) % 3) - 1.0f) / 3.0f,
+                                    pz = z + sp * ((float)(c / 9) - 1.0f) / 3.0f;
+                        uint8_t f2;
+                        const uint8_t l2 = label_at(&s, px, py, pz, &f2);
+                        acc += reflectivity(&s, l2, f2, px, py, pz, fib[idx], fat_w);
+                    }
+                    r = acc / 27.0f;
+                } else {
+                    r = reflectivity(&s, l, feats[idx], x, y, z, fib[idx], fat_w);
+                }
                 /* hyperechoic fascia: a tissue interface across the beam within fascia_r */
                 if (interface_label(l) && feats[idx] == 0u) {
                     for (int d = 1; d <= fascia_r; d++) {
                         if ((int64_t)k - d >= 0) {
-                            uint8_t u = labels[idx - (size_t)d * dim[0] * dim[1]];
+                            uint8_t u = labels[idx - (size_t)d * sz];
                             if (u != l && interface_label(u)) {
-                                r += 1.6f;
+                                fas[idx] = 1.6f;
                                 break;
                             }
                         }
                         if ((uint64_t)k + (uint64_t)d < dim[2]) {
-                            uint8_t u = labels[idx + (size_t)d * dim[0] * dim[1]];
+                            uint8_t u = labels[idx + (size_t)d * sz];
                             if (u != l && interface_label(u)) {
-                                r += 1.6f;
+                                fas[idx] = 1.6f;
                                 break;
                             }
                         }
@@ -458,10 +501,19 @@ int sc_phantom_generate(const sc_phantom_def *pd, sc_phantom *out)
                 if (l == SC_LABEL_BONE && k > 0u && z - bone_top_mm(&s, x) < 0.8f) {
                     r = 7.0f;
                 }
-                fib[idx] = r * re[idx];
+                im[idx] = r; /* im is not needed past this point */
             }
         }
     }
+    const uint32_t fr = (uint32_t)lrintf(0.15f / sp) > 0u ? (uint32_t)lrintf(0.15f / sp) : 1u;
+    blur_axis(fas, dim, 0, fr, line);
+    blur_axis(fas, dim, 1, fr, line);
+    blur_axis(fas, dim, 2, fr, line);
+    for (size_t i = 0; i < n; i++) {
+        /* no fascia inside bone's cortex */
+        fib[i] = (labels[i] == SC_LABEL_BONE ? im[i] : im[i] + fas[i]) * re[i];
+    }
+    free(fas);
 
     /* 4. attenuation along the beam (+z) with TGC; log compression to 8 bits */
     const float dr_db = 50.0f;  /* displayed dynamic range */
@@ -497,7 +549,8 @@ int sc_phantom_generate(const sc_phantom_def *pd, sc_phantom *out)
     out->vessels[1] = s.v[1];
     sc_case_def *d = &out->def;
     *d = sc_case_default_def();
-    d->imaging_flags = pd->engine_acoustics ? SC_CASE_IMAGING_ENGINE_ACOUSTICS : 0u;
+    d->imaging_flags = (pd->engine_acoustics ? SC_CASE_IMAGING_ENGINE_ACOUSTICS : 0u) |
+                       (pd->engine_speckle ? SC_CASE_IMAGING_ENGINE_SPECKLE : 0u);
     snprintf(out->name, sizeof out->name, "%s", kind_names[pd->kind]);
     const sc_phantom_vessel *vv = &s.v[0], *va = &s.v[1];
     const char *what =
@@ -542,19 +595,20 @@ int sc_phantom_generate(const sc_phantom_def *pd, sc_phantom *out)
     _Static_assert(sizeof mats / sizeof mats[0] == SC_LABEL_COUNT, "one material per label");
     d->material_count = SC_LABEL_COUNT;
     memcpy(d->materials, mats, sizeof mats);
-    /* mesh box around the vessels, from the skin down to above the bone */
-    d->mesh.nx = 24u;
+    /* mesh box around the vessels, from the skin down to above the bone. Across (x) it spans
+     * 46 mm, wider than the 38 mm image with the probe over the vessels: with the former
+     * 30 mm box the image's edges sampled undeformed tissue beyond the mesh and a flat press
+     * bent the shallow layers into a U there. The centre stays where it was (x -2 mm on the
+     * neck, 0 in the groin: the probe's place in the press scripts and tests); the cells stay
+     * 1.3 mm (24 nodes over 30 mm before): 34 nodes over 44 mm (neck, -24..20, the volume's
+     * edge), 36 over 46 mm (groin), 1.42x / 1.5x the nodes. */
+    const int neck = pd->kind == SC_PHANTOM_NECK_IJV;
+    d->mesh.nx = neck ? 34u : 36u;
     d->mesh.ny = 12u;
     d->mesh.nz = 12u;
-    if (pd->kind == SC_PHANTOM_NECK_IJV) {
-        d->mesh.origin_mm[0] = -17.0f;
-        d->mesh.size_mm[0] = 30.0f;
-        d->mesh.size_mm[2] = 30.0f;
-    } else {
-        d->mesh.origin_mm[0] = -15.0f;
-        d->mesh.size_mm[0] = 30.0f;
-        d->mesh.size_mm[2] = 32.0f;
-    }
+    d->mesh.origin_mm[0] = neck ? -24.0f : -23.0f;
+    d->mesh.size_mm[0] = neck ? 44.0f : 46.0f;
+    d->mesh.size_mm[2] = neck ? 30.0f : 32.0f;
     /* 30 mm across the probe's 10 mm face (y, its elevation axis): with 20 mm the box's
      * roller sides stood 5 mm beside the face and confined the tissue under a deep press
      * (24 mm of 32: the column under the face had nowhere to go but two 5 mm strips; its

@@ -34,6 +34,9 @@ typedef struct sc_phantom_def {
     int engine_acoustics; /* 1: echogenicity only, no attenuation or TGC in the voxels; the
                              case asks the engine for them (SC_CASE_IMAGING_ENGINE_ACOUSTICS),
                              so shadows and enhancement follow the beam. 0 (default): baked */
+    int engine_speckle;   /* 1: mean echogenicity without speckle in the voxels; the case asks
+                             the engine to form it (SC_CASE_IMAGING_ENGINE_SPECKLE, sc_psf.h).
+                             0 (default): speckle baked in the voxels */
 } sc_phantom_def;
 
 /* A vessel as generated (cross-section at y = 0; the centre drifts by dx_per_mm along y). */
