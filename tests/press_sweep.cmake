@@ -1,6 +1,6 @@
 # test_press_sweep(_fine) and test_physics_robust read the phantom cases that the `cases`
 # target builds into the build tree.
-foreach(_t test_press_sweep test_press_sweep_fine test_physics_robust test_bscan_flat_press)
+foreach(_t test_press_sweep test_press_sweep_fine test_physics_robust)
   if(TARGET ${_t} AND TARGET cases)
     add_dependencies(${_t} cases)
   endif()
