@@ -31,8 +31,8 @@ static inline __m256i pack_lo32(__m256i a, __m256i b)
 
 static inline lanes lanes_init(int64_t x, int64_t d)
 {
-    const __m256i p0 = _mm256_add_epi64(_mm256_set1_epi64x(x + SC_W_HALF),
-                                        _mm256_setr_epi64x(0, d, 2 * d, 3 * d));
+    const __m256i p0 =
+        _mm256_add_epi64(_mm256_set1_epi64x(x + SC_W_HALF), _mm256_setr_epi64x(0, d, 2 * d, 3 * d));
     const __m256i p1 = _mm256_add_epi64(p0, _mm256_set1_epi64x(4 * d));
     const __m256i m = _mm256_set1_epi64x(SC_LOW_MASK);
     const int64_t d8 = 8 * d;
@@ -73,24 +73,23 @@ static inline __m256i pair_level(__m256i g, int sh, __m256i tx)
 static inline __m256i display4(__m256i ifx4, __m256i la, const int64_t *lut, __m256i m64)
 {
     /* lanes past the span read nothing (the table may end there) */
-    const __m256i sum = _mm256_add_epi64(_mm256_mul_epi32(ifx4, la),
-                                         _mm256_maskload_epi64((const long long *)(const void *)lut,
-                                                               m64));
+    const __m256i sum =
+        _mm256_add_epi64(_mm256_mul_epi32(ifx4, la),
+                         _mm256_maskload_epi64((const long long *)(const void *)lut, m64));
     __m256i v = _mm256_srli_epi64(sum, 26);
     v = _mm256_blendv_epi8(v, _mm256_setzero_si256(),
                            _mm256_cmpgt_epi64(_mm256_set1_epi64x((int64_t)1 << 26), sum));
-    v = _mm256_blendv_epi8(
-        v, _mm256_set1_epi64x(255),
-        _mm256_cmpgt_epi64(sum, _mm256_set1_epi64x(((int64_t)255 << 26) - 1)));
+    v = _mm256_blendv_epi8(v, _mm256_set1_epi64x(255),
+                           _mm256_cmpgt_epi64(sum, _mm256_set1_epi64x(((int64_t)255 << 26) - 1)));
     return v;
 }
 
 /* the low byte of each of 8 dwords, to dst[0..8) */
 static inline void store_bytes(uint8_t *dst, __m256i v)
 {
-    const __m256i pick = _mm256_setr_epi8(0, 4, 8, 12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,
-                                          -1, 0, 4, 8, 12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,
-                                          -1, -1);
+    const __m256i pick =
+        _mm256_setr_epi8(0, 4, 8, 12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 0, 4, 8, 12,
+                         -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
     const __m256i p = _mm256_shuffle_epi8(v, pick);
     const int32_t lo = _mm256_cvtsi256_si32(p);
     const int32_t hi = _mm256_extract_epi32(p, 4);
@@ -98,87 +97,109 @@ static inline void store_bytes(uint8_t *dst, __m256i v)
     memcpy(dst + 4, &hi, 4);
 }
 
+/* The constants of the 8-sample step, set once per call. */
+typedef struct samp8 {
+    __m256i wmask, half, vsy, vsz, vsyz2, la, outside, three;
+    const int *vox, *labp;
+} samp8;
+
+static inline samp8 samp8_init(const vol_regs v)
+{
+    samp8 c;
+    c.wmask = _mm256_set1_epi32(SC_W_ONE - 1);
+    c.half = _mm256_set1_epi32(SC_W_ONE / 2 - 1);
+    c.vsy = _mm256_set1_epi32((int32_t)v.sy);
+    c.vsz = _mm256_set1_epi32((int32_t)v.sz);
+    c.vsyz2 = _mm256_set1_epi32((int32_t)(v.sy + v.sz) - 2);
+    c.la = _mm256_set1_epi64x(v.la);
+    c.outside = _mm256_set1_epi32(SC_LABEL_OUTSIDE);
+    c.three = _mm256_set1_epi32(3);
+    c.vox = (const int *)(const void *)v.vox;
+    c.labp = (const int *)(const void *)v.lab;
+    return c;
+}
+
+/* 8 samples at the position words px, py, pz (lanes m; the first r are stored): the trilinear
+ * level through lut[0..8) to out[0..r), the nearest voxel's label to lab_out[0..r). Shared by
+ * the span sampler (words from its 64-bit lanes) and the line sampler (words from memory). */
+static inline void sample8(const samp8 *c, __m256i px, __m256i py, __m256i pz, __m256i m,
+                           uint32_t r, const int64_t *lut, uint8_t *out, uint8_t *lab_out)
+{
+    const __m256i wmask = c->wmask, half = c->half, vsy = c->vsy, vsz = c->vsz, vsyz2 = c->vsyz2,
+                  la = c->la, outside = c->outside, three = c->three;
+    const int *vox = c->vox;
+    const int *labp = c->labp;
+    const __m256i tx = _mm256_and_si256(px, wmask);
+    const __m256i ty = _mm256_and_si256(py, wmask);
+    const __m256i tz = _mm256_and_si256(pz, wmask);
+    const __m256i base = _mm256_add_epi32(
+        _mm256_add_epi32(_mm256_srli_epi32(px, SC_W_BITS),
+                         _mm256_mullo_epi32(_mm256_srli_epi32(py, SC_W_BITS), vsy)),
+        _mm256_mullo_epi32(_mm256_srli_epi32(pz, SC_W_BITS), vsz));
+    /* 4 bytes from each row start; the last row from 2 before it (never past the end: the
+     * +1 neighbour of the last row is the volume's last byte at most) */
+    const __m256i z = _mm256_setzero_si256();
+    const __m256i g00 = _mm256_mask_i32gather_epi32(z, vox, base, m, 1);
+    const __m256i g10 = _mm256_mask_i32gather_epi32(z, vox, _mm256_add_epi32(base, vsy), m, 1);
+    const __m256i g01 = _mm256_mask_i32gather_epi32(z, vox, _mm256_add_epi32(base, vsz), m, 1);
+    const __m256i g11 = _mm256_mask_i32gather_epi32(z, vox, _mm256_add_epi32(base, vsyz2), m, 1);
+    const __m256i c00 = pair_level(g00, 0, tx), c10 = pair_level(g10, 0, tx);
+    const __m256i c01 = pair_level(g01, 0, tx), c11 = pair_level(g11, 16, tx);
+    const __m256i c0 = lerp(c00, c10, ty), c1 = lerp(c01, c11, ty);
+    const __m256i ifx = lerp(c0, c1, tz);
+    __m256i label;
+    if (labp != NULL) {
+        /* nearest voxel: + 1 where the weight is >= 1/2 */
+        const __m256i li =
+            _mm256_add_epi32(_mm256_add_epi32(base, _mm256_srli_epi32(tx, SC_W_BITS - 1)),
+                             _mm256_add_epi32(_mm256_and_si256(_mm256_cmpgt_epi32(ty, half), vsy),
+                                              _mm256_and_si256(_mm256_cmpgt_epi32(tz, half), vsz)));
+        /* the dword ending at the label (or starting at it near the array's start) */
+        const __m256i at = _mm256_max_epi32(_mm256_sub_epi32(li, three), z);
+        const __m256i g = _mm256_mask_i32gather_epi32(z, labp, at, m, 1);
+        label =
+            _mm256_and_si256(_mm256_srlv_epi32(g, _mm256_slli_epi32(_mm256_sub_epi32(li, at), 3)),
+                             _mm256_set1_epi32(0xff));
+    } else {
+        label = _mm256_set1_epi32(SC_LABEL_MUSCLE);
+    }
+    const __m256i d_lo = display4(_mm256_cvtepu32_epi64(_mm256_castsi256_si128(ifx)), la, lut,
+                                  _mm256_cvtepi32_epi64(_mm256_castsi256_si128(m)));
+    const __m256i d_hi = display4(_mm256_cvtepu32_epi64(_mm256_extracti128_si256(ifx, 1)), la,
+                                  lut + 4, _mm256_cvtepi32_epi64(_mm256_extracti128_si256(m, 1)));
+    /* the low dwords of the 8 int64 into 8 dwords, in order */
+    const __m256i sel = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
+    const __m256i disp = _mm256_blend_epi32(_mm256_permutevar8x32_epi32(d_lo, sel),
+                                            _mm256_permutevar8x32_epi32(d_hi, sel), 0xf0);
+    const __m256i shown = _mm256_andnot_si256(_mm256_cmpeq_epi32(label, outside), disp);
+    if (r == 8u) {
+        store_bytes(out, shown);
+        store_bytes(lab_out, label);
+    } else {
+        uint8_t t[16];
+        store_bytes(t, shown);
+        store_bytes(t + 8, label);
+        memcpy(out, t, r);
+        memcpy(lab_out, t + 8, r);
+    }
+}
+
 void sc_bscan_span_x86_64_v3(const vol_regs v, const int64_t *restrict lut_b_fx, uint32_t k0,
-                             uint32_t k1, int64_t X, int64_t Y, int64_t Z, int64_t DX,
-                             int64_t DY, int64_t DZ, uint8_t *restrict out,
-                             uint8_t *restrict lab_out)
+                             uint32_t k1, int64_t X, int64_t Y, int64_t Z, int64_t DX, int64_t DY,
+                             int64_t DZ, uint8_t *restrict out, uint8_t *restrict lab_out)
 {
     if (k1 <= k0) {
         return;
     }
     lanes lx = lanes_init(X, DX), ly = lanes_init(Y, DY), lz = lanes_init(Z, DZ);
-    const __m256i wmask = _mm256_set1_epi32(SC_W_ONE - 1);
-    const __m256i half = _mm256_set1_epi32(SC_W_ONE / 2 - 1);
-    const __m256i vsy = _mm256_set1_epi32((int32_t)v.sy);
-    const __m256i vsz = _mm256_set1_epi32((int32_t)v.sz);
-    const __m256i vsyz2 = _mm256_set1_epi32((int32_t)(v.sy + v.sz) - 2);
-    const __m256i la = _mm256_set1_epi64x(v.la);
-    const __m256i outside = _mm256_set1_epi32(SC_LABEL_OUTSIDE);
-    const __m256i three = _mm256_set1_epi32(3);
+    const samp8 c = samp8_init(v);
     const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-    const int *vox = (const int *)(const void *)v.vox;
-    const int *labp = (const int *)(const void *)v.lab;
     for (uint32_t k = k0; k < k1; k += 8u) {
         /* the lanes of this span: all 8, or the last few (the others gather and load nothing:
          * their positions may be anywhere) */
         const uint32_t r = k1 - k < 8u ? k1 - k : 8u;
         const __m256i m = _mm256_cmpgt_epi32(_mm256_set1_epi32((int32_t)r), lane);
-        const __m256i tx = _mm256_and_si256(lx.hi, wmask);
-        const __m256i ty = _mm256_and_si256(ly.hi, wmask);
-        const __m256i tz = _mm256_and_si256(lz.hi, wmask);
-        const __m256i base = _mm256_add_epi32(
-            _mm256_add_epi32(_mm256_srli_epi32(lx.hi, SC_W_BITS),
-                             _mm256_mullo_epi32(_mm256_srli_epi32(ly.hi, SC_W_BITS), vsy)),
-            _mm256_mullo_epi32(_mm256_srli_epi32(lz.hi, SC_W_BITS), vsz));
-        /* 4 bytes from each row start; the last row from 2 before it (never past the end: the
-         * +1 neighbour of the last row is the volume's last byte at most) */
-        const __m256i z = _mm256_setzero_si256();
-        const __m256i g00 = _mm256_mask_i32gather_epi32(z, vox, base, m, 1);
-        const __m256i g10 = _mm256_mask_i32gather_epi32(z, vox, _mm256_add_epi32(base, vsy), m, 1);
-        const __m256i g01 = _mm256_mask_i32gather_epi32(z, vox, _mm256_add_epi32(base, vsz), m, 1);
-        const __m256i g11 =
-            _mm256_mask_i32gather_epi32(z, vox, _mm256_add_epi32(base, vsyz2), m, 1);
-        const __m256i c00 = pair_level(g00, 0, tx), c10 = pair_level(g10, 0, tx);
-        const __m256i c01 = pair_level(g01, 0, tx), c11 = pair_level(g11, 16, tx);
-        const __m256i c0 = lerp(c00, c10, ty), c1 = lerp(c01, c11, ty);
-        const __m256i ifx = lerp(c0, c1, tz);
-        __m256i label;
-        if (labp != NULL) {
-            /* nearest voxel: + 1 where the weight is >= 1/2 */
-            const __m256i li = _mm256_add_epi32(
-                _mm256_add_epi32(base, _mm256_srli_epi32(tx, SC_W_BITS - 1)),
-                _mm256_add_epi32(_mm256_and_si256(_mm256_cmpgt_epi32(ty, half), vsy),
-                                 _mm256_and_si256(_mm256_cmpgt_epi32(tz, half), vsz)));
-            /* the dword ending at the label (or starting at it near the array's start) */
-            const __m256i at = _mm256_max_epi32(_mm256_sub_epi32(li, three), z);
-            const __m256i g = _mm256_mask_i32gather_epi32(z, labp, at, m, 1);
-            label = _mm256_and_si256(
-                _mm256_srlv_epi32(g, _mm256_slli_epi32(_mm256_sub_epi32(li, at), 3)),
-                _mm256_set1_epi32(0xff));
-        } else {
-            label = _mm256_set1_epi32(SC_LABEL_MUSCLE);
-        }
-        const __m256i d_lo =
-            display4(_mm256_cvtepu32_epi64(_mm256_castsi256_si128(ifx)), la, lut_b_fx + k,
-                     _mm256_cvtepi32_epi64(_mm256_castsi256_si128(m)));
-        const __m256i d_hi =
-            display4(_mm256_cvtepu32_epi64(_mm256_extracti128_si256(ifx, 1)), la,
-                     lut_b_fx + k + 4, _mm256_cvtepi32_epi64(_mm256_extracti128_si256(m, 1)));
-        /* the low dwords of the 8 int64 into 8 dwords, in order */
-        const __m256i sel = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
-        const __m256i disp = _mm256_blend_epi32(_mm256_permutevar8x32_epi32(d_lo, sel),
-                                                _mm256_permutevar8x32_epi32(d_hi, sel), 0xf0);
-        const __m256i shown = _mm256_andnot_si256(_mm256_cmpeq_epi32(label, outside), disp);
-        if (r == 8u) {
-            store_bytes(out + k, shown);
-            store_bytes(lab_out + k, label);
-        } else {
-            uint8_t t[16];
-            store_bytes(t, shown);
-            store_bytes(t + 8, label);
-            memcpy(out + k, t, r);
-            memcpy(lab_out + k, t + 8, r);
-        }
+        sample8(&c, lx.hi, ly.hi, lz.hi, m, r, lut_b_fx + k, out + k, lab_out + k);
         lanes_step(&lx);
         lanes_step(&ly);
         lanes_step(&lz);
@@ -191,9 +212,9 @@ static inline __m256i words8(__m256i p0, __m256i p1)
     return pack_lo32(_mm256_srli_epi64(p0, SC_LOW_BITS), _mm256_srli_epi64(p1, SC_LOW_BITS));
 }
 
-void sc_bscan_words_x86_64_v3(uint32_t *restrict hx, uint32_t *restrict hy,
-                              uint32_t *restrict hz, uint32_t k0, uint32_t k1, int64_t X,
-                              int64_t Y, int64_t Z, int64_t DX, int64_t DY, int64_t DZ)
+void sc_bscan_words_x86_64_v3(uint32_t *restrict hx, uint32_t *restrict hy, uint32_t *restrict hz,
+                              uint32_t k0, uint32_t k1, int64_t X, int64_t Y, int64_t Z, int64_t DX,
+                              int64_t DY, int64_t DZ)
 {
     __m256i x0 = _mm256_add_epi64(_mm256_set1_epi64x(X + SC_W_HALF),
                                   _mm256_setr_epi64x(0, DX, 2 * DX, 3 * DX));
@@ -220,74 +241,15 @@ void sc_bscan_line_x86_64_v3(const vol_regs v, const int64_t *restrict lut_b_fx,
                              const uint32_t *restrict hz, uint8_t *restrict out,
                              uint8_t *restrict lab_out)
 {
-    const __m256i wmask = _mm256_set1_epi32(SC_W_ONE - 1);
-    const __m256i half = _mm256_set1_epi32(SC_W_ONE / 2 - 1);
-    const __m256i vsy = _mm256_set1_epi32((int32_t)v.sy);
-    const __m256i vsz = _mm256_set1_epi32((int32_t)v.sz);
-    const __m256i vsyz2 = _mm256_set1_epi32((int32_t)(v.sy + v.sz) - 2);
-    const __m256i la = _mm256_set1_epi64x(v.la);
-    const __m256i outside = _mm256_set1_epi32(SC_LABEL_OUTSIDE);
-    const __m256i three = _mm256_set1_epi32(3);
+    const samp8 c = samp8_init(v);
     const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-    const int *vox = (const int *)(const void *)v.vox;
-    const int *labp = (const int *)(const void *)v.lab;
     for (uint32_t k = 0; k < n; k += 8u) {
         const uint32_t r = n - k < 8u ? n - k : 8u;
         const __m256i m = _mm256_cmpgt_epi32(_mm256_set1_epi32((int32_t)r), lane);
         const __m256i px = _mm256_loadu_si256((const __m256i *)(const void *)(hx + k));
         const __m256i py = _mm256_loadu_si256((const __m256i *)(const void *)(hy + k));
         const __m256i pz = _mm256_loadu_si256((const __m256i *)(const void *)(hz + k));
-        const __m256i tx = _mm256_and_si256(px, wmask);
-        const __m256i ty = _mm256_and_si256(py, wmask);
-        const __m256i tz = _mm256_and_si256(pz, wmask);
-        const __m256i base = _mm256_add_epi32(
-            _mm256_add_epi32(_mm256_srli_epi32(px, SC_W_BITS),
-                             _mm256_mullo_epi32(_mm256_srli_epi32(py, SC_W_BITS), vsy)),
-            _mm256_mullo_epi32(_mm256_srli_epi32(pz, SC_W_BITS), vsz));
-        const __m256i z = _mm256_setzero_si256();
-        const __m256i g00 = _mm256_mask_i32gather_epi32(z, vox, base, m, 1);
-        const __m256i g10 = _mm256_mask_i32gather_epi32(z, vox, _mm256_add_epi32(base, vsy), m, 1);
-        const __m256i g01 = _mm256_mask_i32gather_epi32(z, vox, _mm256_add_epi32(base, vsz), m, 1);
-        const __m256i g11 =
-            _mm256_mask_i32gather_epi32(z, vox, _mm256_add_epi32(base, vsyz2), m, 1);
-        const __m256i c00 = pair_level(g00, 0, tx), c10 = pair_level(g10, 0, tx);
-        const __m256i c01 = pair_level(g01, 0, tx), c11 = pair_level(g11, 16, tx);
-        const __m256i c0 = lerp(c00, c10, ty), c1 = lerp(c01, c11, ty);
-        const __m256i ifx = lerp(c0, c1, tz);
-        __m256i label;
-        if (labp != NULL) {
-            const __m256i li = _mm256_add_epi32(
-                _mm256_add_epi32(base, _mm256_srli_epi32(tx, SC_W_BITS - 1)),
-                _mm256_add_epi32(_mm256_and_si256(_mm256_cmpgt_epi32(ty, half), vsy),
-                                 _mm256_and_si256(_mm256_cmpgt_epi32(tz, half), vsz)));
-            const __m256i at = _mm256_max_epi32(_mm256_sub_epi32(li, three), z);
-            const __m256i g = _mm256_mask_i32gather_epi32(z, labp, at, m, 1);
-            label = _mm256_and_si256(
-                _mm256_srlv_epi32(g, _mm256_slli_epi32(_mm256_sub_epi32(li, at), 3)),
-                _mm256_set1_epi32(0xff));
-        } else {
-            label = _mm256_set1_epi32(SC_LABEL_MUSCLE);
-        }
-        const __m256i d_lo =
-            display4(_mm256_cvtepu32_epi64(_mm256_castsi256_si128(ifx)), la, lut_b_fx + k,
-                     _mm256_cvtepi32_epi64(_mm256_castsi256_si128(m)));
-        const __m256i d_hi =
-            display4(_mm256_cvtepu32_epi64(_mm256_extracti128_si256(ifx, 1)), la,
-                     lut_b_fx + k + 4, _mm256_cvtepi32_epi64(_mm256_extracti128_si256(m, 1)));
-        const __m256i sel = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
-        const __m256i disp = _mm256_blend_epi32(_mm256_permutevar8x32_epi32(d_lo, sel),
-                                                _mm256_permutevar8x32_epi32(d_hi, sel), 0xf0);
-        const __m256i shown = _mm256_andnot_si256(_mm256_cmpeq_epi32(label, outside), disp);
-        if (r == 8u) {
-            store_bytes(out + k, shown);
-            store_bytes(lab_out + k, label);
-        } else {
-            uint8_t t[16];
-            store_bytes(t, shown);
-            store_bytes(t + 8, label);
-            memcpy(out + k, t, r);
-            memcpy(lab_out + k, t + 8, r);
-        }
+        sample8(&c, px, py, pz, m, r, lut_b_fx + k, out + k, lab_out + k);
     }
 }
 #else
