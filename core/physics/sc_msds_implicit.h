@@ -10,10 +10,15 @@
  * solved by a fixed number of warm-started Jacobi-PCG iterations on the grid matrix the FEM
  * uses (sc_grid.h): the springs are exactly the tets' edges, so every spring is one of the
  * grid's stencil blocks.
- * K(x), per spring (d = x_j - x_i, L = |d|, u = d / L): k u u^T + k max(0, 1 - L0 / L)
- * (I - u u^T) (the transverse term only where the spring is stretched, so K stays positive
- * semi-definite when springs are compressed: a compressed spring's negative transverse
- * stiffness is what lets an explicit or a Newton step buckle); per tet of the volume term
+ * K(x), per spring (d = x_j - x_i, L = |d|, u = d / L): k u u^T + k |1 - L0 / L| (I - u u^T).
+ * A compressed spring's exact transverse stiffness k (1 - L0 / L) is negative (what lets an
+ * explicit or a Newton step buckle); its absolute value keeps K positive semi-definite and
+ * still gives a crushed node stiffness in the directions its springs push it. Dropping the
+ * term instead (K's former form, max(0, 1 - L0 / L)) left a node squeezed between the probe
+ * face's end and the fixed bottom with large spring forces and almost no stiffness against
+ * them: one step threw it up to 59 mm sideways (a guard reset under a fast 35 degree tilt
+ * at a 16 mm press; test_physics_robust). Only the matrix changed: the forces, and so the
+ * rest and the pressed equilibria, are the same. Per tet of the volume term
  * (energy 1/2 k_vol (6V - 6V0)^2 / 36): k_vol / 36 g_a g_b^T, g = grad 6V (the Gauss-Newton
  * part; the (V - V0) Hess V part is left out for the same reason).
  * Why this integrator: backward Euler with a positive semi-definite K is unconditionally

@@ -43,31 +43,13 @@ static float ratio(const sc_bscan_status *b, uint32_t label)
     return b->areas_valid ? b->area_ratio[label] : -1.0f;
 }
 
-/* the loaded case's tissue again on an nx x ny x nz mesh of the same box, as the engine builds
- * it at case load (the case's drive kept) */
-static void remesh(uint32_t nx, uint32_t ny, uint32_t nz)
-{
-    sc_tissue *t = sc_test_press_tissue(&rig);
-    const sc_lumen_drive drive = t->lumen.drive;
-    sc_tissue_def td = t->def;
-    td.mesh.nx = nx;
-    td.mesh.ny = ny;
-    td.mesh.nz = nz;
-    const sc_material_table mat = t->mat;
-    assert_int_equal(sc_tissue_init(t, &td, &rig.engine.slot.c.volume, &mat,
-                                    (uint8_t)SC_LABEL_FAT),
-                     SC_OK);
-    assert_int_equal(sc_bscan_attach_mesh(&rig.engine.bscan, &t->mesh), SC_OK);
-    assert_int_equal(sc_tissue_set_drive(t, &drive), SC_OK);
-}
-
 static void press(const char *case_name, sc_tissue_method m, uint32_t fine)
 {
     char file[64];
     snprintf(file, sizeof file, "%s.scase", case_name);
     sc_test_press_rig_up(&rig, &storage, SC_BINARY_DIR "/cases", file, m);
     if (fine) {
-        remesh(32u, 16u, 16u);
+        sc_test_press_remesh(&rig, 32u, 16u, 16u);
     }
     if (getenv("SC_PRESS_PULSE_OFF") != NULL) {
         /* diagnosis: the same press without the pulse and the breath */

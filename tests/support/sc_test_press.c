@@ -7,6 +7,8 @@
 
 #include "sc_engine.h"
 #include "sc_err.h"
+#include "sc_labels.h"
+#include "sc_bscan.h"
 
 void sc_test_press_rig_up(sc_hs_rig *rig, sc_storage_linux *storage, const char *cases_dir,
                           const char *case_file, sc_tissue_method m)
@@ -26,6 +28,22 @@ void sc_test_press_rig_up(sc_hs_rig *rig, sc_storage_linux *storage, const char 
     }
     assert_int_equal(rc, SC_OK);
     assert_int_equal(sc_test_press_tissue(rig)->method, m);
+}
+
+void sc_test_press_remesh(sc_hs_rig *rig, uint32_t nx, uint32_t ny, uint32_t nz)
+{
+    sc_tissue *t = sc_test_press_tissue(rig);
+    const sc_lumen_drive drive = t->lumen.drive;
+    sc_tissue_def td = t->def;
+    td.mesh.nx = nx;
+    td.mesh.ny = ny;
+    td.mesh.nz = nz;
+    const sc_material_table mat = t->mat;
+    assert_int_equal(sc_tissue_init(t, &td, &rig->engine.slot.c.volume, &mat,
+                                    (uint8_t)SC_LABEL_FAT),
+                     SC_OK);
+    assert_int_equal(sc_bscan_attach_mesh(&rig->engine.bscan, &t->mesh), SC_OK);
+    assert_int_equal(sc_tissue_set_drive(t, &drive), SC_OK);
 }
 
 static int send_peer(void *ctx, const sc_can_frame *f)

@@ -20,6 +20,10 @@ void sc_test_press_rig_up(sc_hs_rig *rig, sc_storage_linux *storage, const char 
  * when the emulator started; *more cleared when it has no more), then the engine's step. */
 void sc_test_press_frame(sc_hs_rig *rig, sc_emu *emu, uint64_t t0, int *more);
 
+/* The loaded case's tissue again on an nx x ny x nz mesh of the same box, as the engine builds
+ * it at case load, the case's vessel drive kept; asserts (cmocka) that it builds. */
+void sc_test_press_remesh(sc_hs_rig *rig, uint32_t nx, uint32_t ny, uint32_t nz);
+
 /* The active tissue. */
 sc_tissue *sc_test_press_tissue(sc_hs_rig *rig);
 

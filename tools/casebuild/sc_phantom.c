@@ -595,19 +595,20 @@ int sc_phantom_generate(const sc_phantom_def *pd, sc_phantom *out)
     _Static_assert(sizeof mats / sizeof mats[0] == SC_LABEL_COUNT, "one material per label");
     d->material_count = SC_LABEL_COUNT;
     memcpy(d->materials, mats, sizeof mats);
-    /* mesh box around the vessels, from the skin down to above the bone */
-    d->mesh.nx = 24u;
+    /* mesh box around the vessels, from the skin down to above the bone. Across (x) it spans
+     * 46 mm, wider than the 38 mm image with the probe over the vessels: with the former
+     * 30 mm box the image's edges sampled undeformed tissue beyond the mesh and a flat press
+     * bent the shallow layers into a U there. The centre stays where it was (x -2 mm on the
+     * neck, 0 in the groin: the probe's place in the press scripts and tests); the cells stay
+     * 1.3 mm (24 nodes over 30 mm before): 34 nodes over 44 mm (neck, -24..20, the volume's
+     * edge), 36 over 46 mm (groin), 1.42x / 1.5x the nodes. */
+    const int neck = pd->kind == SC_PHANTOM_NECK_IJV;
+    d->mesh.nx = neck ? 34u : 36u;
     d->mesh.ny = 12u;
     d->mesh.nz = 12u;
-    if (pd->kind == SC_PHANTOM_NECK_IJV) {
-        d->mesh.origin_mm[0] = -17.0f;
-        d->mesh.size_mm[0] = 30.0f;
-        d->mesh.size_mm[2] = 30.0f;
-    } else {
-        d->mesh.origin_mm[0] = -15.0f;
-        d->mesh.size_mm[0] = 30.0f;
-        d->mesh.size_mm[2] = 32.0f;
-    }
+    d->mesh.origin_mm[0] = neck ? -24.0f : -23.0f;
+    d->mesh.size_mm[0] = neck ? 44.0f : 46.0f;
+    d->mesh.size_mm[2] = neck ? 30.0f : 32.0f;
     /* 30 mm across the probe's 10 mm face (y, its elevation axis): with 20 mm the box's
      * roller sides stood 5 mm beside the face and confined the tissue under a deep press
      * (24 mm of 32: the column under the face had nowhere to go but two 5 mm strips; its
