@@ -526,6 +526,7 @@ static int write_frame_png(const options *o, sc_scanconv *conv, uint8_t *raster,
                 memcpy(colour + (size_t)l * n, d->colour + (size_t)l * SC_MAX_SCAN_SAMPLES, n);
             }
             sc_scanconv_render_colour(conv, &d->last_info, d->last, colour, n, rgb);
+            sc_overlay_draw_rgb(rgb, raster, conv->width, conv->height, &d->last_info);
             const int rc = sc_png_write(path, conv->width, conv->height, 3, rgb, 3u * conv->width);
             free(rgb);
             return rc;

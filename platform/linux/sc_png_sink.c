@@ -66,15 +66,8 @@ static void *writer_main(void *arg)
         if (s->handoff_has_colour) { /* colour Doppler over the grey B-scan: an RGB file */
             sc_scanconv_render_colour(&s->conv, &info, s->handoff, s->handoff_colour, STRIDE,
                                       s->rgb);
-            /* the scanner's display over the colour image: drawn on a blank grey plane, copied
-             * where it drew */
-            memset(s->raster, 0, (size_t)s->conv.width * s->conv.height);
-            sc_overlay_draw(s->raster, s->conv.width, s->conv.height, &info);
-            for (size_t i = 0; i < (size_t)s->conv.width * s->conv.height; i++) {
-                if (s->raster[i] != 0u) {
-                    s->rgb[3u * i] = s->rgb[3u * i + 1u] = s->rgb[3u * i + 2u] = s->raster[i];
-                }
-            }
+            /* the scanner's display over the colour image */
+            sc_overlay_draw_rgb(s->rgb, s->raster, s->conv.width, s->conv.height, &info);
             rc = sc_png_write(path, s->conv.width, s->conv.height, 3u, s->rgb, 3u * s->conv.width);
         } else {
             sc_scanconv_render(&s->conv, &info, s->handoff, STRIDE, s->raster);

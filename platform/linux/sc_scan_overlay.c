@@ -171,6 +171,27 @@ void sc_overlay_draw(uint8_t *raster, uint32_t w, uint32_t h, const sc_display_f
     sc_overlay_draw_below(raster, w, h, g, 0);
 }
 
+/* the plane's untouched value: neither SC_OVERLAY_FG nor SC_OVERLAY_BG */
+#define SC_OVERLAY_NONE 128u
+_Static_assert(SC_OVERLAY_NONE != SC_OVERLAY_FG && SC_OVERLAY_NONE != SC_OVERLAY_BG,
+               "the untouched value differs from what the overlay writes");
+
+void sc_overlay_draw_rgb(uint8_t *rgb, uint8_t *plane, uint32_t w, uint32_t h,
+                         const sc_display_frame_info *g)
+{
+    if (rgb == NULL || plane == NULL) {
+        return;
+    }
+    const size_t n = (size_t)w * h;
+    memset(plane, SC_OVERLAY_NONE, n);
+    sc_overlay_draw(plane, w, h, g);
+    for (size_t i = 0; i < n; i++) {
+        if (plane[i] != SC_OVERLAY_NONE) {
+            rgb[3u * i] = rgb[3u * i + 1u] = rgb[3u * i + 2u] = plane[i];
+        }
+    }
+}
+
 void sc_overlay_draw_below(uint8_t *raster, uint32_t w, uint32_t h, const sc_display_frame_info *g,
                            int top_px)
 {

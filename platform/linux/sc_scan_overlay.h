@@ -33,6 +33,12 @@ void sc_overlay_draw(uint8_t *raster, uint32_t w, uint32_t h, const sc_display_f
 void sc_overlay_draw_below(uint8_t *raster, uint32_t w, uint32_t h, const sc_display_frame_info *g,
                            int top_px);
 
+/* The same over an RGB raster (w x h x 3 bytes, a colour Doppler frame): drawn on plane (w x h
+ * scratch bytes) prefilled with a value the overlay never writes, then copied as grey where it
+ * drew, its dark band behind the text included. */
+void sc_overlay_draw_rgb(uint8_t *rgb, uint8_t *plane, uint32_t w, uint32_t h,
+                         const sc_display_frame_info *g);
+
 /* Text in the overlay's 5x7 font (upper case, digits, . + - : /; others blank), cell 6x8 times
  * scale, at (x, y). Returns the x after the text. */
 int sc_overlay_text(uint8_t *raster, uint32_t w, uint32_t h, int x, int y, int scale, uint8_t v,

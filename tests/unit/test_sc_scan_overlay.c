@@ -1,7 +1,8 @@
 /* test_sc_scan_overlay.c: the scanner display items drawn over the scan-converted B-scan
  * (platform/linux/sc_scan_overlay.h) sit where the geometry puts them: each depth tick on the
  * row where sc_scanconv draws that depth, for a linear and a curvilinear probe; the focus marker
- * at the focus depth; the readout only with the values the frame record carries. */
+ * at the focus depth; the readout only with the values the frame record carries; over a colour
+ * Doppler frame (RGB) the same items, grey, and the colour kept everywhere else. */
 #include "sc_test.h"
 
 #include <math.h>
@@ -18,6 +19,7 @@
 static uint8_t g_img[LINES * SAMPLES];
 static uint8_t g_ras[W * H];
 static uint8_t g_ovl[W * H];
+static uint8_t g_rgb[3u * W * H];
 
 static sc_display_frame_info geom(uint16_t kind)
 {
@@ -127,12 +129,55 @@ static void focus_marker_is_at_the_focus_depth_and_readout_only_with_values(void
     assert_int_equal(sc_overlay_edge_px(&g, W, H, 41.0, 1, &x, &y), -1);
 }
 
+/* The overlay over an RGB frame: every pixel the grey overlay writes (ticks, marks, text and
+ * its dark band) is that grey in all three channels; every other pixel keeps its colour. */
+static void rgb_overlay_draws_the_same_items_and_keeps_the_colour_elsewhere(void **state)
+{
+    (void)state;
+    sc_display_frame_info g = geom(0u);
+    g.focus_mm = 25.0f;
+    g.dynamic_range_db = 60.0f;
+    g.frequency_mhz = 7.5f;
+    for (size_t i = 0; i < (size_t)W * H; i++) {
+        g_rgb[3u * i] = 200u; /* a red-orange colour flow everywhere */
+        g_rgb[3u * i + 1u] = 60u;
+        g_rgb[3u * i + 2u] = 10u;
+    }
+    static uint8_t plane[W * H];
+    sc_overlay_draw_rgb(g_rgb, plane, W, H, &g);
+    /* the grey overlay on two differently filled planes: a pixel it writes is the same in both */
+    memset(g_ovl, 7, sizeof g_ovl);
+    sc_overlay_draw(g_ovl, W, H, &g);
+    memset(g_ras, 201, sizeof g_ras);
+    sc_overlay_draw(g_ras, W, H, &g);
+    uint32_t drawn = 0, fg = 0, bg = 0;
+    for (size_t i = 0; i < (size_t)W * H; i++) {
+        const int written = g_ovl[i] != 7u || g_ras[i] != 201u;
+        if (written) {
+            drawn++;
+            fg += g_ovl[i] == SC_OVERLAY_FG;
+            bg += g_ovl[i] == SC_OVERLAY_BG;
+            assert_int_equal(g_rgb[3u * i], g_ovl[i]);
+            assert_int_equal(g_rgb[3u * i + 1u], g_ovl[i]);
+            assert_int_equal(g_rgb[3u * i + 2u], g_ovl[i]);
+        } else {
+            assert_int_equal(g_rgb[3u * i], 200u);
+            assert_int_equal(g_rgb[3u * i + 1u], 60u);
+            assert_int_equal(g_rgb[3u * i + 2u], 10u);
+        }
+    }
+    assert_true(fg > 100u); /* ticks, marker, text */
+    assert_true(bg > 100u); /* the band behind the text */
+    assert_int_equal(fg + bg, drawn);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(linear_depth_ticks_sit_on_the_scan_converted_depth_rows),
         cmocka_unit_test(curvilinear_depth_ticks_sit_on_the_fan_edge_at_their_depth),
         cmocka_unit_test(focus_marker_is_at_the_focus_depth_and_readout_only_with_values),
+        cmocka_unit_test(rgb_overlay_draws_the_same_items_and_keeps_the_colour_elsewhere),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
