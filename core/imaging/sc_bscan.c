@@ -1234,6 +1234,7 @@ typedef struct vol_ctx {
     sc_bscan_span_fn span; /* the selected variant's sampler of spans clear of the border */
     sc_bscan_line_fn line; /* the selected variant's sampler of a whole line's positions */
     sc_bscan_words_fn words; /* the selected variant's position words of a clear span */
+    sc_acoustics_run_fn acou_run; /* the selected variant's acoustics run kernel */
 } vol_ctx;
 
 _Static_assert(SC_MAX_VOLUME_DIM < (1u << (32 - SC_W_BITS)), "position words fit 32 bits");
@@ -1652,7 +1653,7 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
     }
     if (b->def.acoustics != 0u) {
         /* along the beam as it runs now: the labels are this frame's (deformed) ones */
-        sc_acoustics_line(&b->acou, b->line_label, b->line_out, n);
+        sc_acoustics_line_k(&b->acou, b->line_label, b->line_out, n, vc->acou_run);
     }
 #if SC_BSCAN_PSF
     if (b->def.psf != 0u) {
@@ -1866,6 +1867,7 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
     vc.span = sc_bscan_span_selected();
     vc.line = sc_bscan_line_selected();
     vc.words = sc_bscan_words_selected();
+    vc.acou_run = sc_acoustics_run_selected();
     vc.sy32 = volume->dim[0];
     vc.sz32 = volume->dim[0] * volume->dim[1];
     area_acc acc;

@@ -71,3 +71,13 @@ sc_bscan_span_fn sc_bscan_span_selected(void)
 #endif
     return sc_bscan_span_generic;
 }
+
+sc_acoustics_run_fn sc_acoustics_run_selected(void)
+{
+#if defined(SC_SIMD_X86_64_V3_BUILT)
+    if (sc_simd_selected() != SC_SIMD_GENERIC) {
+        return sc_acoustics_run_x86_64_v3;
+    }
+#endif
+    return sc_acoustics_run_generic;
+}

@@ -163,4 +163,10 @@ void sc_bscan_span_x86_64_v3(const vol_regs v, const int64_t *restrict lut_b_fx,
 /* The selected variant's span sampler (sc_simd_selected()). */
 sc_bscan_span_fn sc_bscan_span_selected(void);
 
+/* The acoustics pass's run kernel (sc_acoustics.h): the portable one there, the x86-64-v3
+ * one here (AVX2: 32 samples per iteration, the same integer arithmetic, the same bytes). */
+#include "sc_acoustics.h"
+void sc_acoustics_run_x86_64_v3(uint8_t *restrict out, uint32_t len, int32_t base, int32_t step);
+sc_acoustics_run_fn sc_acoustics_run_selected(void);
+
 #endif /* SC_BSCAN_KERN_H */
