@@ -1419,13 +1419,6 @@ static int in_volume_k(const vol_ctx *vc, const float a[3], const float bb[3], u
 static int sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1, const float a[3],
                        const float bb[3], span_mode mode)
 {
-    if (mode == SPAN_WORDS) {
-        for (uint32_t k = k0; k < k1; k++) {
-            b->pos_h[0][k] = 0u;
-            b->pos_h[1][k] = 0u;
-            b->pos_h[2][k] = 0u;
-        }
-    }
     {
         /* the common case first (a mesh run is one tet's crossing, a few samples): both ends
          * clear of the half-voxel border, so every sample is, and the per-sample box test below
@@ -1449,6 +1442,16 @@ static int sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1,
                 vc->words(b->pos_h[0], b->pos_h[1], b->pos_h[2], k0, k1, X, Y, Z, DX, DY, DZ);
             }
             return 1;
+        }
+    }
+    if (mode == SPAN_WORDS) {
+        /* the line sampler reads every word: the samples of this span that sample_span_inside
+         * does not give words (clamped ends, beyond the volume) read voxel 0 until SPAN_REST
+         * redoes them (a clear span above writes all of its own words) */
+        for (uint32_t k = k0; k < k1; k++) {
+            b->pos_h[0][k] = 0u;
+            b->pos_h[1][k] = 0u;
+            b->pos_h[2][k] = 0u;
         }
     }
     /* the line parameter range inside the box, per axis: -1/2 <= a + k b < hi */
