@@ -351,6 +351,18 @@ static int tet_affine(const sc_bscan *b, const uint32_t tv[4], float alpha[4], f
 /* ---- walker ------------------------------------------------------------------------------ */
 
 /* Boundary triangles cut by the image plane, as 2D segments, bucketed by their first line. */
+/* fminf and fmaxf without the libm call (the portable x86-64 build does not inline them):
+ * a NaN argument gives the other one, as theirs; among equal values (+0, -0) either, which
+ * the comparisons these boxes serve do not tell apart. */
+static inline float min_f(float a, float b)
+{
+    return (b < a || isnan(a)) ? b : a;
+}
+static inline float max_f(float a, float b)
+{
+    return (b > a || isnan(a)) ? b : a;
+}
+
 static void build_segments(sc_bscan *b, const sc_mesh *m)
 {
     const uint32_t lines = b->def.scan.lines_n;
@@ -401,8 +413,8 @@ static void build_segments(sc_bscan *b, const sc_mesh *m)
             nrm[2] = -nrm[2];
         }
         int32_t lo, hi;
-        if (!sc_scan_geom_line_range(&b->geom, fminf(px[0], px[1]), fmaxf(px[0], px[1]),
-                                     fminf(pz[0], pz[1]), fmaxf(pz[0], pz[1]), &lo, &hi)) {
+        if (!sc_scan_geom_line_range(&b->geom, min_f(px[0], px[1]), max_f(px[0], px[1]),
+                                     min_f(pz[0], pz[1]), max_f(pz[0], pz[1]), &lo, &hi)) {
             continue;
         }
         sc_bscan_seg *s = &b->segs[ns++];
@@ -765,17 +777,6 @@ static void ptet_ready(sc_bscan *b, const sc_mesh *m, sc_bscan_ptet *p)
     p->tet = t;
 }
 
-/* fminf and fmaxf without the libm call (the portable x86-64 build does not inline them):
- * a NaN argument gives the other one, as theirs; among equal values (+0, -0) either, which
- * the comparisons these boxes serve do not tell apart. */
-static inline float min_f(float a, float b)
-{
-    return (b < a || isnan(a)) ? b : a;
-}
-static inline float max_f(float a, float b)
-{
-    return (b > a || isnan(a)) ? b : a;
-}
 
 /* Index of the lowest set bit of x != 0. */
 static inline uint32_t sc_ctz64(uint64_t x)
