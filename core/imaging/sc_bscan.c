@@ -1541,13 +1541,7 @@ static void rest_labels(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
                 (Z >> 32) <= lz && (ze >> 32) <= lz) {
                 /* both ends clear of the clamps, so every position between them is (they are
                  * linear in kk): the loop below without them, the same labels */
-                for (uint32_t kk = k0; kk < k1; kk++) {
-                    out[kk] = lab[(size_t)(X >> 32) + sy * (size_t)(Y >> 32) +
-                                  sz * (size_t)(Z >> 32)];
-                    X += DX;
-                    Y += DY;
-                    Z += DZ;
-                }
+                sc_bscan_labels_nearest(lab, sy, sz, out + k0, k1 - k0, X, Y, Z, DX, DY, DZ);
                 continue;
             }
             for (uint32_t kk = k0; kk < k1; kk++) {
