@@ -1386,9 +1386,16 @@ static void sample_span_inside(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint
                 vc->span(vr, lut, k0 + (uint32_t)jlo, k0 + (uint32_t)jhi, X, Y, Z, DX, DY, DZ,
                          out, lab);
             } else if (mode == SPAN_WORDS) {
-                /* the exact words only: the span's clamped samples after these need theirs 0 */
-                sc_bscan_words_generic(b->pos_h[0], b->pos_h[1], b->pos_h[2], k0 + (uint32_t)jlo,
-                                       k0 + (uint32_t)jhi, X, Y, Z, DX, DY, DZ);
+                /* the selected variant writes up to 7 words past the clear part: the span's
+                 * clamped samples after it need theirs 0 again (the next span writes its own) */
+                const uint32_t w1 = k0 + (uint32_t)jhi;
+                vc->words(b->pos_h[0], b->pos_h[1], b->pos_h[2], k0 + (uint32_t)jlo, w1, X, Y, Z,
+                          DX, DY, DZ);
+                for (uint32_t k = w1; k < k1 && k < w1 + 7u; k++) {
+                    b->pos_h[0][k] = 0u;
+                    b->pos_h[1][k] = 0u;
+                    b->pos_h[2][k] = 0u;
+                }
             }
             const int64_t m = jhi - jlo;
             X += m * DX;
