@@ -1684,15 +1684,31 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
     count_labels(b->line_label, n, acc->rest_n, acc->rest_k);
     /* the rest reference continues above the face by the margin: tissue the probe has pushed
      * into the image was there at rest (every 4th sample, each counting for 4) */
-    /* blocks of 4 samples above the face, -(4i + 1) .. -(4i + 4), each sampled at -(4i + 2) */
+    /* blocks of 4 samples above the face, -(4i + 1) .. -(4i + 4), each sampled at -(4i + 2);
+     * the counts of a run of one label summed in registers and added at its end (labels come
+     * in runs: the counter in memory, read and written back per block, was a chain through the
+     * store forwarding; integers: the same sums) */
+    uint32_t run_label = SC_LABEL_COUNT, run_n = 0;
+    int32_t run_k = 0;
     for (uint32_t j0 = 0; j0 + SC_BSCAN_MARGIN_STEP <= c->margin_n; j0 += SC_BSCAN_MARGIN_STEP) {
         const float s = -(float)(j0 + 2u);
         const uint8_t label =
             label_at(v, c->f0[0] + s * c->fd[0], c->f0[1] + s * c->fd[1], c->f0[2] + s * c->fd[2]);
-        if (label < SC_LABEL_COUNT) {
-            acc->margin_n[label] += SC_BSCAN_MARGIN_STEP;
-            acc->margin_k[label] -= (int32_t)(4u * j0 + 10u); /* sum of the block's indices */
+        if (label != run_label) {
+            if (run_label < SC_LABEL_COUNT) {
+                acc->margin_n[run_label] += run_n;
+                acc->margin_k[run_label] += run_k;
+            }
+            run_label = label;
+            run_n = 0u;
+            run_k = 0;
         }
+        run_n += SC_BSCAN_MARGIN_STEP;
+        run_k -= (int32_t)(4u * j0 + 10u); /* sum of the block's indices */
+    }
+    if (run_label < SC_LABEL_COUNT) {
+        acc->margin_n[run_label] += run_n;
+        acc->margin_k[run_label] += run_k;
     }
 }
 
