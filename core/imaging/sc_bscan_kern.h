@@ -11,6 +11,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "sc_acoustics.h"
 #include "sc_labels.h"
 
 /* Trilinear weights: 10 bits, rounded to nearest (half a weight step added to the position). */
@@ -173,8 +174,7 @@ void sc_bscan_labels_nearest(const uint8_t *restrict lab, size_t sy, size_t sz,
                              int64_t DX, int64_t DY, int64_t DZ);
 
 /* The acoustics pass's run kernel (sc_acoustics.h): the portable one there, the x86-64-v3
- * one here (AVX2: 32 samples per iteration, the same integer arithmetic, the same bytes). */
-#include "sc_acoustics.h"
+ * one here (AVX2: 16 samples per iteration, the same integer arithmetic, the same bytes). */
 void sc_acoustics_run_x86_64_v3(uint8_t *restrict out, uint32_t len, int32_t base, int32_t step);
 sc_acoustics_run_fn sc_acoustics_run_selected(void);
 
