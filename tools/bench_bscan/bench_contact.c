@@ -9,7 +9,10 @@
  *    walker handed to the region path;
  *  - the same frame through the region path and the oracle's agreement count;
  *  - the whole frame (rx + physics + imaging + status + control): sc_engine_step during the hold
- *    at the bottom (t 1.55 .. 2.45 s), min / median thread CPU time.
+ *    at the bottom (t 1.55 .. 2.0 s), min / median thread CPU time, split at the imaging stage's
+ *    display calls (its frame_begin .. the end of its frame_end: the imaging stage; the rest:
+ *    rx, physics, status, control, state stream); then the same frames again with the display
+ *    a buffer instead of the host simulator's, which hashes every frame.
  * Thread CPU time throughout: the machine is shared.
  */
 #define _POSIX_C_SOURCE 200809L
