@@ -24,8 +24,11 @@
  * Values are displayed grey levels (the display's dynamic range maps dB to 0..255), so the pass
  * works on the finished line in place. Pixels at 0 (air above the skin) stay 0.
  *
- * Memory: the caller's sc_acoustics (about 0.8 KiB). Never allocates, never calls the OS.
- * Deterministic (float32, one fixed order).
+ * Memory: the caller's sc_acoustics (about 0.7 KiB). Never allocates, never calls the OS.
+ * Deterministic: the tables are computed in float32 once (sc_acoustics_init) and held in Q16
+ * fixed point (1/65536 grey level); the pass along a line is integer arithmetic, so its bytes
+ * are the same in every build and it works per run of one label (the loss at a run's sample i
+ * is the loss at its start plus i steps, exactly), not as a float chain per sample.
  */
 #ifndef SC_ACOUSTICS_H
 #define SC_ACOUSTICS_H
@@ -47,12 +50,17 @@ typedef struct sc_acoustics_def {
     float ref_atten_db_cm_mhz; /* what the automatic TGC gives back, [0, 10] */
 } sc_acoustics_def;
 
-/* Precomputed per line sample (grey levels). */
+/* Table values are clamped to this many Q16 units (4096 grey levels): a per-sample loss, an
+ * interface loss or a scattering offset that large leaves what it touches black (or white)
+ * either way, and the 32-bit tables and the per-run arithmetic cannot overflow. */
+#define SC_ACOU_Q_LIMIT (INT32_C(1) << 28)
+
+/* Precomputed per line sample, in Q16 grey levels (value x 65536, rounded). */
 typedef struct sc_acoustics {
-    float atten_gl[SC_LABEL_COUNT]; /* two-way loss per sample, minus the TGC's */
-    float scatter_gl[SC_LABEL_COUNT];
-    float trans_gl[SC_LABEL_COUNT][SC_LABEL_COUNT]; /* two-way transmission loss at a->b */
-    float echo_gl[SC_LABEL_COUNT][SC_LABEL_COUNT];  /* interface echo a->b (0: none) */
+    int32_t atten_q[SC_LABEL_COUNT]; /* two-way loss per sample, minus the TGC's (even) */
+    int32_t scatter_q[SC_LABEL_COUNT];
+    int32_t trans_q[SC_LABEL_COUNT][SC_LABEL_COUNT]; /* two-way transmission loss at a->b */
+    int32_t echo_q[SC_LABEL_COUNT][SC_LABEL_COUNT];  /* interface echo a->b (0: none) */
 } sc_acoustics;
 
 /* Soft-tissue values at 7.5 MHz from Duck, "Physical properties of tissue" (1990) and Szabo,
@@ -71,7 +79,21 @@ int sc_acoustics_init(sc_acoustics *a, const sc_acoustics_def *def, float sample
                       float dynamic_range_db);
 
 /* Apply the pass to one line in place: out[k] the displayed value, lab[k] its label (values
- * >= SC_LABEL_COUNT are read as SC_LABEL_OUTSIDE). O(n). Never allocates. */
+ * >= SC_LABEL_COUNT are read as SC_LABEL_OUTSIDE). O(n), per run of one label. Never
+ * allocates. The portable run kernel (sc_acoustics_run_generic). */
 void sc_acoustics_line(const sc_acoustics *a, const uint8_t *lab, uint8_t *out, uint32_t n);
+
+/* The samples of a run of one label after its first, no interface among them: sample i
+ * becomes shade(out[i], out[i] x 65536 + base - i step) (Q16; 0 stays 0; rounded to nearest,
+ * halves up, saturated to 0..255). The caller keeps base - i step within +-2^29 over the run.
+ * A variant of the x86-64-v3 level (sc_bscan_kern.h: sc_acoustics_run_selected) gives the
+ * same bytes. */
+typedef void (*sc_acoustics_run_fn)(uint8_t *restrict out, uint32_t len, int32_t base,
+                                    int32_t step);
+void sc_acoustics_run_generic(uint8_t *restrict out, uint32_t len, int32_t base, int32_t step);
+
+/* sc_acoustics_line with the run kernel run. */
+void sc_acoustics_line_k(const sc_acoustics *a, const uint8_t *lab, uint8_t *out, uint32_t n,
+                         sc_acoustics_run_fn run);
 
 #endif /* SC_ACOUSTICS_H */

@@ -351,6 +351,18 @@ static int tet_affine(const sc_bscan *b, const uint32_t tv[4], float alpha[4], f
 /* ---- walker ------------------------------------------------------------------------------ */
 
 /* Boundary triangles cut by the image plane, as 2D segments, bucketed by their first line. */
+/* fminf and fmaxf without the libm call (the portable x86-64 build does not inline them):
+ * a NaN argument gives the other one, as theirs; among equal values (+0, -0) either, which
+ * the comparisons these boxes serve do not tell apart. */
+static inline float min_f(float a, float b)
+{
+    return (b < a || isnan(a)) ? b : a;
+}
+static inline float max_f(float a, float b)
+{
+    return (b > a || isnan(a)) ? b : a;
+}
+
 static void build_segments(sc_bscan *b, const sc_mesh *m)
 {
     const uint32_t lines = b->def.scan.lines_n;
@@ -401,8 +413,8 @@ static void build_segments(sc_bscan *b, const sc_mesh *m)
             nrm[2] = -nrm[2];
         }
         int32_t lo, hi;
-        if (!sc_scan_geom_line_range(&b->geom, fminf(px[0], px[1]), fmaxf(px[0], px[1]),
-                                     fminf(pz[0], pz[1]), fmaxf(pz[0], pz[1]), &lo, &hi)) {
+        if (!sc_scan_geom_line_range(&b->geom, min_f(px[0], px[1]), max_f(px[0], px[1]),
+                                     min_f(pz[0], pz[1]), max_f(pz[0], pz[1]), &lo, &hi)) {
             continue;
         }
         sc_bscan_seg *s = &b->segs[ns++];
@@ -765,17 +777,6 @@ static void ptet_ready(sc_bscan *b, const sc_mesh *m, sc_bscan_ptet *p)
     p->tet = t;
 }
 
-/* fminf and fmaxf without the libm call (the portable x86-64 build does not inline them):
- * a NaN argument gives the other one, as theirs; among equal values (+0, -0) either, which
- * the comparisons these boxes serve do not tell apart. */
-static inline float min_f(float a, float b)
-{
-    return (b < a || isnan(a)) ? b : a;
-}
-static inline float max_f(float a, float b)
-{
-    return (b > a || isnan(a)) ? b : a;
-}
 
 /* Index of the lowest set bit of x != 0. */
 static inline uint32_t sc_ctz64(uint64_t x)
@@ -1234,6 +1235,7 @@ typedef struct vol_ctx {
     sc_bscan_span_fn span; /* the selected variant's sampler of spans clear of the border */
     sc_bscan_line_fn line; /* the selected variant's sampler of a whole line's positions */
     sc_bscan_words_fn words; /* the selected variant's position words of a clear span */
+    sc_acoustics_run_fn acou_run; /* the selected variant's acoustics run kernel */
 } vol_ctx;
 
 _Static_assert(SC_MAX_VOLUME_DIM < (1u << (32 - SC_W_BITS)), "position words fit 32 bits");
@@ -1384,9 +1386,16 @@ static void sample_span_inside(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint
                 vc->span(vr, lut, k0 + (uint32_t)jlo, k0 + (uint32_t)jhi, X, Y, Z, DX, DY, DZ,
                          out, lab);
             } else if (mode == SPAN_WORDS) {
-                /* the exact words only: the span's clamped samples after these need theirs 0 */
-                sc_bscan_words_generic(b->pos_h[0], b->pos_h[1], b->pos_h[2], k0 + (uint32_t)jlo,
-                                       k0 + (uint32_t)jhi, X, Y, Z, DX, DY, DZ);
+                /* the selected variant writes up to 7 words past the clear part: the span's
+                 * clamped samples after it need theirs 0 again (the next span writes its own) */
+                const uint32_t w1 = k0 + (uint32_t)jhi;
+                vc->words(b->pos_h[0], b->pos_h[1], b->pos_h[2], k0 + (uint32_t)jlo, w1, X, Y, Z,
+                          DX, DY, DZ);
+                for (uint32_t k = w1; k < k1 && k < w1 + 7u; k++) {
+                    b->pos_h[0][k] = 0u;
+                    b->pos_h[1][k] = 0u;
+                    b->pos_h[2][k] = 0u;
+                }
             }
             const int64_t m = jhi - jlo;
             X += m * DX;
@@ -1418,13 +1427,6 @@ static int in_volume_k(const vol_ctx *vc, const float a[3], const float bb[3], u
 static int sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1, const float a[3],
                        const float bb[3], span_mode mode)
 {
-    if (mode == SPAN_WORDS) {
-        for (uint32_t k = k0; k < k1; k++) {
-            b->pos_h[0][k] = 0u;
-            b->pos_h[1][k] = 0u;
-            b->pos_h[2][k] = 0u;
-        }
-    }
     {
         /* the common case first (a mesh run is one tet's crossing, a few samples): both ends
          * clear of the half-voxel border, so every sample is, and the per-sample box test below
@@ -1448,6 +1450,16 @@ static int sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1,
                 vc->words(b->pos_h[0], b->pos_h[1], b->pos_h[2], k0, k1, X, Y, Z, DX, DY, DZ);
             }
             return 1;
+        }
+    }
+    if (mode == SPAN_WORDS) {
+        /* the line sampler reads every word: the samples of this span that sample_span_inside
+         * does not give words (clamped ends, beyond the volume) read voxel 0 until SPAN_REST
+         * redoes them (a clear span above writes all of its own words) */
+        for (uint32_t k = k0; k < k1; k++) {
+            b->pos_h[0][k] = 0u;
+            b->pos_h[1][k] = 0u;
+            b->pos_h[2][k] = 0u;
         }
     }
     /* the line parameter range inside the box, per axis: -1/2 <= a + k b < hi */
@@ -1536,13 +1548,7 @@ static void rest_labels(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
                 (Z >> 32) <= lz && (ze >> 32) <= lz) {
                 /* both ends clear of the clamps, so every position between them is (they are
                  * linear in kk): the loop below without them, the same labels */
-                for (uint32_t kk = k0; kk < k1; kk++) {
-                    out[kk] = lab[(size_t)(X >> 32) + sy * (size_t)(Y >> 32) +
-                                  sz * (size_t)(Z >> 32)];
-                    X += DX;
-                    Y += DY;
-                    Z += DZ;
-                }
+                sc_bscan_labels_nearest(lab, sy, sz, out + k0, k1 - k0, X, Y, Z, DX, DY, DZ);
                 continue;
             }
             for (uint32_t kk = k0; kk < k1; kk++) {
@@ -1652,7 +1658,7 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
     }
     if (b->def.acoustics != 0u) {
         /* along the beam as it runs now: the labels are this frame's (deformed) ones */
-        sc_acoustics_line(&b->acou, b->line_label, b->line_out, n);
+        sc_acoustics_line_k(&b->acou, b->line_label, b->line_out, n, vc->acou_run);
     }
 #if SC_BSCAN_PSF
     if (b->def.psf != 0u) {
@@ -1678,15 +1684,31 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
     count_labels(b->line_label, n, acc->rest_n, acc->rest_k);
     /* the rest reference continues above the face by the margin: tissue the probe has pushed
      * into the image was there at rest (every 4th sample, each counting for 4) */
-    /* blocks of 4 samples above the face, -(4i + 1) .. -(4i + 4), each sampled at -(4i + 2) */
+    /* blocks of 4 samples above the face, -(4i + 1) .. -(4i + 4), each sampled at -(4i + 2);
+     * the counts of a run of one label summed in registers and added at its end (labels come
+     * in runs: the counter in memory, read and written back per block, was a chain through the
+     * store forwarding; integers: the same sums) */
+    uint32_t run_label = SC_LABEL_COUNT, run_n = 0;
+    int32_t run_k = 0;
     for (uint32_t j0 = 0; j0 + SC_BSCAN_MARGIN_STEP <= c->margin_n; j0 += SC_BSCAN_MARGIN_STEP) {
         const float s = -(float)(j0 + 2u);
         const uint8_t label =
             label_at(v, c->f0[0] + s * c->fd[0], c->f0[1] + s * c->fd[1], c->f0[2] + s * c->fd[2]);
-        if (label < SC_LABEL_COUNT) {
-            acc->margin_n[label] += SC_BSCAN_MARGIN_STEP;
-            acc->margin_k[label] -= (int32_t)(4u * j0 + 10u); /* sum of the block's indices */
+        if (label != run_label) {
+            if (run_label < SC_LABEL_COUNT) {
+                acc->margin_n[run_label] += run_n;
+                acc->margin_k[run_label] += run_k;
+            }
+            run_label = label;
+            run_n = 0u;
+            run_k = 0;
         }
+        run_n += SC_BSCAN_MARGIN_STEP;
+        run_k -= (int32_t)(4u * j0 + 10u); /* sum of the block's indices */
+    }
+    if (run_label < SC_LABEL_COUNT) {
+        acc->margin_n[run_label] += run_n;
+        acc->margin_k[run_label] += run_k;
     }
 }
 
@@ -1866,6 +1888,7 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
     vc.span = sc_bscan_span_selected();
     vc.line = sc_bscan_line_selected();
     vc.words = sc_bscan_words_selected();
+    vc.acou_run = sc_acoustics_run_selected();
     vc.sy32 = volume->dim[0];
     vc.sz32 = volume->dim[0] * volume->dim[1];
     area_acc acc;

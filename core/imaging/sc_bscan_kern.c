@@ -71,3 +71,25 @@ sc_bscan_span_fn sc_bscan_span_selected(void)
 #endif
     return sc_bscan_span_generic;
 }
+
+sc_acoustics_run_fn sc_acoustics_run_selected(void)
+{
+#if defined(SC_SIMD_X86_64_V3_BUILT)
+    if (sc_simd_selected() != SC_SIMD_GENERIC) {
+        return sc_acoustics_run_x86_64_v3;
+    }
+#endif
+    return sc_acoustics_run_generic;
+}
+
+void sc_bscan_labels_nearest(const uint8_t *restrict lab, size_t sy, size_t sz,
+                             uint8_t *restrict out, uint32_t n, int64_t X, int64_t Y, int64_t Z,
+                             int64_t DX, int64_t DY, int64_t DZ)
+{
+    for (uint32_t k = 0; k < n; k++) {
+        out[k] = lab[(size_t)(X >> 32) + sy * (size_t)(Y >> 32) + sz * (size_t)(Z >> 32)];
+        X += DX;
+        Y += DY;
+        Z += DZ;
+    }
+}

@@ -11,6 +11,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "sc_acoustics.h"
 #include "sc_labels.h"
 
 /* Trilinear weights: 10 bits, rounded to nearest (half a weight step added to the position). */
@@ -162,5 +163,19 @@ void sc_bscan_span_x86_64_v3(const vol_regs v, const int64_t *restrict lut_b_fx,
 
 /* The selected variant's span sampler (sc_simd_selected()). */
 sc_bscan_span_fn sc_bscan_span_selected(void);
+
+/* The labels at n positions (X, Y, Z) + k (DX, DY, DZ) in 32.32 voxel units, each the voxel
+ * of the integer parts (the caller offsets by a half for the nearest voxel and keeps every
+ * position inside the grid): the compression measure's rest labels of a mesh run. A unit of
+ * its own so that the B-scan's frame loop, with every stage inlined, does not keep its
+ * operands on the stack. */
+void sc_bscan_labels_nearest(const uint8_t *restrict lab, size_t sy, size_t sz,
+                             uint8_t *restrict out, uint32_t n, int64_t X, int64_t Y, int64_t Z,
+                             int64_t DX, int64_t DY, int64_t DZ);
+
+/* The acoustics pass's run kernel (sc_acoustics.h): the portable one there, the x86-64-v3
+ * one here (AVX2: 16 samples per iteration, the same integer arithmetic, the same bytes). */
+void sc_acoustics_run_x86_64_v3(uint8_t *restrict out, uint32_t len, int32_t base, int32_t step);
+sc_acoustics_run_fn sc_acoustics_run_selected(void);
 
 #endif /* SC_BSCAN_KERN_H */

@@ -252,6 +252,40 @@ void sc_bscan_line_x86_64_v3(const vol_regs v, const int64_t *restrict lut_b_fx,
         sample8(&c, px, py, pz, m, r, lut_b_fx + k, out + k, lab_out + k);
     }
 }
+/* The acoustics pass's run kernel: 16 samples per iteration (sc_acoustics_run_generic's
+ * arithmetic in 32-bit lanes; the arithmetic shift is the generic's biased one, the two
+ * saturating packs its clamp to 0..255), the tail sample by sample as there. */
+void sc_acoustics_run_x86_64_v3(uint8_t *restrict out, uint32_t len, int32_t base, int32_t step)
+{
+    uint32_t i = 0;
+    if (len >= 16u) {
+        const __m256i j8 = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+        const __m256i half = _mm256_set1_epi32(1 << 15);
+        /* base - j step + half, lanes 0..7, and the same 8 further on */
+        __m256i t0 = _mm256_sub_epi32(_mm256_set1_epi32(base),
+                                      _mm256_mullo_epi32(j8, _mm256_set1_epi32(step)));
+        t0 = _mm256_add_epi32(t0, half);
+        const __m256i d8 = _mm256_set1_epi32((int32_t)((uint32_t)step * 8u));
+        for (; i + 16u <= len; i += 16u) {
+            const __m128i b = _mm_loadu_si128((const __m128i *)(const void *)(out + i));
+            const __m256i t1 = _mm256_sub_epi32(t0, d8);
+            const __m256i o0 = _mm256_cvtepu8_epi32(b);
+            const __m256i o1 = _mm256_cvtepu8_epi32(_mm_srli_si128(b, 8));
+            const __m256i r0 = _mm256_srai_epi32(_mm256_add_epi32(_mm256_slli_epi32(o0, 16), t0), 16);
+            const __m256i r1 = _mm256_srai_epi32(_mm256_add_epi32(_mm256_slli_epi32(o1, 16), t1), 16);
+            /* per 128-bit half: r0 0..3, r1 0..3 | r0 4..7, r1 4..7 -> in sample order */
+            const __m256i p16 = _mm256_permute4x64_epi64(_mm256_packs_epi32(r0, r1), 0xd8);
+            const __m128i p8 = _mm_packus_epi16(_mm256_castsi256_si128(p16),
+                                                _mm256_extracti128_si256(p16, 1));
+            const __m128i z = _mm_cmpeq_epi8(b, _mm_setzero_si128());
+            _mm_storeu_si128((__m128i *)(void *)(out + i), _mm_andnot_si128(z, p8));
+            t0 = _mm256_sub_epi32(t1, d8);
+        }
+    }
+    if (i < len) {
+        sc_acoustics_run_generic(out + i, len - i, (int32_t)(base - (int32_t)i * step), step);
+    }
+}
 #else
 typedef int sc_bscan_kern_x86_64_v3_unused; /* ISO C: a translation unit is not empty */
 #endif

@@ -112,6 +112,28 @@ void sc_scan_geom_pixel(const sc_scan_geom *g, uint32_t l, uint32_t k, float out
     out_mm[2] = g->start_z_mm[l] + (float)k * g->step_z_mm[l];
 }
 
+/* floorf and ceilf without the libm call (the portable x86-64 build has no rounding
+ * instruction; this runs for every boundary face and plane tet of a frame): the same value for
+ * every finite x in int32's range but the sign of a zero result, which the +-1 below removes;
+ * libm's beyond. */
+static inline float floor_nolibm(float x)
+{
+    if (!(x > -2147483520.0f && x < 2147483520.0f)) {
+        return floorf(x);
+    }
+    const float t = (float)(int32_t)x; /* toward zero, exact below 2^24; above, x is whole */
+    return t > x ? t - 1.0f : t;
+}
+
+static inline float ceil_nolibm(float x)
+{
+    if (!(x > -2147483520.0f && x < 2147483520.0f)) {
+        return ceilf(x);
+    }
+    const float t = (float)(int32_t)x;
+    return t < x ? t + 1.0f : t;
+}
+
 int sc_scan_geom_line_range(const sc_scan_geom *g, float xmin, float xmax, float zmin, float zmax,
                             int32_t *lo, int32_t *hi)
 {
@@ -137,7 +159,7 @@ int sc_scan_geom_line_range(const sc_scan_geom *g, float xmin, float xmax, float
     if (!(b >= -1.0f) || !(a <= (float)last + 1.0f)) {
         return 0;
     }
-    float fa = floorf(a) - 1.0f, fb = ceilf(b) + 1.0f;
+    float fa = floor_nolibm(a) - 1.0f, fb = ceil_nolibm(b) + 1.0f;
     *lo = fa < 0.0f ? 0 : (int32_t)fa;
     *hi = fb > (float)last ? last : (int32_t)fb;
     return *lo <= *hi;

@@ -202,12 +202,78 @@ static void test_generic_values(void **state)
     }
 }
 
+/* The acoustics pass's run kernel (sc_acoustics.h): every variant against the generic one on
+ * random runs (lengths 0..600, with and without a remainder of 16; zero samples among them;
+ * base and step up to the +-2^29 the caller keeps), and the generic one against the formula
+ * in 64-bit arithmetic. */
+static uint8_t g_run_in[N], g_run_g[N], g_run_v[N];
+
+static uint8_t shade_ref(uint32_t o, int64_t v)
+{
+    if (o == 0u || v <= 0) {
+        return 0u;
+    }
+    return v >= ((int64_t)255 << 16) ? 255u : (uint8_t)((v + 32768) >> 16);
+}
+
+static void test_acoustics_run_variants_agree(void **state)
+{
+    (void)state;
+    const sc_simd keep = sc_simd_selected();
+    const sc_simd best = sc_cpu_best_simd();
+    uint32_t tried = 0, differ = 0;
+    for (int s = 0; s < (int)SC_SIMD_COUNT; s++) {
+        if (!sc_simd_built((sc_simd)s) || s > (int)best) {
+            continue;
+        }
+        assert_int_equal(sc_simd_select((sc_simd)s), SC_OK);
+        const sc_acoustics_run_fn f = sc_acoustics_run_selected();
+        assert_non_null(f);
+        for (uint32_t it = 0; it < 2000u; it++) {
+            const uint32_t len = it % 7u == 0u ? 16u * (rnd() % 38u) : rnd() % (N + 1u);
+            /* a step up to 2^28 / len (one in 8: up to 16 grey levels per sample) */
+            const int32_t lim = (int32_t)1 << 29;
+            const int32_t smax = len > 1u ? (int32_t)((uint32_t)lim / len) : lim;
+            const int32_t sm = rnd() % 8u == 0u ? smax : (smax < (1 << 20) ? smax : (1 << 20));
+            const int32_t step = (int32_t)(rnd() % (uint32_t)(2 * sm + 1)) - sm;
+            /* base such that base and base - (len - 1) step are both within +-2^29 */
+            const int64_t span = (int64_t)(len > 0u ? len - 1u : 0u) * step;
+            const int64_t lo = span > 0 ? -lim + span : -lim, hi = span > 0 ? lim : lim + span;
+            const int64_t wide = rnd() % 4u == 0u ? hi - lo : ((int64_t)600 << 16);
+            const int64_t mid = rnd() % 2u == 0u ? (lo + hi) / 2 : (int64_t)(rnd() % (256u << 16));
+            int64_t base = mid - wide / 2 + (int64_t)(((uint64_t)rnd() << 8) % (uint64_t)(wide + 1));
+            base = base < lo ? lo : (base > hi ? hi : base);
+            for (uint32_t i = 0; i < len; i++) {
+                const uint32_t r = rnd();
+                g_run_in[i] = (uint8_t)(r % 5u == 0u ? 0u : (r >> 4) & 255u);
+            }
+            memcpy(g_run_g, g_run_in, len);
+            memcpy(g_run_v, g_run_in, len);
+            sc_acoustics_run_generic(g_run_g, len, (int32_t)base, step);
+            f(g_run_v, len, (int32_t)base, step);
+            for (uint32_t i = 0; i < len; i++) {
+                const uint8_t want =
+                    shade_ref(g_run_in[i], ((int64_t)g_run_in[i] << 16) + base - (int64_t)i * step);
+                assert_int_equal(g_run_g[i], want);
+                differ += g_run_in[i] != want;
+            }
+            assert_memory_equal(g_run_v, g_run_g, len);
+        }
+        tried++;
+    }
+    (void)sc_simd_select(keep);
+    print_message("acoustics run kernel variants compared with the generic one: %u\n", tried);
+    assert_true(tried >= 1u);
+    assert_true(differ > 1000u); /* the runs changed samples */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_variants_agree),
         cmocka_unit_test(test_line_sampler_equals_span_sampler),
         cmocka_unit_test(test_generic_values),
+        cmocka_unit_test(test_acoustics_run_variants_agree),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
