@@ -127,6 +127,9 @@ int sc_skin_init(sc_skin *s, const sc_skin_def *def)
     return SC_OK;
 }
 
+/* springs per chunk of the spring pass (stack: 3 x 4 x SC_SKIN_CHUNK bytes) */
+#define SC_SKIN_CHUNK 64u
+
 static void skin_substep(sc_skin *s)
 {
     const uint32_t nn = s->count;
@@ -140,24 +143,47 @@ static void skin_substep(sc_skin *s)
         ay_[n] = s->fy[n] - ka * (y[n] - s->rest_y[n]) - g * ka * vy[n];
         az_[n] = s->fz[n] - ka * (z[n] - s->rest_z[n]) - g * ka * vz[n];
     }
+    /* Springs in chunks: the chunk's forces first (no dependence between springs: the loop
+     * vectorises), then the far ends' subtractions, then the origins' additions. A node j
+     * gets -F(j - o) before +F(j), as in the one-pass loop it replaces (spring j - o is in
+     * j's chunk or an earlier one), so the sums are bit-identical to it. */
+    float tx[SC_SKIN_CHUNK], ty[SC_SKIN_CHUNK], tz[SC_SKIN_CHUNK];
     for (uint32_t f = 0; f < SC_SKIN_FAMILIES; f++) {
         const uint32_t o = s->off[f];
         const float *restrict k = s->k_fam[f], *restrict l0 = s->l0_fam[f];
-        for (uint32_t n = 0; n + o < nn; n++) {
-            const uint32_t m = n + o;
-            const float dx = x[m] - x[n], dy = y[m] - y[n], dz = z[m] - z[n];
-            const float len2 = dx * dx + dy * dy + dz * dz;
-            const float len = sqrtf(len2 + SC_SKIN_MIN_LEN2_MM2);
-            const float inv = 1.0f / len;
-            const float rate = (dx * (vx[m] - vx[n]) + dy * (vy[m] - vy[n]) +
-                                dz * (vz[m] - vz[n])) * inv;
-            const float sc = k[n] * ((len - l0[n]) + g * rate) * inv;
-            ax_[n] += sc * dx;
-            ay_[n] += sc * dy;
-            az_[n] += sc * dz;
-            ax_[m] -= sc * dx;
-            ay_[m] -= sc * dy;
-            az_[m] -= sc * dz;
+        const uint32_t end = o < nn ? nn - o : 0u;
+        for (uint32_t n0 = 0; n0 < end; n0 += SC_SKIN_CHUNK) {
+            const uint32_t c = end - n0 < SC_SKIN_CHUNK ? end - n0 : SC_SKIN_CHUNK;
+            for (uint32_t i = 0; i < c; i++) {
+                const uint32_t n = n0 + i, m = n + o;
+                const float dx = x[m] - x[n], dy = y[m] - y[n], dz = z[m] - z[n];
+                const float len2 = dx * dx + dy * dy + dz * dz;
+                const float len = sqrtf(len2 + SC_SKIN_MIN_LEN2_MM2);
+                const float inv = 1.0f / len;
+                const float rate = (dx * (vx[m] - vx[n]) + dy * (vy[m] - vy[n]) +
+                                    dz * (vz[m] - vz[n])) * inv;
+                const float sc = k[n] * ((len - l0[n]) + g * rate) * inv;
+                tx[i] = sc * dx;
+                ty[i] = sc * dy;
+                tz[i] = sc * dz;
+            }
+            { /* the far ends (each block's pointers are its only access to those rows) */
+                float *restrict ex = ax_ + n0 + o, *restrict ey = ay_ + n0 + o,
+                                *restrict ez = az_ + n0 + o;
+                for (uint32_t i = 0; i < c; i++) {
+                    ex[i] -= tx[i];
+                    ey[i] -= ty[i];
+                    ez[i] -= tz[i];
+                }
+            }
+            { /* the origins */
+                float *restrict bx = ax_ + n0, *restrict by = ay_ + n0, *restrict bz = az_ + n0;
+                for (uint32_t i = 0; i < c; i++) {
+                    bx[i] += tx[i];
+                    by[i] += ty[i];
+                    bz[i] += tz[i];
+                }
+            }
         }
     }
     const float keep = 1.0f - dt * s->def.drag_per_s;
