@@ -685,10 +685,14 @@ static void map_line_walk(sc_bscan *b, const sc_mesh *m, uint32_t l, uint32_t *a
     uint32_t k = 0, steps = 0, ei = 0;
     int trouble = 0;
     if (ne > 0u && !b->events[0].entry) {
-        /* the line starts inside the mesh (behind the face) or the boundary is folded:
-         * harmless if that is behind the first pixel, else the walk starts by locating */
+        /* the line starts inside the mesh (behind the face) or the boundary is folded: the
+         * walk starts by locating the first pixel. Also when that exit lies behind the first
+         * pixel: under a pressed face the skin's boundary triangles lie in the face's plane,
+         * so the crossing is at s ~ 0 and its side (entry or exit) is a rounding, cell by
+         * cell; skipping it left whole lines unmapped (bars in a rocked frame, 9 lines wide:
+         * test_bscan_folds). A line that does start outside costs one point location. */
         ei = 1u;
-        if (b->events[0].s > 0.0f) {
+        {
             uint32_t t0 = 0;
             float s0 = 0.0f;
             const int rr = relocate(b, m, c, 0u, &k, 0, &t0, &s0);
