@@ -13,7 +13,7 @@
  * 24x12x12, 28x14x14, 32x16x16) and 48x24x24, 64x32x32. Methods: the stable MSDS (default), the FEM
  * linear and corotated (the paper's explicit MSDS is bench-physics'). Every run's frame state hash
  * is checked against the one-worker run of the same mesh and method: a mismatch is reported (and
- * the exit status is 1).
+ * the exit status is 1); the state hash itself is printed last (compare binaries with it).
  *
  * Usage: bench-scale [--frames N] [--repeats R] [--workers 1,2] [--meshes 20x10x10,...]
  *                    [--methods msds,fem,corot] [--csv FILE]
@@ -150,8 +150,9 @@ int main(int argc, char **argv)
     printf("bench-scale: %d runs x %d frames per row, wall clock; median (min..max of the runs' "
            "medians)\n",
            o.b.repeats, o.b.frames);
-    printf("%-9s %6s %7s %-6s %3s %9s %19s %8s %8s %7s %9s %6s\n", "mesh", "nodes", "tets",
-           "method", "w", "frame ms", "spread", "coll ms", "speedup", "60Hz", "cpu ms", "hash");
+    printf("%-9s %6s %7s %-6s %3s %9s %19s %8s %8s %7s %9s %6s %16s\n", "mesh", "nodes", "tets",
+           "method", "w", "frame ms", "spread", "coll ms", "speedup", "60Hz", "cpu ms", "hash",
+           "state hash");
     int status = 0;
     for (int mi = 0; mi < o.b.nmesh; mi++) {
         for (int m = 0; m < BENCH_METHODS; m++) {
@@ -189,11 +190,11 @@ int main(int argc, char **argv)
                 status |= !same;
                 printf(
                     "%2ux%2ux%2u  %6u %7u %-6s %3u %9.3f %8.3f..%8.3f %8.3f %7.2fx %6.0f%% %9.3f "
-                    "%s\n",
+                    "%-7s %016llx\n",
                     o.b.mesh[mi][0], o.b.mesh[mi][1], o.b.mesh[mi][2], r.nodes, r.tets,
                     bench_method_name[m], (unsigned)w, r.med_ms, r.min_ms, r.max_ms, r.coll_ms,
                     one / r.med_ms, 100.0 * (1.0 - r.med_ms / (1000.0 / 60.0)), r.cpu_ms,
-                    same ? "same" : "DIFFERS");
+                    same ? "same" : "DIFFERS", (unsigned long long)r.hash);
                 fflush(stdout);
             }
         }
