@@ -104,7 +104,10 @@ static void pool_run(void *ctx, sc_pool_job_fn fn, void *arg, uint32_t ranges)
     atomic_store_explicit(&p->ranges, ranges, memory_order_relaxed);
     atomic_store_explicit(&p->done, 0u, memory_order_relaxed);
     atomic_store_explicit(&p->seq, seq, memory_order_seq_cst);
+    p->jobs++;
+    p->ranges_run += ranges;
     if (atomic_load_explicit(&p->sleeping, memory_order_seq_cst) != 0u) {
+        p->wakes++;
         futex_wake_all(&p->seq);
     }
     run_ranges(p, seq);
