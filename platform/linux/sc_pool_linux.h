@@ -48,6 +48,8 @@ typedef struct sc_pool_linux {
     uint64_t jobs;    /* run calls that went to the workers (ranges > 1) */
     uint64_t ranges_run; /* their ranges */
     uint64_t wakes;   /* jobs that found a worker asleep on the futex (a wake-up syscall) */
+    uint64_t job_ns;  /* wall time the caller spent in those runs (CLOCK_MONOTONIC): the rest
+                       * of its time between two readings is its work alone, no worker's */
 } sc_pool_linux;
 
 /* Start a pool of `workers` (1..SC_POOL_LINUX_MAX_WORKERS; 0: one per online CPU) and fill
