@@ -65,6 +65,7 @@ int sc_collider_init(sc_collider *c, const sc_collider_def *def)
     }
     c->def = *def;
     c->active = 0;
+    c->pool = NULL;
     c->to_vol = sc_xform_identity();
     c->to_probe = sc_xform_identity();
     if (def->shape == SC_COLLIDER_SPHERE) {
@@ -247,6 +248,120 @@ static void index_range(float lo, float hi, float origin, float cell, uint32_t n
     *i1 = (uint32_t)b + 1u;
 }
 
+/* What a detection needs, for the rows of the candidate box (sc_collider_detect). */
+typedef struct detect_ctx {
+    const sc_collider *c;
+    const sc_collider_grid *g;
+    const float *x, *y, *z;
+    const uint8_t *fixed;
+    float infl;
+    float lim[3];
+    uint32_t r0[3], r1[3];
+    uint32_t rows_per_chunk, chunks;
+    uint32_t count[SC_COLLIDER_CHUNKS], cand[SC_COLLIDER_CHUNKS], mpr[SC_COLLIDER_CHUNKS];
+    uint32_t base[SC_COLLIDER_CHUNKS];
+    sc_contact *out; /* the set's contacts; chunk q writes from out + base[q] */
+} detect_ctx;
+
+/* The contacts of the candidate rows row0 .. row1 - 1 (row: (j, k) of the box, k major, the
+ * nodes along i in order) into dst, in node order; returns their count. Every node's contact is
+ * its own (MPR from a hint of its own): any split of the rows gives the same contacts. */
+static uint32_t detect_rows(const detect_ctx *d, uint32_t row0, uint32_t row1, sc_contact *dst,
+                            uint32_t *cand_out, uint32_t *mpr_out)
+{
+    const sc_collider *c = d->c;
+    const sc_collider_grid *g = d->g;
+    const float *x = d->x, *y = d->y, *z = d->z;
+    const uint8_t *fixed = d->fixed;
+    const uint32_t *r0 = d->r0, *r1 = d->r1;
+    const float *lim = d->lim;
+    /* CCD_INIT would reference ccdFirstDirDefault, which lives in libccd's ccd.c (GJK/EPA,
+     * heap-allocating, not linked into the bare-metal image); MPR never calls first_dir. */
+    ccd_t ccd;
+    memset(&ccd, 0, sizeof(ccd));
+    ccd.first_dir = first_dir_x;
+    ccd.support1 = probe_support;
+    ccd.center1 = probe_center;
+    ccd.support2 = point_support;
+    ccd.center2 = point_center;
+    ccd.max_iterations = 100u;
+    ccd.mpr_tolerance = 1e-6;
+    ccd_probe probe = {c, (double)d->infl, {0.0, 0.0, 0.0}};
+    uint32_t count = 0, cand = 0, mpr = 0;
+    const uint32_t nj = r1[1] - r0[1];
+    for (uint32_t row = row0; row < row1; row++) {
+        const uint32_t k = r0[2] + row / nj, j = r0[1] + row % nj;
+        for (uint32_t i = r0[0]; i < r1[0]; i++) {
+            const uint32_t n = i + g->nx * (j + g->ny * k);
+            if (fixed != NULL && fixed[n] != 0u) {
+                continue;
+            }
+            cand++;
+            const float p[3] = {x[n], y[n], z[n]};
+            float l[3];
+            sc_xform_apply(&c->to_probe, p, l);
+            /* conservative: outside the inflated shape's box in the probe frame */
+            if (fabsf(l[0] - c->center_probe_mm[0]) > lim[0] ||
+                fabsf(l[1] - c->center_probe_mm[1]) > lim[1] ||
+                fabsf(l[2] - c->center_probe_mm[2]) > lim[2]) {
+                continue;
+            }
+            const ccd_point pt = {{(double)p[0], (double)p[1], (double)p[2]}};
+            core_hint(c, l, probe.hint);
+            ccd_real_t depth = 0.0;
+            ccd_vec3_t dir, pos;
+            mpr++;
+            if (ccdMPRPenetration(&probe, &pt, &ccd, &depth, &dir, &pos) != 0) {
+                continue;
+            }
+            const double dl =
+                sqrt(dir.v[0] * dir.v[0] + dir.v[1] * dir.v[1] + dir.v[2] * dir.v[2]);
+            if (!(dl > 0.0) || !isfinite(depth)) {
+                continue;
+            }
+            /* moving the node by depth along dir reaches the inflated surface; the real
+             * surface is margin closer */
+            const double d_real = depth - (double)c->def.margin_mm;
+            sc_contact *ct = &dst[count++];
+            ct->node = n;
+            for (uint32_t a = 0; a < 3u; a++) {
+                const double u = dir.v[a] / dl;
+                ct->n[a] = (float)u;
+                ct->p_mm[a] = (float)((double)p[a] + d_real * u);
+            }
+            /* Sliding face: a node inside the probe leaves through the face plane (the
+             * probe came from outside the body, through the skin; tissue slides under a
+             * gel-coated face), not through the nearest side wall or rounded edge: MPR's
+             * shortest way out lets a probe that moves sideways at depth, or jumps
+             * between two frames, bulldoze the tissue ahead of it until a node is pushed
+             * out of the box (the guard's displacement reset, measured with `--script
+             * sweep` on all three phantoms). */
+            /* (also a contact within the margin above the face plane: a node left on
+             * the face plane at the rounded rim lies just outside the rounding; with the
+             * rounding's own plane it would not be held, would spring back into the
+             * probe and chatter between the two every frame) */
+            if (c->def.shape == SC_COLLIDER_ROUNDED_BOX && l[2] < c->def.margin_mm) {
+                const float lf[3] = {l[0], l[1], 0.0f};
+                const float nz[3] = {0.0f, 0.0f, 1.0f};
+                sc_xform_apply(&c->to_vol, lf, ct->p_mm);
+                sc_xform_rotate(&c->to_vol, nz, ct->n);
+            }
+        }
+    }
+    *cand_out = cand;
+    *mpr_out = mpr;
+    return count;
+}
+
+static void job_detect(void *arg, uint32_t q)
+{
+    detect_ctx *d = (detect_ctx *)arg;
+    const uint32_t rows = (d->r1[2] - d->r0[2]) * (d->r1[1] - d->r0[1]);
+    const uint32_t a = q * d->rows_per_chunk;
+    const uint32_t b = a + d->rows_per_chunk < rows ? a + d->rows_per_chunk : rows;
+    d->count[q] = detect_rows(d, a, b, d->out + d->base[q], &d->cand[q], &d->mpr[q]);
+}
+
 void sc_collider_detect(const sc_collider *c, const sc_collider_grid *g, const float *x,
                         const float *y, const float *z, const uint8_t *fixed,
                         float max_disp_mm, sc_contact_set *out)
@@ -259,7 +374,15 @@ void sc_collider_detect(const sc_collider *c, const sc_collider_grid *g, const f
     if (!c->active) {
         return;
     }
+    detect_ctx d;
+    d.c = c;
+    d.g = g;
+    d.x = x;
+    d.y = y;
+    d.z = z;
+    d.fixed = fixed;
     const float infl = inflate_of(c);
+    d.infl = infl;
     const float widen = infl + (isfinite(max_disp_mm) && max_disp_mm > 0.0f ? max_disp_mm : 0.0f);
     /* AABB of the core box (or centre) in the volume frame, widened */
     float lo[3], hi[3], cen[3];
@@ -271,86 +394,43 @@ void sc_collider_detect(const sc_collider *c, const sc_collider_grid *g, const f
         lo[i] = cen[i] - ext - widen;
         hi[i] = cen[i] + ext + widen;
     }
-    uint32_t r0[3], r1[3];
-    index_range(lo[0], hi[0], g->origin_mm[0], g->cell_mm[0], g->nx, &r0[0], &r1[0]);
-    index_range(lo[1], hi[1], g->origin_mm[1], g->cell_mm[1], g->ny, &r0[1], &r1[1]);
-    index_range(lo[2], hi[2], g->origin_mm[2], g->cell_mm[2], g->nz, &r0[2], &r1[2]);
-
-    /* CCD_INIT would reference ccdFirstDirDefault, which lives in libccd's ccd.c (GJK/EPA,
-     * heap-allocating, not linked into the bare-metal image); MPR never calls first_dir. */
-    ccd_t ccd;
-    memset(&ccd, 0, sizeof(ccd));
-    ccd.first_dir = first_dir_x;
-    ccd.support1 = probe_support;
-    ccd.center1 = probe_center;
-    ccd.support2 = point_support;
-    ccd.center2 = point_center;
-    ccd.max_iterations = 100u;
-    ccd.mpr_tolerance = 1e-6;
-    ccd_probe probe = {c, (double)infl, {0.0, 0.0, 0.0}};
-    const float lim[3] = {c->core_half_mm[0] + infl, c->core_half_mm[1] + infl,
-                          c->core_half_mm[2] + infl};
-
-    for (uint32_t k = r0[2]; k < r1[2]; k++) {
-        for (uint32_t j = r0[1]; j < r1[1]; j++) {
-            for (uint32_t i = r0[0]; i < r1[0]; i++) {
-                const uint32_t n = i + g->nx * (j + g->ny * k);
-                if (fixed != NULL && fixed[n] != 0u) {
-                    continue;
-                }
-                out->candidates++;
-                const float p[3] = {x[n], y[n], z[n]};
-                float l[3];
-                sc_xform_apply(&c->to_probe, p, l);
-                /* conservative: outside the inflated shape's box in the probe frame */
-                if (fabsf(l[0] - c->center_probe_mm[0]) > lim[0] ||
-                    fabsf(l[1] - c->center_probe_mm[1]) > lim[1] ||
-                    fabsf(l[2] - c->center_probe_mm[2]) > lim[2]) {
-                    continue;
-                }
-                const ccd_point pt = {{(double)p[0], (double)p[1], (double)p[2]}};
-                core_hint(c, l, probe.hint);
-                ccd_real_t depth = 0.0;
-                ccd_vec3_t dir, pos;
-                out->mpr_calls++;
-                if (ccdMPRPenetration(&probe, &pt, &ccd, &depth, &dir, &pos) != 0) {
-                    continue;
-                }
-                const double dl =
-                    sqrt(dir.v[0] * dir.v[0] + dir.v[1] * dir.v[1] + dir.v[2] * dir.v[2]);
-                if (!(dl > 0.0) || !isfinite(depth)) {
-                    continue;
-                }
-                /* moving the node by depth along dir reaches the inflated surface; the real
-                 * surface is margin closer */
-                const double d_real = depth - (double)c->def.margin_mm;
-                sc_contact *ct = &out->c[out->count++];
-                ct->node = n;
-                for (uint32_t a = 0; a < 3u; a++) {
-                    const double u = dir.v[a] / dl;
-                    ct->n[a] = (float)u;
-                    ct->p_mm[a] = (float)((double)p[a] + d_real * u);
-                }
-                /* Sliding face: a node inside the probe leaves through the face plane (the
-                 * probe came from outside the body, through the skin; tissue slides under a
-                 * gel-coated face), not through the nearest side wall or rounded edge: MPR's
-                 * shortest way out lets a probe that moves sideways at depth, or jumps
-                 * between two frames, bulldoze the tissue ahead of it until a node is pushed
-                 * out of the box (the guard's displacement reset, measured with `--script
-                 * sweep` on all three phantoms). */
-                /* (also a contact within the margin above the face plane: a node left on
-                 * the face plane at the rounded rim lies just outside the rounding; with the
-                 * rounding's own plane it would not be held, would spring back into the
-                 * probe and chatter between the two every frame) */
-                if (c->def.shape == SC_COLLIDER_ROUNDED_BOX && l[2] < c->def.margin_mm) {
-                    const float lf[3] = {l[0], l[1], 0.0f};
-                    const float nz[3] = {0.0f, 0.0f, 1.0f};
-                    sc_xform_apply(&c->to_vol, lf, ct->p_mm);
-                    sc_xform_rotate(&c->to_vol, nz, ct->n);
-                }
-            }
-        }
+    index_range(lo[0], hi[0], g->origin_mm[0], g->cell_mm[0], g->nx, &d.r0[0], &d.r1[0]);
+    index_range(lo[1], hi[1], g->origin_mm[1], g->cell_mm[1], g->ny, &d.r0[1], &d.r1[1]);
+    index_range(lo[2], hi[2], g->origin_mm[2], g->cell_mm[2], g->nz, &d.r0[2], &d.r1[2]);
+    for (uint32_t i = 0; i < 3u; i++) {
+        d.lim[i] = c->core_half_mm[i] + infl;
     }
+    const uint32_t width = d.r1[0] - d.r0[0];
+    const uint32_t rows = (d.r1[2] - d.r0[2]) * (d.r1[1] - d.r0[1]);
+    if (width == 0u || rows == 0u) {
+        return;
+    }
+    d.out = out->c;
+    if (c->pool == NULL || rows * width < SC_COLLIDER_POOL_MIN) {
+        /* serial: one chunk, straight into the set */
+        out->count = detect_rows(&d, 0u, rows, out->c, &out->candidates, &out->mpr_calls);
+        return;
+    }
+    /* on the pool: the rows cut into at most SC_COLLIDER_CHUNKS chunks (by the box alone, not
+     * the workers); chunk q writes from the first slot that the candidates before it could
+     * fill (the box holds at most SC_MAX_CONTACTS nodes), then the chunks' contacts are moved
+     * together in chunk order: the serial loop's set */
+    d.rows_per_chunk = (rows + SC_COLLIDER_CHUNKS - 1u) / SC_COLLIDER_CHUNKS;
+    d.chunks = (rows + d.rows_per_chunk - 1u) / d.rows_per_chunk;
+    for (uint32_t q = 0; q < d.chunks; q++) {
+        d.base[q] = q * d.rows_per_chunk * width;
+    }
+    sc_pool_run(c->pool, job_detect, &d, d.chunks);
+    uint32_t count = 0;
+    for (uint32_t q = 0; q < d.chunks; q++) {
+        if (d.count[q] > 0u && d.base[q] != count) {
+            memmove(&out->c[count], &out->c[d.base[q]], (size_t)d.count[q] * sizeof out->c[0]);
+        }
+        count += d.count[q];
+        out->candidates += d.cand[q];
+        out->mpr_calls += d.mpr[q];
+    }
+    out->count = count;
 }
 
 float sc_contact_depth_mm(const sc_contact *ct, float x, float y, float z)

@@ -31,7 +31,14 @@
 #include <stdint.h>
 
 #include "sc_config.h"
+#include "sc_hal_pool.h"
 #include "sc_pose.h"
+
+/* Detection on a worker pool (sc_collider.pool): the candidate box's rows are cut into at most
+ * SC_COLLIDER_CHUNKS chunks, by the box alone; a box of fewer than SC_COLLIDER_POOL_MIN
+ * candidates runs serially. Either way the same contacts in the same order. */
+#define SC_COLLIDER_CHUNKS 32u
+#define SC_COLLIDER_POOL_MIN 2048u
 
 typedef enum sc_collider_shape {
     SC_COLLIDER_SPHERE = 0,
@@ -74,6 +81,8 @@ typedef struct sc_collider {
     sc_xform to_probe;   /* volume -> probe */
     float core_half_mm[3]; /* box swept by the sphere of radius round_radius_mm */
     float center_probe_mm[3];
+    const sc_pool_dev *pool; /* workers of the detection (NULL: serial); init sets NULL, the
+                              * owner may set it (sc_tissue_set_pool) */
 } sc_collider;
 
 /* Linear probe: 40 x 10 mm face, 2 mm rounding, 20 mm body, 0.5 mm margin. */

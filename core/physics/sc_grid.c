@@ -192,6 +192,19 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
     /* cell origins 0 .. nn - off[7] - 1 (the last plane, row and column have none) */
     const uint32_t cells = nn - g->off[7];
     g->cell_end = (cells + SC_GRID_CELL_BLOCK - 1u) / SC_GRID_CELL_BLOCK * SC_GRID_CELL_BLOCK;
+    /* the pool's split, by the mesh alone (sc_grid.h): up to two ranges of SC_GRID_ASM_SPAN and
+     * one sum block the serial loops' sums, bigger meshes finer ranges for the workers */
+    g->asm_span = SC_GRID_ASM_SPAN;
+    if (g->cell_end > 2u * SC_GRID_ASM_SPAN) {
+        const uint32_t apart = nxy + nx + SC_GRID_CELL_BLOCK + 1u;
+        const uint32_t span = (apart + SC_GRID_CELL_BLOCK - 1u) / SC_GRID_CELL_BLOCK *
+                              SC_GRID_CELL_BLOCK;
+        g->asm_span = span > SC_GRID_ASM_SPAN_MIN ? span : SC_GRID_ASM_SPAN_MIN;
+    }
+    SC_ASSERT(g->asm_span % SC_GRID_CELL_BLOCK == 0u &&
+              g->asm_span > nxy + nx + SC_GRID_CELL_BLOCK &&
+              (g->cell_end + g->asm_span - 1u) / g->asm_span <= SC_GRID_ASM_RANGES);
+    g->sum_block = g->node_end > SC_GRID_SUM_BLOCK ? SC_GRID_SUM_BLOCK_BIG : SC_GRID_SUM_BLOCK;
     init_slots(g);
     init_targets(g);
     /* the kernels' constant tables are this derivation */
@@ -337,7 +350,7 @@ static int rigid_motions_pinned(const sc_grid *g)
 
 /* The step's node loops on the worker pool (sc_grid.h): ranges of SC_GRID_POOL_RANGE nodes,
  * every node's values its own (the serial loops' bits); the loaded test is an OR per range and
- * the solution's sum of squares is summed per SC_GRID_SUM_BLOCK nodes and added in block order
+ * the solution's sum of squares is summed per sc_grid.sum_block nodes and added in block order
  * (one block up to 32x16x16: the serial sum). */
 #define SC_GRID_NODE_RANGES ((SC_MAX_NODES + SC_GRID_POOL_RANGE - 1u) / SC_GRID_POOL_RANGE)
 typedef struct step_job {
@@ -462,17 +475,39 @@ void sc_grid_begin(sc_grid *g, const sc_mesh *m, const sc_nodes *n, float dt_s, 
     sc_pool_run(g->pool, job_start, &j, ranges);
 }
 
+/* sc_grid_clear on the pool: the used part of the rows cut into ranges of SC_GRID_POOL_RANGE
+ * floats (zeros: any split gives the same bits; 60 rows of 262 KB each at 64x32x32 was a serial
+ * 16 MB memset of the corotated step) */
+typedef struct clear_job {
+    sc_grid *g;
+    uint32_t which, used;
+} clear_job;
+
+static void job_clear(void *arg, uint32_t r)
+{
+    const clear_job *j = (const clear_job *)arg;
+    sc_grid *g = j->g;
+    const uint32_t a = r * SC_GRID_POOL_RANGE;
+    const uint32_t b = a + SC_GRID_POOL_RANGE < j->used ? a + SC_GRID_POOL_RANGE : j->used;
+    const size_t bytes = (size_t)(b - a) * sizeof(float);
+    if ((j->which & SC_GRID_CLEAR_DIAG) != 0u) {
+        for (uint32_t k = 0; k < 6u; k++) {
+            memset(&g->d[k][a], 0, bytes);
+        }
+    }
+    if ((j->which & SC_GRID_CLEAR_BLOCKS) != 0u) {
+        for (uint32_t k = 0; k < 27u; k++) {
+            memset(&g->e[0][0][0] + (size_t)k * SC_GRID_ROW + a, 0, bytes);
+            memset(&g->f[0][0][0] + (size_t)k * SC_GRID_ROW + a, 0, bytes);
+        }
+    }
+}
+
 void sc_grid_clear(sc_grid *g, uint32_t which)
 {
     SC_ASSERT(g != NULL);
-    const uint32_t used = SC_GRID_HEAD + g->node_end + SC_GRID_PAD;
-    if ((which & SC_GRID_CLEAR_DIAG) != 0u) {
-        zero_rows(&g->d[0][0], 6u, used);
-    }
-    if ((which & SC_GRID_CLEAR_BLOCKS) != 0u) {
-        zero_rows(&g->e[0][0][0], 27u, used);
-        zero_rows(&g->f[0][0][0], 27u, used);
-    }
+    clear_job j = {g, which, SC_GRID_HEAD + g->node_end + SC_GRID_PAD};
+    sc_pool_run(g->pool, job_clear, &j, (j.used + SC_GRID_POOL_RANGE - 1u) / SC_GRID_POOL_RANGE);
 }
 
 static void job_precond(void *arg, uint32_t r)
@@ -499,7 +534,7 @@ static void job_vsum(void *arg, uint32_t b)
     step_job *j = (step_job *)arg;
     const sc_grid *g = j->g;
     uint32_t i0, i1;
-    job_span(j, b, SC_GRID_SUM_BLOCK, &i0, &i1);
+    job_span(j, b, g->sum_block, &i0, &i1);
     const uint32_t h = SC_GRID_HEAD;
     float vsum = 0.0f;
     for (uint32_t c = 0; c < 3u; c++) {
@@ -552,7 +587,7 @@ int sc_grid_solve(sc_grid *g, sc_nodes *n, float dt_s, float beta_s, float alpha
     g->stats.cg_iterations_run = out.iterations;
     g->stats.residual_ratio = (out.rz0 > 0.0f && out.rz >= 0.0f) ? sqrtf(out.rz / out.rz0) : 0.0f;
     /* refuse a non-finite solution: the shared state stays as it was */
-    const uint32_t blocks = job_ranges(g, SC_GRID_SUM_BLOCK);
+    const uint32_t blocks = job_ranges(g, g->sum_block);
     sc_pool_run(g->pool, job_vsum, &j, blocks);
     float vsum = j.vsum[0];
     for (uint32_t b = 1; b < blocks && b < SC_GRID_SUM_BLOCKS; b++) {

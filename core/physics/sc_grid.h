@@ -95,7 +95,13 @@ _Static_assert((SC_GRID_ROW / 16u) % 2u == 1u, "row stride an odd multiple of 16
  * workers is not. */
 #define SC_GRID_POOL_RANGE 1024u
 #define SC_GRID_SUM_BLOCK 8192u
-#define SC_GRID_SUM_BLOCKS ((SC_MAX_NODES + SC_GRID_SUM_BLOCK - 1u) / SC_GRID_SUM_BLOCK)
+/* A mesh of more than SC_GRID_SUM_BLOCK nodes sums its dot products over blocks of
+ * SC_GRID_SUM_BLOCK_BIG nodes instead (sc_grid.sum_block, chosen by the mesh alone): one block per
+ * mat-vec range, so two workers share the blocks evenly (with 8,192-node blocks a 48x24x24 mesh
+ * had four, the last 3,072 nodes: 3.4 blocks of work over two workers took the time of 2) and
+ * the p.Ap partials are formed in the mat-vec's own job. */
+#define SC_GRID_SUM_BLOCK_BIG SC_GRID_POOL_RANGE
+#define SC_GRID_SUM_BLOCKS ((SC_MAX_NODES + SC_GRID_SUM_BLOCK_BIG - 1u) / SC_GRID_SUM_BLOCK_BIG)
 _Static_assert(SC_GRID_POOL_RANGE % SC_GRID_CHUNK == 0u && SC_GRID_SUM_BLOCK % 16u == 0u,
                "pool ranges and sum blocks are whole chunks and whole partial-sum groups");
 
@@ -107,7 +113,13 @@ _Static_assert(SC_GRID_POOL_RANGE % SC_GRID_CHUNK == 0u && SC_GRID_SUM_BLOCK % 1
  * order is part of what makes a state hash, the number of workers is not; a mesh of one range
  * (cell origins up to SC_GRID_ASM_SPAN: up to 32x16x16) sums exactly as the serial loop did. */
 #define SC_GRID_ASM_SPAN 8192u
-#define SC_GRID_ASM_RANGES ((SC_MAX_NODES + SC_GRID_ASM_SPAN - 1u) / SC_GRID_ASM_SPAN)
+/* A mesh of more than two such ranges (more than 16,384 cell origins: 48x24x24, 64x32x32) is cut
+ * into ranges of sc_grid.asm_span origins instead, chosen by the mesh alone: the smallest whole
+ * number of cell blocks above nx ny + nx + SC_GRID_CELL_BLOCK (the two-apart rule above), at
+ * least SC_GRID_ASM_SPAN_MIN: about one z-plane of cells per range, 22 ranges at 48x24x24 (four
+ * of 8,192 before: the odd phase ran one full range beside a quarter one), 30 at 64x32x32. */
+#define SC_GRID_ASM_SPAN_MIN 1024u
+#define SC_GRID_ASM_RANGES ((SC_MAX_NODES + SC_GRID_ASM_SPAN_MIN - 1u) / SC_GRID_ASM_SPAN_MIN)
 
 /* cells per assembly block (a multiple of every variant's vector width); part of what makes
  * a state hash, so it is the same on every target (the MCU's SRAM sets it: the buffer is
@@ -151,6 +163,8 @@ typedef struct sc_grid {
     uint32_t node_count;
     uint32_t node_end;  /* node_count rounded up to SC_GRID_CHUNK */
     uint32_t cell_end;  /* cell origins 0 .. cell_end - 1 are visited (rounded up to a block) */
+    uint32_t asm_span;  /* cell origins per range of the cell passes (SC_GRID_ASM_SPAN above) */
+    uint32_t sum_block; /* nodes per block of the CG's dot products (SC_GRID_SUM_BLOCK above) */
     uint32_t off[8];    /* node offset of cell corner c (bit 0 +x, bit 1 +y, bit 2 +z) */
     sc_grid_slot slot[18];
     int8_t slot_of[8][8]; /* edge slot of a template corner pair, -1 if none */

@@ -396,6 +396,25 @@ static float law(const sc_lumen_vessel *v, float s)
     return v->bulk_pa * s;
 }
 
+/* The first tet from t on with a region (nt if none): the frame's loops visit the lumens' tets
+ * alone, in tet order (the sums' order unchanged), skipping the rest eight region bytes at a time
+ * (the lumens are a few percent of the tets: the byte-per-tet scan was most of these passes). */
+static uint32_t next_region_tet(const uint8_t *region, uint32_t t, uint32_t nt)
+{
+    while (t + 8u <= nt) {
+        uint64_t w;
+        memcpy(&w, region + t, sizeof w);
+        if (w != 0u) {
+            break;
+        }
+        t += 8u;
+    }
+    while (t < nt && region[t] == 0u) {
+        t++;
+    }
+    return t;
+}
+
 void sc_lumen_apply(sc_lumen *l, const sc_mesh *m, sc_nodes *n)
 {
     l->faces = 0u;
@@ -407,12 +426,11 @@ void sc_lumen_apply(sc_lumen *l, const sc_mesh *m, sc_nodes *n)
     float vol[SC_LUMEN_MAX][SC_LUMEN_SLICES];
     memset(vol, 0, sizeof vol);
     const uint32_t nt = m->tet_count;
-    for (uint32_t t = 0; t < nt; t++) {
+    for (uint32_t t = next_region_tet(l->region, 0u, nt); t < nt;
+         t = next_region_tet(l->region, t + 1u, nt)) {
         const uint8_t r = l->region[t];
-        if (r != 0u) {
-            vol[r - 1u][slice_of(&l->v[r - 1u], m, t)] +=
-                sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[t]);
-        }
+        vol[r - 1u][slice_of(&l->v[r - 1u], m, t)] +=
+            sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[t]);
     }
     float press_nmm2[SC_LUMEN_MAX][SC_LUMEN_SLICES];
     for (uint32_t k = 0; k < l->count; k++) {
@@ -447,11 +465,9 @@ void sc_lumen_apply(sc_lumen *l, const sc_mesh *m, sc_nodes *n)
         v->p_pa = isfinite(v->p_pa) ? v->p_pa : 0.0f;
     }
     uint32_t faces = 0;
-    for (uint32_t t = 0; t < nt; t++) {
+    for (uint32_t t = next_region_tet(l->region, 0u, nt); t < nt;
+         t = next_region_tet(l->region, t + 1u, nt)) {
         const uint8_t r = l->region[t];
-        if (r == 0u) {
-            continue;
-        }
         const float pk = press_nmm2[r - 1u][slice_of(&l->v[r - 1u], m, t)];
         const uint32_t *tv = m->tet[t];
         if (!(sc_mesh_tet_volume_mm3(n->x, n->y, n->z, tv) > 0.0f)) {
@@ -501,11 +517,9 @@ void sc_lumen_clear(const sc_lumen *l, const sc_mesh *m, sc_nodes *n)
     if (l->faces == 0u) {
         return;
     }
-    for (uint32_t t = 0; t < m->tet_count; t++) {
-        const uint8_t r = l->region[t];
-        if (r == 0u) {
-            continue;
-        }
+    const uint32_t nt = m->tet_count;
+    for (uint32_t t = next_region_tet(l->region, 0u, nt); t < nt;
+         t = next_region_tet(l->region, t + 1u, nt)) {
         for (uint32_t f = 0; f < 4u; f++) {
             const int32_t nb = m->tet_nbr[t][f];
             if (nb < 0 || l->region[nb] != 0u) {

@@ -89,6 +89,7 @@ static int build_contact(sc_tissue *t)
     if (rc != SC_OK) {
         return rc;
     }
+    t->collider.pool = t->pool;
     sc_skin_def sd = t->def.skin;
     if (!t->def.skin_enabled) {
         /* a minimal, never stepped surface keeps the struct valid */
@@ -279,23 +280,58 @@ static void step_kinematic(sc_tissue *t, int implicit_msds)
     t->stats.kinematic = held;
 }
 
-/* Guard pass: finite check, largest displacement. O(N). */
-static sc_tissue_guard guard(sc_tissue *t)
+/* The guard's scan on the worker pool: ranges of SC_TISSUE_GUARD_RANGE nodes, each its largest
+ * squared displacement and whether a value is not finite; the ranges' maxima and flags combined
+ * afterwards (a maximum and an OR: the serial loop's result for any split). */
+#define SC_TISSUE_GUARD_RANGE 4096u
+#define SC_TISSUE_GUARD_RANGES ((SC_MAX_NODES + SC_TISSUE_GUARD_RANGE - 1u) / SC_TISSUE_GUARD_RANGE)
+typedef struct guard_job {
+    const sc_nodes *n;
+    const sc_mesh *m;
+    float maxd2[SC_TISSUE_GUARD_RANGES];
+    uint8_t bad[SC_TISSUE_GUARD_RANGES];
+} guard_job;
+
+static void job_guard(void *arg, uint32_t r)
 {
-    const sc_nodes *n = &t->nodes;
-    const sc_mesh *m = &t->mesh;
+    guard_job *j = (guard_job *)arg;
+    const sc_nodes *n = j->n;
+    const sc_mesh *m = j->m;
+    const uint32_t i0 = r * SC_TISSUE_GUARD_RANGE;
+    const uint32_t i1 =
+        i0 + SC_TISSUE_GUARD_RANGE < m->node_count ? i0 + SC_TISSUE_GUARD_RANGE : m->node_count;
     float maxd2 = 0.0f;
     float acc = 0.0f;
-    for (uint32_t i = 0; i < m->node_count; i++) {
+    for (uint32_t i = i0; i < i1; i++) {
         const float dx = n->x[i] - m->rest_x[i], dy = n->y[i] - m->rest_y[i],
                     dz = n->z[i] - m->rest_z[i];
         const float d2 = dx * dx + dy * dy + dz * dz;
         maxd2 = d2 > maxd2 ? d2 : maxd2;
         acc += d2 * 0.0f + (n->vx[i] + n->vy[i] + n->vz[i]) * 0.0f;
     }
+    j->maxd2[r] = maxd2;
+    j->bad[r] = (uint8_t)!isfinite(acc);
+}
+
+/* Guard pass: finite check, largest displacement. O(N), on the pool. */
+static sc_tissue_guard guard(sc_tissue *t)
+{
+    guard_job j;
+    j.n = &t->nodes;
+    j.m = &t->mesh;
+    const uint32_t ranges = (t->mesh.node_count + SC_TISSUE_GUARD_RANGE - 1u) / SC_TISSUE_GUARD_RANGE;
+    SC_ASSERT(ranges <= SC_TISSUE_GUARD_RANGES);
+    sc_pool_run(t->pool, job_guard, &j, ranges);
+    float maxd2 = 0.0f;
+    int bad = 0;
+    for (uint32_t r = 0; r < ranges && r < SC_TISSUE_GUARD_RANGES; r++) {
+        maxd2 = j.maxd2[r] > maxd2 ? j.maxd2[r] : maxd2;
+        bad |= j.bad[r];
+    }
+    const sc_nodes *n = &t->nodes;
     const float maxd = sqrtf(maxd2);
     t->stats.max_disp_mm = maxd;
-    if (!isfinite(acc) || !isfinite(maxd)) {
+    if (bad || !isfinite(maxd)) {
         return SC_TISSUE_GUARD_NOT_FINITE;
     }
     if (maxd > t->box_diag_mm) {
@@ -487,6 +523,7 @@ void sc_tissue_set_pool(sc_tissue *t, const sc_pool_dev *pool)
 {
     SC_ASSERT(t != NULL);
     t->pool = pool;
+    t->collider.pool = pool; /* (the contact phase's init copies t->pool too) */
     if (t->build_phase > (uint8_t)SC_TISSUE_BUILD_FEM) {
         t->fem.grid.pool = pool; /* before: the FEM phase copies t->pool (and until then the
                                     FEM's storage holds the springs) */

@@ -95,6 +95,7 @@ static void *worker_main(void *argp)
 static void pool_run(void *ctx, sc_pool_job_fn fn, void *arg, uint32_t ranges)
 {
     sc_pool_linux *p = (sc_pool_linux *)ctx;
+    const uint64_t t0 = now_ns();
     const uint32_t seq = atomic_load_explicit(&p->seq, memory_order_relaxed) + 1u;
     /* the claim word first: from here no late worker of the previous job can claim */
     atomic_store_explicit(&p->claim, (uint64_t)seq << 32, memory_order_seq_cst);
@@ -104,7 +105,10 @@ static void pool_run(void *ctx, sc_pool_job_fn fn, void *arg, uint32_t ranges)
     atomic_store_explicit(&p->ranges, ranges, memory_order_relaxed);
     atomic_store_explicit(&p->done, 0u, memory_order_relaxed);
     atomic_store_explicit(&p->seq, seq, memory_order_seq_cst);
+    p->jobs++;
+    p->ranges_run += ranges;
     if (atomic_load_explicit(&p->sleeping, memory_order_seq_cst) != 0u) {
+        p->wakes++;
         futex_wake_all(&p->seq);
     }
     run_ranges(p, seq);
@@ -117,6 +121,7 @@ static void pool_run(void *ctx, sc_pool_job_fn fn, void *arg, uint32_t ranges)
             (void)sched_yield();
         }
     }
+    p->job_ns += now_ns() - t0;
 }
 
 static uint32_t pool_workers(void *ctx)

@@ -44,6 +44,12 @@ typedef struct sc_pool_linux {
     _Atomic uint32_t stop;
     _Atomic uint32_t sleeping; /* workers blocked on the futex */
     int first_cpu;             /* worker w pinned to CPU first_cpu + w (-1: not pinned) */
+    /* counters of the caller (run's thread alone writes them; read them between jobs) */
+    uint64_t jobs;    /* run calls that went to the workers (ranges > 1) */
+    uint64_t ranges_run; /* their ranges */
+    uint64_t wakes;   /* jobs that found a worker asleep on the futex (a wake-up syscall) */
+    uint64_t job_ns;  /* wall time the caller spent in those runs (CLOCK_MONOTONIC): the rest
+                       * of its time between two readings is its work alone, no worker's */
 } sc_pool_linux;
 
 /* Start a pool of `workers` (1..SC_POOL_LINUX_MAX_WORKERS; 0: one per online CPU) and fill

@@ -4,8 +4,12 @@
  * result depended on which worker ran which range, or on their order, changes the hash. The
  * mesh, 40 x 16 x 16 nodes (10,240), has two of the CG's sum blocks and ten mat-vec ranges, and
  * two ranges of the cell passes (sc_grid.h: SC_GRID_ASM_SPAN); 40 x 16 x 28 (17,920 nodes) has
- * three, so a seam where the even range's sums come before the odd one's. The springs' passes
- * run on the pool at every size. */
+ * three, so a seam where the even range's sums come before the odd one's (and, above two ranges
+ * of SC_GRID_ASM_SPAN, the finer per-mesh split of sc_grid.asm_span: 17 ranges, and the CG's
+ * sum blocks of 1,024 nodes whose p.Ap partials come from the mat-vec's job). The springs'
+ * passes run on the pool at every size; the collider's detection (a tilted probe pressed into a
+ * 40 x 30 x 20 grid of jittered nodes) gives the serial contact set on every pool. */
+#include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -14,6 +18,7 @@
 
 #include <cmocka.h>
 
+#include "sc_collider.h"
 #include "sc_err.h"
 #include "sc_hs_pool.h"
 #include "sc_labels.h"
@@ -161,10 +166,80 @@ static void host_pool_runs_every_range_once(void **state)
     assert_int_equal(sc_pool_workers(NULL), 1);
 }
 
+/* The collider on the pool: the contacts (nodes, planes, order) and the counters of a
+ * detection are those of the serial detection, for 1..4 host-pool workers and 2 threads. */
+static float g_cx[24000], g_cy[24000], g_cz[24000];
+static sc_contact_set g_serial, g_pooled;
+
+static void collider_on_the_pool_gives_the_serial_contacts(void **state)
+{
+    (void)state;
+    const sc_collider_grid g = {40u, 30u, 20u, {0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}};
+    uint32_t rng = 777u;
+    for (uint32_t k = 0; k < g.nz; k++) {
+        for (uint32_t j = 0; j < g.ny; j++) {
+            for (uint32_t i = 0; i < g.nx; i++) {
+                const uint32_t n = i + g.nx * (j + g.ny * k);
+                float jit[3];
+                for (uint32_t a = 0; a < 3u; a++) {
+                    rng = rng * 1664525u + 1013904223u;
+                    jit[a] = 0.3f * ((float)(rng >> 8) / 16777216.0f - 0.5f);
+                }
+                g_cx[n] = (float)i + jit[0];
+                g_cy[n] = (float)j + jit[1];
+                g_cz[n] = (float)k + jit[2];
+            }
+        }
+    }
+    sc_collider c;
+    assert_int_equal(sc_collider_init(&c, &(sc_collider_def){.shape = SC_COLLIDER_ROUNDED_BOX,
+                                                              .sphere_radius_mm = 10.0f,
+                                                              .half_mm = {20.0f, 5.0f, 10.0f},
+                                                              .round_radius_mm = 2.0f,
+                                                              .margin_mm = 0.5f}),
+                     SC_OK);
+    assert_null(c.pool);
+    sc_pose pose = sc_pose_identity();
+    const float ang = 0.3f; /* tilted about y, face 4 mm into the grid's top */
+    pose.q[0] = cosf(ang / 2.0f);
+    pose.q[2] = sinf(ang / 2.0f);
+    pose.pos_mm[0] = 19.5f;
+    pose.pos_mm[1] = 14.5f;
+    pose.pos_mm[2] = 4.0f;
+    assert_int_equal(sc_collider_set_pose(&c, &pose), SC_OK);
+    sc_collider_detect(&c, &g, g_cx, g_cy, g_cz, NULL, 1.0f, &g_serial);
+    print_message("serial: %u contacts, %u candidates, %u MPR calls\n", g_serial.count,
+                  g_serial.candidates, g_serial.mpr_calls);
+    assert_true(g_serial.count > 100u && g_serial.candidates >= SC_COLLIDER_POOL_MIN);
+    for (uint32_t w = 1u; w <= 5u; w++) {
+        sc_hs_pool hp;
+        static sc_pool_linux lp;
+        sc_pool_dev dev;
+        if (w <= 4u) {
+            sc_hs_pool_init(&hp, w, &dev);
+        } else {
+            assert_int_equal(sc_pool_linux_start(&lp, 2u, -1, 50u, &dev), 0);
+        }
+        c.pool = &dev;
+        memset(&g_pooled, 0xA5, sizeof g_pooled);
+        sc_collider_detect(&c, &g, g_cx, g_cy, g_cz, NULL, 1.0f, &g_pooled);
+        if (w <= 4u) {
+            assert_true(hp.ranges > 1u); /* it did go through the pool, in chunks */
+        } else {
+            sc_pool_linux_stop(&lp);
+        }
+        assert_int_equal(g_pooled.count, g_serial.count);
+        assert_int_equal(g_pooled.candidates, g_serial.candidates);
+        assert_int_equal(g_pooled.mpr_calls, g_serial.mpr_calls);
+        assert_memory_equal(g_pooled.c, g_serial.c, (size_t)g_serial.count * sizeof g_serial.c[0]);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(host_pool_runs_every_range_once),
+        cmocka_unit_test(collider_on_the_pool_gives_the_serial_contacts),
         cmocka_unit_test(state_hash_is_the_same_for_1_2_3_and_4_workers),
         cmocka_unit_test(three_cell_ranges_give_the_same_hash_for_1_2_and_4_workers),
         cmocka_unit_test(linux_pool_threads_give_the_serial_state_hash),

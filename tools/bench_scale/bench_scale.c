@@ -13,7 +13,9 @@
  * 24x12x12, 28x14x14, 32x16x16) and 48x24x24, 64x32x32. Methods: the stable MSDS (default), the FEM
  * linear and corotated (the paper's explicit MSDS is bench-physics'). Every run's frame state hash
  * is checked against the one-worker run of the same mesh and method: a mismatch is reported (and
- * the exit status is 1).
+ * the exit status is 1); then the state hash itself (compare binaries with it) and, with workers,
+ * the pool's hand-overs per frame: jobs (each a barrier), ranges, futex wake-ups, and the step's
+ * wall time outside the jobs (`alone ms`: the caller's serial work, median frame).
  *
  * Usage: bench-scale [--frames N] [--repeats R] [--workers 1,2] [--meshes 20x10x10,...]
  *                    [--methods msds,fem,corot] [--csv FILE]
@@ -73,13 +75,16 @@ static int parse_args(int argc, char **argv, opts *o)
 
 typedef struct run_out {
     double med_ms, min_ms, max_ms, coll_ms, cpu_ms;
+    double jobs, ranges, wakes; /* the pool's, per timed frame (0 without a pool) */
+    double alone_ms;            /* the step's wall time outside the pool's jobs (the caller
+                                 * alone), median over the timed frames */
     uint64_t hash;
     uint32_t nodes, tets, contacts;
 } run_out;
 
 /* build, press, then `repeats` runs of `frames` frames; the pool may be NULL */
 static int bench_one(const uint32_t mesh[3], bench_method m, const sc_pool_dev *pool, const opts *o,
-                     run_out *out, FILE *csv, uint32_t workers)
+                     run_out *out, FILE *csv, uint32_t workers, const sc_pool_linux *lp)
 {
     sc_pose pose;
     sc_collider_grid g;
@@ -89,13 +94,20 @@ static int bench_one(const uint32_t mesh[3], bench_method m, const sc_pool_dev *
     }
     static sc_contact_set cs;
     static uint64_t fr[BENCH_MAX_FRAMES], co[BENCH_MAX_FRAMES], cp[BENCH_MAX_FRAMES];
+    static uint64_t al[BENCH_MAX_FRAMES * BENCH_MAX_REPEATS];
+    uint32_t nal = 0;
     double meds[BENCH_MAX_REPEATS], colls[BENCH_MAX_REPEATS], cpus[BENCH_MAX_REPEATS];
+    const uint64_t jobs0 = lp ? lp->jobs : 0u, ranges0 = lp ? lp->ranges_run : 0u,
+                   wakes0 = lp ? lp->wakes : 0u;
     for (int r = 0; r < o->b.repeats; r++) {
         for (int f = 0; f < o->b.frames; f++) {
             const uint64_t c0 = bench_cpu_ns();
+            const uint64_t j0 = lp ? lp->job_ns : 0u;
             const uint64_t t0 = bench_now_ns();
             rc = sc_tissue_step(&g_t, &pose);
             const uint64_t t1 = bench_now_ns();
+            const uint64_t in_jobs = lp ? lp->job_ns - j0 : 0u;
+            al[nal++] = t1 - t0 > in_jobs ? t1 - t0 - in_jobs : 0u;
             cp[f] = bench_cpu_ns() - c0;
             sc_collider_detect(&g_t.collider, &g, g_t.nodes.x, g_t.nodes.y, g_t.nodes.z,
                                g_t.mesh.node_fixed, g_t.stats.max_disp_mm, &cs);
@@ -114,6 +126,11 @@ static int bench_one(const uint32_t mesh[3], bench_method m, const sc_pool_dev *
                     (unsigned)workers, r, meds[r], colls[r], cpus[r]);
         }
     }
+    const double timed = (double)o->b.repeats * (double)o->b.frames;
+    out->jobs = lp ? (double)(lp->jobs - jobs0) / timed : 0.0;
+    out->ranges = lp ? (double)(lp->ranges_run - ranges0) / timed : 0.0;
+    out->wakes = lp ? (double)(lp->wakes - wakes0) / timed : 0.0;
+    out->alone_ms = lp ? bench_median_ms(al, (int)nal) : 0.0;
     qsort(meds, (size_t)o->b.repeats, sizeof meds[0], bench_cmp_d);
     qsort(colls, (size_t)o->b.repeats, sizeof colls[0], bench_cmp_d);
     qsort(cpus, (size_t)o->b.repeats, sizeof cpus[0], bench_cmp_d);
@@ -150,8 +167,9 @@ int main(int argc, char **argv)
     printf("bench-scale: %d runs x %d frames per row, wall clock; median (min..max of the runs' "
            "medians)\n",
            o.b.repeats, o.b.frames);
-    printf("%-9s %6s %7s %-6s %3s %9s %19s %8s %8s %7s %9s %6s\n", "mesh", "nodes", "tets",
-           "method", "w", "frame ms", "spread", "coll ms", "speedup", "60Hz", "cpu ms", "hash");
+    printf("%-9s %6s %7s %-6s %3s %9s %19s %8s %8s %7s %9s %6s %16s %7s %8s %7s %8s\n", "mesh",
+           "nodes", "tets", "method", "w", "frame ms", "spread", "coll ms", "speedup", "60Hz",
+           "cpu ms", "hash", "state hash", "jobs/f", "ranges/f", "wakes/f", "alone ms");
     int status = 0;
     for (int mi = 0; mi < o.b.nmesh; mi++) {
         for (int m = 0; m < BENCH_METHODS; m++) {
@@ -170,7 +188,8 @@ int main(int argc, char **argv)
                 }
                 run_out r;
                 const int rc =
-                    bench_one(o.b.mesh[mi], (bench_method)m, w > 1u ? &dev : NULL, &o, &r, csv, w);
+                    bench_one(o.b.mesh[mi], (bench_method)m, w > 1u ? &dev : NULL, &o, &r, csv, w,
+                              w > 1u ? &lp : NULL);
                 if (w > 1u) {
                     sc_pool_linux_stop(&lp);
                 }
@@ -189,11 +208,12 @@ int main(int argc, char **argv)
                 status |= !same;
                 printf(
                     "%2ux%2ux%2u  %6u %7u %-6s %3u %9.3f %8.3f..%8.3f %8.3f %7.2fx %6.0f%% %9.3f "
-                    "%s\n",
+                    "%-7s %016llx %7.1f %8.1f %7.2f %8.3f\n",
                     o.b.mesh[mi][0], o.b.mesh[mi][1], o.b.mesh[mi][2], r.nodes, r.tets,
                     bench_method_name[m], (unsigned)w, r.med_ms, r.min_ms, r.max_ms, r.coll_ms,
                     one / r.med_ms, 100.0 * (1.0 - r.med_ms / (1000.0 / 60.0)), r.cpu_ms,
-                    same ? "same" : "DIFFERS");
+                    same ? "same" : "DIFFERS", (unsigned long long)r.hash, r.jobs, r.ranges,
+                    r.wakes, r.alone_ms);
                 fflush(stdout);
             }
         }
