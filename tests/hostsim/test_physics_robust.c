@@ -160,8 +160,14 @@ static int abuse(const char *case_name, sc_tissue_method m)
     uint32_t contact = 0;
     float max_disp = 0.0f;
     for (uint32_t f = 0; f < lift_frame + hz; f++) {
+        const uint64_t resets0 = rig.engine.counters.phys_resets;
         frame(t0, &more);
         assert_true(state_finite());
+        if (getenv("SC_ROBUST_TRACE") != NULL && rig.engine.counters.phys_resets != resets0) {
+            /* diagnosis: where in the script a reset came */
+            print_message("  reset at frame %u (t %.3f s of the script)\n", f,
+                          (double)f / (double)hz);
+        }
         contact += rig.engine.tissue_out.contact;
         max_disp = fmaxf(max_disp, rig.engine.tissue[rig.engine.active].stats.max_disp_mm);
     }
