@@ -692,20 +692,18 @@ static void map_line_walk(sc_bscan *b, const sc_mesh *m, uint32_t l, uint32_t *a
          * cell; skipping it left whole lines unmapped (bars in a rocked frame, 9 lines wide:
          * test_bscan_folds). A line that does start outside costs one point location. */
         ei = 1u;
-        {
-            uint32_t t0 = 0;
-            float s0 = 0.0f;
-            const int rr = relocate(b, m, c, 0u, &k, 0, &t0, &s0);
-            float sx = s0;
-            if (rr < 0) {
-                trouble = 1;
-            } else if (rr > 0) {
-                b->status.walk_relocations++;
-                sx = walk(b, m, c, t0, 4u, s0, &k, &steps, &trouble);
-            }
-            while (ei < ne && b->events[ei].s < sx - 1e-3f) {
-                ei++;
-            }
+        uint32_t t0 = 0;
+        float s0 = 0.0f;
+        const int rr = relocate(b, m, c, 0u, &k, 0, &t0, &s0);
+        float sx = s0;
+        if (rr < 0) {
+            trouble = 1;
+        } else if (rr > 0) {
+            b->status.walk_relocations++;
+            sx = walk(b, m, c, t0, 4u, s0, &k, &steps, &trouble);
+        }
+        while (ei < ne && b->events[ei].s < sx - 1e-3f) {
+            ei++;
         }
     }
     while (!trouble && ei < ne && k < c->n) {
