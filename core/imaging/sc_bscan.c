@@ -1183,6 +1183,8 @@ typedef struct area_acc {
 /* Samples of the rest reference above the face are taken every SC_BSCAN_MARGIN_STEP. */
 #define SC_BSCAN_MARGIN_STEP 4u
 _Static_assert(SC_BSCAN_MARGIN_STEP == 4u, "the margin block sums in sample_line assume 4");
+/* Blocks of the margin labelled per call of the margin kernel (a buffer on the stack). */
+#define SC_BSCAN_MARGIN_CHUNK 64u
 
 /* Nearest label at voxel-index position f, or SC_LABEL_OUTSIDE outside the grid. */
 static uint8_t label_at(const sc_volume *v, float fx, float fy, float fz)
@@ -1238,6 +1240,8 @@ typedef struct vol_ctx {
     sc_bscan_line_fn line; /* the selected variant's sampler of a whole line's positions */
     sc_bscan_words_fn words; /* the selected variant's position words of a clear span */
     sc_acoustics_run_fn acou_run; /* the selected variant's acoustics run kernel */
+    sc_bscan_nearest_fn nearest;  /* the selected variant's rest labels of a clear mesh run */
+    sc_bscan_margin_fn margin;    /* the selected variant's rest reference above the face */
 } vol_ctx;
 
 _Static_assert(SC_MAX_VOLUME_DIM < (1u << (32 - SC_W_BITS)), "position words fit 32 bits");
@@ -1531,7 +1535,16 @@ static void rest_labels(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
     const uint32_t runs = b->run_count;
     const sc_bscan_run *restrict rs = b->runs;
     for (uint32_t i = 0; i < runs; i++) {
-        const uint32_t k0 = rs[i].k0, k1 = rs[i].k1;
+        /* a run is one tet crossed (about 13 samples) but the rest labels do not depend on the
+         * tet: consecutive runs that touch are labelled as one, positions stepped from the
+         * first one's start (a deliberate change: before, each run's start was rounded on its
+         * own; a label can differ only where a position lies within about 1e-5 voxel of a
+         * voxel's boundary) */
+        const uint32_t k0 = rs[i].k0;
+        uint32_t k1 = rs[i].k1;
+        while (i + 1u < runs && rs[i + 1u].k0 == k1) {
+            k1 = rs[++i].k1;
+        }
         float p0[3], p1[3];
         for (uint32_t d = 0; d < 3u; d++) {
             p0[d] = f0[d] + (float)k0 * fd[d];
@@ -1550,7 +1563,7 @@ static void rest_labels(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
                 (Z >> 32) <= lz && (ze >> 32) <= lz) {
                 /* both ends clear of the clamps, so every position between them is (they are
                  * linear in kk): the loop below without them, the same labels */
-                sc_bscan_labels_nearest(lab, sy, sz, out + k0, k1 - k0, X, Y, Z, DX, DY, DZ);
+                vc->nearest(lab, sy, sz, out + k0, k1 - k0, X, Y, Z, DX, DY, DZ);
                 continue;
             }
             for (uint32_t kk = k0; kk < k1; kk++) {
@@ -1690,23 +1703,30 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
      * the counts of a run of one label summed in registers and added at its end (labels come
      * in runs: the counter in memory, read and written back per block, was a chain through the
      * store forwarding; integers: the same sums) */
+    /* the blocks' labels come from the selected variant (the same positions, tests and
+     * rounding as label_at), a chunk at a time */
     uint32_t run_label = SC_LABEL_COUNT, run_n = 0;
     int32_t run_k = 0;
-    for (uint32_t j0 = 0; j0 + SC_BSCAN_MARGIN_STEP <= c->margin_n; j0 += SC_BSCAN_MARGIN_STEP) {
-        const float s = -(float)(j0 + 2u);
-        const uint8_t label =
-            label_at(v, c->f0[0] + s * c->fd[0], c->f0[1] + s * c->fd[1], c->f0[2] + s * c->fd[2]);
-        if (label != run_label) {
-            if (run_label < SC_LABEL_COUNT) {
-                acc->margin_n[run_label] += run_n;
-                acc->margin_k[run_label] += run_k;
+    const uint32_t blocks = c->margin_n / SC_BSCAN_MARGIN_STEP;
+    uint8_t mlab[SC_BSCAN_MARGIN_CHUNK];
+    for (uint32_t b0 = 0; b0 < blocks; b0 += SC_BSCAN_MARGIN_CHUNK) {
+        const uint32_t nb = blocks - b0 < SC_BSCAN_MARGIN_CHUNK ? blocks - b0 : SC_BSCAN_MARGIN_CHUNK;
+        vc->margin(vc->lab, v->dim, c->f0, c->fd, b0 * SC_BSCAN_MARGIN_STEP, nb, mlab);
+        for (uint32_t i = 0; i < nb; i++) {
+            const uint32_t j0 = (b0 + i) * SC_BSCAN_MARGIN_STEP;
+            const uint8_t label = mlab[i];
+            if (label != run_label) {
+                if (run_label < SC_LABEL_COUNT) {
+                    acc->margin_n[run_label] += run_n;
+                    acc->margin_k[run_label] += run_k;
+                }
+                run_label = label;
+                run_n = 0u;
+                run_k = 0;
             }
-            run_label = label;
-            run_n = 0u;
-            run_k = 0;
+            run_n += SC_BSCAN_MARGIN_STEP;
+            run_k -= (int32_t)(4u * j0 + 10u); /* sum of the block's indices */
         }
-        run_n += SC_BSCAN_MARGIN_STEP;
-        run_k -= (int32_t)(4u * j0 + 10u); /* sum of the block's indices */
     }
     if (run_label < SC_LABEL_COUNT) {
         acc->margin_n[run_label] += run_n;
@@ -1891,6 +1911,8 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
     vc.line = sc_bscan_line_selected();
     vc.words = sc_bscan_words_selected();
     vc.acou_run = sc_acoustics_run_selected();
+    vc.nearest = sc_bscan_nearest_selected();
+    vc.margin = sc_bscan_margin_selected();
     vc.sy32 = volume->dim[0];
     vc.sz32 = volume->dim[0] * volume->dim[1];
     area_acc acc;

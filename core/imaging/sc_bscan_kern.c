@@ -93,3 +93,41 @@ void sc_bscan_labels_nearest(const uint8_t *restrict lab, size_t sy, size_t sz,
         Z += DZ;
     }
 }
+
+sc_bscan_nearest_fn sc_bscan_nearest_selected(void)
+{
+#if defined(SC_SIMD_X86_64_V3_BUILT)
+    if (sc_simd_selected() != SC_SIMD_GENERIC) {
+        return sc_bscan_labels_nearest_x86_64_v3;
+    }
+#endif
+    return sc_bscan_labels_nearest;
+}
+
+void sc_bscan_margin_labels_generic(const uint8_t *restrict lab, const uint32_t dim[3],
+                                    const float f0[3], const float fd[3], uint32_t j0, uint32_t n,
+                                    uint8_t *restrict out)
+{
+    const float hx = (float)dim[0] - 0.5f, hy = (float)dim[1] - 0.5f, hz = (float)dim[2] - 0.5f;
+    for (uint32_t i = 0; i < n; i++) {
+        const float s = -(float)(j0 + 4u * i + 2u);
+        const float fx = f0[0] + s * fd[0], fy = f0[1] + s * fd[1], fz = f0[2] + s * fd[2];
+        if (!(fx >= -0.5f && fx < hx && fy >= -0.5f && fy < hy && fz >= -0.5f && fz < hz)) {
+            out[i] = (uint8_t)SC_LABEL_OUTSIDE;
+            continue;
+        }
+        const uint32_t x = (uint32_t)(fx + 0.5f), y = (uint32_t)(fy + 0.5f),
+                       z = (uint32_t)(fz + 0.5f);
+        out[i] = lab[(size_t)x + (size_t)dim[0] * ((size_t)y + (size_t)dim[1] * z)];
+    }
+}
+
+sc_bscan_margin_fn sc_bscan_margin_selected(void)
+{
+#if defined(SC_SIMD_X86_64_V3_BUILT)
+    if (sc_simd_selected() != SC_SIMD_GENERIC) {
+        return sc_bscan_margin_labels_x86_64_v3;
+    }
+#endif
+    return sc_bscan_margin_labels_generic;
+}

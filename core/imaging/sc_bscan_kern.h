@@ -172,6 +172,38 @@ sc_bscan_span_fn sc_bscan_span_selected(void);
 void sc_bscan_labels_nearest(const uint8_t *restrict lab, size_t sy, size_t sz,
                              uint8_t *restrict out, uint32_t n, int64_t X, int64_t Y, int64_t Z,
                              int64_t DX, int64_t DY, int64_t DZ);
+typedef void (*sc_bscan_nearest_fn)(const uint8_t *restrict lab, size_t sy, size_t sz,
+                                    uint8_t *restrict out, uint32_t n, int64_t X, int64_t Y,
+                                    int64_t Z, int64_t DX, int64_t DY, int64_t DZ);
+#if defined(SC_SIMD_X86_64_V3_BUILT)
+/* The same labels, 8 positions per iteration (64-bit lanes, the integer parts packed, the
+ * labels gathered), the tail as the generic one. */
+void sc_bscan_labels_nearest_x86_64_v3(const uint8_t *restrict lab, size_t sy, size_t sz,
+                                       uint8_t *restrict out, uint32_t n, int64_t X, int64_t Y,
+                                       int64_t Z, int64_t DX, int64_t DY, int64_t DZ);
+#endif
+/* The selected variant's rest-label kernel (sc_simd_selected()). */
+sc_bscan_nearest_fn sc_bscan_nearest_selected(void);
+
+/* The compression measure's rest reference above the probe face: out[i] = the nearest label at
+ * the float position f0 + s fd (voxel-index units, multiplied then added: no contraction),
+ * s = -(float)(j0 + 4 i + 2), i in [0, n), or SC_LABEL_OUTSIDE where that position is outside
+ * [-1/2, dim - 1/2) on an axis (or not a number). The same test, rounding and index as
+ * sc_bscan.c's label_at, sample by sample. lab holds dim[0] dim[1] dim[2] labels
+ * (dim[d] <= SC_MAX_VOLUME_DIM). */
+typedef void (*sc_bscan_margin_fn)(const uint8_t *restrict lab, const uint32_t dim[3],
+                                   const float f0[3], const float fd[3], uint32_t j0, uint32_t n,
+                                   uint8_t *restrict out);
+void sc_bscan_margin_labels_generic(const uint8_t *restrict lab, const uint32_t dim[3],
+                                    const float f0[3], const float fd[3], uint32_t j0, uint32_t n,
+                                    uint8_t *restrict out);
+#if defined(SC_SIMD_X86_64_V3_BUILT)
+/* 8 positions per iteration in float lanes: the same products, sums, tests and truncations. */
+void sc_bscan_margin_labels_x86_64_v3(const uint8_t *restrict lab, const uint32_t dim[3],
+                                      const float f0[3], const float fd[3], uint32_t j0,
+                                      uint32_t n, uint8_t *restrict out);
+#endif
+sc_bscan_margin_fn sc_bscan_margin_selected(void);
 
 /* The acoustics pass's run kernel (sc_acoustics.h): the portable one there, the x86-64-v3
  * one here (AVX2: 16 samples per iteration, the same integer arithmetic, the same bytes). */

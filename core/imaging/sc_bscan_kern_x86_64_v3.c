@@ -286,6 +286,102 @@ void sc_acoustics_run_x86_64_v3(uint8_t *restrict out, uint32_t len, int32_t bas
         sc_acoustics_run_generic(out + i, len - i, (int32_t)(base - (int32_t)i * step), step);
     }
 }
+
+/* the label byte at each of 8 dword indices li (>= 0, inside the array): the dword ending at it
+ * (or starting at it near the array's start) gathered and shifted */
+static inline __m256i gather_labels(const int *labp, __m256i li)
+{
+    const __m256i z = _mm256_setzero_si256();
+    const __m256i at = _mm256_max_epi32(_mm256_sub_epi32(li, _mm256_set1_epi32(3)), z);
+    const __m256i g = _mm256_i32gather_epi32(labp, at, 1);
+    return _mm256_and_si256(_mm256_srlv_epi32(g, _mm256_slli_epi32(_mm256_sub_epi32(li, at), 3)),
+                            _mm256_set1_epi32(0xff));
+}
+
+/* the high dwords (integer parts of 32.32) of 8 int64 lanes, in order */
+static inline __m256i pack_hi32(__m256i a, __m256i b)
+{
+    const __m256i sel = _mm256_setr_epi32(1, 3, 5, 7, 1, 3, 5, 7);
+    return _mm256_blend_epi32(_mm256_permutevar8x32_epi32(a, sel),
+                              _mm256_permutevar8x32_epi32(b, sel), 0xf0);
+}
+
+void sc_bscan_labels_nearest_x86_64_v3(const uint8_t *restrict lab, size_t sy, size_t sz,
+                                       uint8_t *restrict out, uint32_t n, int64_t X, int64_t Y,
+                                       int64_t Z, int64_t DX, int64_t DY, int64_t DZ)
+{
+    uint32_t k = 0;
+    if (n >= 8u) {
+        const int *labp = (const int *)(const void *)lab;
+        const __m256i vsy = _mm256_set1_epi32((int32_t)sy), vsz = _mm256_set1_epi32((int32_t)sz);
+        __m256i x0 = _mm256_add_epi64(_mm256_set1_epi64x(X), _mm256_setr_epi64x(0, DX, 2 * DX, 3 * DX));
+        __m256i y0 = _mm256_add_epi64(_mm256_set1_epi64x(Y), _mm256_setr_epi64x(0, DY, 2 * DY, 3 * DY));
+        __m256i z0 = _mm256_add_epi64(_mm256_set1_epi64x(Z), _mm256_setr_epi64x(0, DZ, 2 * DZ, 3 * DZ));
+        const __m256i dx4 = _mm256_set1_epi64x(4 * DX), dy4 = _mm256_set1_epi64x(4 * DY),
+                      dz4 = _mm256_set1_epi64x(4 * DZ);
+        for (; k + 8u <= n; k += 8u) {
+            const __m256i x1 = _mm256_add_epi64(x0, dx4), y1 = _mm256_add_epi64(y0, dy4),
+                          z1 = _mm256_add_epi64(z0, dz4);
+            const __m256i li = _mm256_add_epi32(
+                _mm256_add_epi32(pack_hi32(x0, x1), _mm256_mullo_epi32(pack_hi32(y0, y1), vsy)),
+                _mm256_mullo_epi32(pack_hi32(z0, z1), vsz));
+            store_bytes(out + k, gather_labels(labp, li));
+            x0 = _mm256_add_epi64(x1, dx4);
+            y0 = _mm256_add_epi64(y1, dy4);
+            z0 = _mm256_add_epi64(z1, dz4);
+        }
+    }
+    if (k < n) {
+        const int64_t kk = (int64_t)k;
+        sc_bscan_labels_nearest(lab, sy, sz, out + k, n - k, X + kk * DX, Y + kk * DY,
+                                Z + kk * DZ, DX, DY, DZ);
+    }
+}
+
+void sc_bscan_margin_labels_x86_64_v3(const uint8_t *restrict lab, const uint32_t dim[3],
+                                      const float f0[3], const float fd[3], uint32_t j0,
+                                      uint32_t n, uint8_t *restrict out)
+{
+    const int *labp = (const int *)(const void *)lab;
+    const __m256 lo = _mm256_set1_ps(-0.5f), half = _mm256_set1_ps(0.5f);
+    const __m256 hx = _mm256_set1_ps((float)dim[0] - 0.5f), hy = _mm256_set1_ps((float)dim[1] - 0.5f),
+                 hz = _mm256_set1_ps((float)dim[2] - 0.5f);
+    const __m256 ax = _mm256_set1_ps(f0[0]), ay = _mm256_set1_ps(f0[1]), az = _mm256_set1_ps(f0[2]);
+    const __m256 bx = _mm256_set1_ps(fd[0]), by = _mm256_set1_ps(fd[1]), bz = _mm256_set1_ps(fd[2]);
+    const __m256i d0 = _mm256_set1_epi32((int32_t)dim[0]), d1 = _mm256_set1_epi32((int32_t)dim[1]);
+    const __m256i outside = _mm256_set1_epi32(SC_LABEL_OUTSIDE);
+    const __m256 sign = _mm256_set1_ps(-0.0f);
+    /* j0 + 4 i + 2 for the 8 lanes (below 2^24: exact in float) */
+    __m256i jv = _mm256_add_epi32(_mm256_set1_epi32((int32_t)(j0 + 2u)),
+                                  _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28));
+    const __m256i j32 = _mm256_set1_epi32(32);
+    for (uint32_t i = 0; i < n; i += 8u) {
+        const __m256 s = _mm256_xor_ps(_mm256_cvtepi32_ps(jv), sign); /* -(float)j */
+        const __m256 fx = _mm256_add_ps(ax, _mm256_mul_ps(s, bx));
+        const __m256 fy = _mm256_add_ps(ay, _mm256_mul_ps(s, by));
+        const __m256 fz = _mm256_add_ps(az, _mm256_mul_ps(s, bz));
+        const __m256 in = _mm256_and_ps(
+            _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(fx, lo, _CMP_GE_OQ), _mm256_cmp_ps(fx, hx, _CMP_LT_OQ)),
+                          _mm256_and_ps(_mm256_cmp_ps(fy, lo, _CMP_GE_OQ), _mm256_cmp_ps(fy, hy, _CMP_LT_OQ))),
+            _mm256_and_ps(_mm256_cmp_ps(fz, lo, _CMP_GE_OQ), _mm256_cmp_ps(fz, hz, _CMP_LT_OQ)));
+        const __m256i m = _mm256_castps_si256(in);
+        const __m256i x = _mm256_cvttps_epi32(_mm256_add_ps(fx, half));
+        const __m256i y = _mm256_cvttps_epi32(_mm256_add_ps(fy, half));
+        const __m256i z = _mm256_cvttps_epi32(_mm256_add_ps(fz, half));
+        /* outside lanes: index 0 (their label is replaced) */
+        const __m256i li = _mm256_and_si256(
+            _mm256_add_epi32(x, _mm256_mullo_epi32(d0, _mm256_add_epi32(y, _mm256_mullo_epi32(d1, z)))), m);
+        const __m256i label = _mm256_blendv_epi8(outside, gather_labels(labp, li), m);
+        if (n - i >= 8u) {
+            store_bytes(out + i, label);
+        } else {
+            uint8_t t[8];
+            store_bytes(t, label);
+            memcpy(out + i, t, n - i);
+        }
+        jv = _mm256_add_epi32(jv, j32);
+    }
+}
 #else
 typedef int sc_bscan_kern_x86_64_v3_unused; /* ISO C: a translation unit is not empty */
 #endif

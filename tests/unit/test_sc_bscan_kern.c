@@ -4,6 +4,7 @@
  * generic against each variant this build and CPU have. */
 #include "sc_test.h"
 
+#include <math.h>
 #include <string.h>
 
 #include "sc_bscan_kern.h"
@@ -267,6 +268,123 @@ static void test_acoustics_run_variants_agree(void **state)
     assert_true(differ > 1000u); /* the runs changed samples */
 }
 
+/* The rest labels of a clear run (32.32 positions, integer parts): every variant against the
+ * generic kernel on random runs inside the grid (lengths 1..300, every direction). */
+static void test_nearest_variants_agree(void **state)
+{
+    (void)state;
+    fill();
+    const sc_simd keep = sc_simd_selected();
+    const sc_simd best = sc_cpu_best_simd();
+    const int64_t xm[3] = {((int64_t)NX << 32) - 1, ((int64_t)NY << 32) - 1,
+                           ((int64_t)NZ << 32) - 1};
+    uint32_t tried = 0;
+    for (int s = 0; s < (int)SC_SIMD_COUNT; s++) {
+        if (!sc_simd_built((sc_simd)s) || s > (int)best) {
+            continue;
+        }
+        assert_int_equal(sc_simd_select((sc_simd)s), SC_OK);
+        const sc_bscan_nearest_fn f = sc_bscan_nearest_selected();
+        assert_non_null(f);
+        uint32_t varied = 0;
+        for (uint32_t it = 0; it < 3000u; it++) {
+            const uint32_t len = 1u + rnd() % (it % 3u == 0u ? 20u : 300u);
+            int64_t p0[3], d[3];
+            for (int a = 0; a < 3; a++) {
+                p0[a] = pos(xm[a]);
+                const int64_t p1 = rnd() % 8u == 0u ? p0[a] : pos(xm[a]);
+                d[a] = len > 1u ? (p1 - p0[a]) / (int64_t)(len - 1u) : 0;
+            }
+            uint8_t o1[N], o2[N];
+            memset(o1, 0xa5, sizeof o1);
+            memset(o2, 0xa5, sizeof o2);
+            sc_bscan_labels_nearest(g_lab, NX, (size_t)NX * NY, o1, len, p0[0], p0[1], p0[2], d[0],
+                                    d[1], d[2]);
+            f(g_lab, NX, (size_t)NX * NY, o2, len, p0[0], p0[1], p0[2], d[0], d[1], d[2]);
+            assert_memory_equal(o1, o2, sizeof o1);
+            for (uint32_t k = 1; k < len; k++) {
+                if (o1[k] != o1[0]) {
+                    varied++;
+                    break;
+                }
+            }
+        }
+        assert_true(varied > 1000u); /* runs crossing several labels */
+        tried++;
+    }
+    (void)sc_simd_select(keep);
+    print_message("rest-label kernel variants compared with the generic one: %u\n", tried);
+    assert_true(tried >= 1u);
+}
+
+/* The rest reference above the face: the generic kernel against label_at's formula written out
+ * here, and every variant against the generic one, on random lines through, beside and far
+ * outside the grid (and a direction that is not a number). */
+static float frnd(float lo, float hi)
+{
+    return lo + (hi - lo) * (float)(rnd() & 0xffffu) / 65535.0f;
+}
+
+static void test_margin_variants_agree(void **state)
+{
+    (void)state;
+    fill();
+    const uint32_t dim[3] = {NX, NY, NZ};
+    const sc_simd keep = sc_simd_selected();
+    const sc_simd best = sc_cpu_best_simd();
+    uint32_t tried = 0, inside = 0, outside = 0;
+    for (int s = 0; s < (int)SC_SIMD_COUNT; s++) {
+        if (!sc_simd_built((sc_simd)s) || s > (int)best) {
+            continue;
+        }
+        assert_int_equal(sc_simd_select((sc_simd)s), SC_OK);
+        const sc_bscan_margin_fn f = sc_bscan_margin_selected();
+        assert_non_null(f);
+        for (uint32_t it = 0; it < 3000u; it++) {
+            const uint32_t n = rnd() % 80u, j0 = 4u * (rnd() % 64u);
+            float f0[3], fd[3];
+            for (int a = 0; a < 3; a++) {
+                f0[a] = frnd(-4.0f, (float)dim[a] + 4.0f);
+                fd[a] = frnd(-0.3f, 0.3f);
+                if (rnd() % 16u == 0u) {
+                    f0[a] = (float)(rnd() % dim[a]) - 0.5f; /* on the lower boundary */
+                    fd[a] = 0.0f;
+                }
+            }
+            if (it == 7u) {
+                fd[1] = NAN; /* not a number: outside */
+            }
+            uint8_t o1[N], o2[N];
+            memset(o1, 0xa5, sizeof o1);
+            memset(o2, 0xa5, sizeof o2);
+            sc_bscan_margin_labels_generic(g_lab, dim, f0, fd, j0, n, o1);
+            f(g_lab, dim, f0, fd, j0, n, o2);
+            assert_memory_equal(o1, o2, sizeof o1);
+            for (uint32_t i = 0; i < n; i++) {
+                const float t = -(float)(j0 + 4u * i + 2u);
+                const float p[3] = {f0[0] + t * fd[0], f0[1] + t * fd[1], f0[2] + t * fd[2]};
+                uint8_t want = (uint8_t)SC_LABEL_OUTSIDE;
+                if (p[0] >= -0.5f && p[0] < (float)NX - 0.5f && p[1] >= -0.5f &&
+                    p[1] < (float)NY - 0.5f && p[2] >= -0.5f && p[2] < (float)NZ - 0.5f) {
+                    const uint32_t x = (uint32_t)(p[0] + 0.5f), y = (uint32_t)(p[1] + 0.5f),
+                                   z = (uint32_t)(p[2] + 0.5f);
+                    want = g_lab[x + NX * (y + NY * z)];
+                    inside++;
+                } else {
+                    outside++;
+                }
+                assert_int_equal(o1[i], want);
+            }
+        }
+        tried++;
+    }
+    (void)sc_simd_select(keep);
+    print_message("margin label variants compared with the generic one: %u (%u in, %u out)\n",
+                  tried, inside, outside);
+    assert_true(tried >= 1u);
+    assert_true(inside > 10000u && outside > 10000u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -274,6 +392,8 @@ int main(void)
         cmocka_unit_test(test_line_sampler_equals_span_sampler),
         cmocka_unit_test(test_generic_values),
         cmocka_unit_test(test_acoustics_run_variants_agree),
+        cmocka_unit_test(test_nearest_variants_agree),
+        cmocka_unit_test(test_margin_variants_agree),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
