@@ -141,6 +141,7 @@ int sc_bscan_set_def(sc_bscan *b, const sc_bscan_def *def)
     }
 #endif
     b->acou = acou;
+    b->margin_memo.valid = 0u;
     b->geom = g_new;
     b->def = *def;
     build_lut(b);
@@ -216,6 +217,7 @@ int sc_bscan_attach_mesh(sc_bscan *b, const sc_mesh *mesh)
         }
     }
     b->hull_count = n;
+    b->margin_memo.valid = 0u; /* a case switch: the volume may be another under the same pointer */
     b->mesh_tets = mesh->tet_count;
     b->mesh_grid = mesh_is_grid(mesh);
     return SC_OK;
@@ -1623,7 +1625,7 @@ static int psf_emit(sc_bscan *b, const sc_display_dev *disp, uint32_t frame_no, 
 
 /* The whole line: mesh runs at their rest positions, the gaps rigid; then label areas. */
 static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, const frame_ctx *c,
-                        area_acc *acc)
+                        area_acc *acc, int margin_known)
 {
     const uint32_t n = c->n;
     /* the position words of every span's part clear of the volume's border (nearly every
@@ -1705,6 +1707,9 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
      * store forwarding; integers: the same sums) */
     /* the blocks' labels come from the selected variant (the same positions, tests and
      * rounding as label_at), a chunk at a time */
+    if (margin_known) {
+        return; /* the same pose and volume as the last frame: its counts (sc_bscan_frame) */
+    }
     uint32_t run_label = SC_LABEL_COUNT, run_n = 0;
     int32_t run_k = 0;
     const uint32_t blocks = c->margin_n / SC_BSCAN_MARGIN_STEP;
@@ -1917,6 +1922,13 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
     vc.sz32 = volume->dim[0] * volume->dim[1];
     area_acc acc;
     memset(&acc, 0, sizeof acc);
+    sc_bscan_margin_memo *mm = &b->margin_memo;
+    const int margin_known =
+        mm->valid != 0u && volume->labels != NULL && mm->labels == volume->labels &&
+        mm->margin_n == c.margin_n && memcmp(&mm->pose, probe_to_volume, sizeof mm->pose) == 0 &&
+        memcmp(mm->dim, volume->dim, sizeof mm->dim) == 0 &&
+        memcmp(mm->origin_mm, volume->origin_mm, sizeof mm->origin_mm) == 0 &&
+        memcmp(mm->spacing_mm, volume->spacing_mm, sizeof mm->spacing_mm) == 0;
     uint32_t active_n = 0;
     uint32_t psf_next = 0;
     (void)psf_next;
@@ -1959,7 +1971,7 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
                 st->pixels_in_mesh += (uint32_t)b->runs[i].k1 - b->runs[i].k0;
             }
         }
-        sample_line(b, &vc, volume, &c, &acc);
+        sample_line(b, &vc, volume, &c, &acc, margin_known);
 #if SC_BSCAN_PSF
         if (b->def.psf != 0u) {
             rc = psf_emit(b, display, frame_no, l, &psf_next, rc);
@@ -1967,6 +1979,22 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
         }
 #endif
         rc = emit_line(b, display, frame_no, l, rc);
+    }
+    if (volume->labels != NULL) {
+        if (margin_known) {
+            memcpy(acc.margin_n, mm->n, sizeof acc.margin_n);
+            memcpy(acc.margin_k, mm->k, sizeof acc.margin_k);
+        } else {
+            mm->valid = 1u;
+            mm->pose = *probe_to_volume;
+            mm->labels = volume->labels;
+            memcpy(mm->dim, volume->dim, sizeof mm->dim);
+            memcpy(mm->origin_mm, volume->origin_mm, sizeof mm->origin_mm);
+            memcpy(mm->spacing_mm, volume->spacing_mm, sizeof mm->spacing_mm);
+            mm->margin_n = c.margin_n;
+            memcpy(mm->n, acc.margin_n, sizeof mm->n);
+            memcpy(mm->k, acc.margin_k, sizeof mm->k);
+        }
     }
     /* areas: sum over pixels of the pixel area, from counts (exact integers) */
     const float a0 = b->geom.sample_area_mm2[0];

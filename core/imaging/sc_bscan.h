@@ -200,6 +200,22 @@ typedef struct sc_bscan_line_view {
  * frame); it must be bounded (it runs inside the imaging stage) and must not call back into b. */
 typedef void (*sc_bscan_line_hook_fn)(void *ctx, const sc_bscan_line_view *view);
 
+/* The rest reference above the probe face (the compression measure's margin) of the last frame
+ * and what it was computed from: it depends on the pose and the volume only, not on the mesh,
+ * so a frame with the same pose (bit for bit: a held probe), the same volume (labels pointer,
+ * dimensions, origin, spacing) and settings takes the counts instead of labelling the margin
+ * again. Forgotten by sc_bscan_set_def and sc_bscan_attach_mesh (a case switch). */
+typedef struct sc_bscan_margin_memo {
+    uint32_t valid;
+    sc_xform pose; /* probe -> volume */
+    const uint8_t *labels;
+    uint32_t dim[3];
+    float origin_mm[3], spacing_mm[3];
+    uint32_t margin_n;
+    uint32_t n[SC_LABEL_COUNT];
+    int32_t k[SC_LABEL_COUNT];
+} sc_bscan_margin_memo;
+
 typedef struct sc_bscan {
     sc_bscan_def def;
     sc_bscan_line_hook_fn line_hook; /* NULL: none (sc_bscan_set_line_hook) */
@@ -246,6 +262,7 @@ typedef struct sc_bscan {
      * line sampler: one call per line), padded to a multiple of 8 */
     SC_ALIGN_HOT uint32_t pos_h[3][SC_MAX_SCAN_SAMPLES + 8u];
     sc_acoustics acou; /* tables of def.acoustic for this geometry and range */
+    sc_bscan_margin_memo margin_memo; /* the last frame's rest reference above the face */
 #if SC_BSCAN_PSF
     sc_psf psf; /* speckle pass: kernels and the lines in flight */
 #endif

@@ -648,6 +648,84 @@ static void rest_reference_counts_vessels_far_above_a_deep_face(void **state)
     assert_true(g_b.status.area_rest_mm2[SC_LABEL_VEIN] < 45.0f);
 }
 
+/* The rest reference above the face is kept from the last frame while the pose and the volume
+ * are the same (a held probe): every frame's measure equals a fresh object's, which labels the
+ * margin itself, through a held pose, a deeper press under it, a moved pose and back, another
+ * volume (another labels pointer) under the same pose and a changed margin. */
+static sc_bscan g_fresh;
+static scn_volume g_vol2;
+
+static void frame_on(sc_bscan *b, const sc_volume *v, const sc_xform *probe)
+{
+    sc_hs_display_init(&g_disp);
+    const sc_display_dev dev = sc_hs_display_dev(&g_disp);
+    assert_int_equal(sc_bscan_frame(b, &g_mesh, &g_nodes, v, probe, 1, &dev, 3u), SC_OK);
+}
+
+static void expect_as_fresh(const sc_bscan_def *d, const sc_volume *v, const sc_xform *probe)
+{
+    frame_on(&g_b, v, probe);
+    assert_int_equal(sc_bscan_init(&g_fresh, d), SC_OK);
+    assert_int_equal(sc_bscan_attach_mesh(&g_fresh, &g_mesh), SC_OK);
+    frame_on(&g_fresh, v, probe);
+    const sc_bscan_status *a = &g_b.status, *f = &g_fresh.status;
+    assert_int_equal(a->areas_valid, 1);
+    assert_memory_equal(a->area_rest_mm2, f->area_rest_mm2, sizeof a->area_rest_mm2);
+    assert_memory_equal(a->area_now_mm2, f->area_now_mm2, sizeof a->area_now_mm2);
+    assert_memory_equal(a->area_ratio, f->area_ratio, sizeof a->area_ratio);
+}
+
+static void rest_reference_kept_for_a_held_pose_equals_recomputed(void **state)
+{
+    (void)state;
+    build_mesh(32, 16, 16);
+    deform(SCN_DEFORM_DENT, 6.0f, 0);
+    const sc_xform probe = scn_probe(20.0f, 10.0f, 10.0f, 0.0f);
+    sc_bscan_def d = sc_bscan_default_def();
+    assert_int_equal(sc_bscan_init(&g_b, &d), SC_OK);
+    assert_int_equal(sc_bscan_attach_mesh(&g_b, &g_mesh), SC_OK);
+    assert_int_equal(g_b.margin_memo.valid, 0);
+    expect_as_fresh(&d, &g_vol.v, &probe);
+    assert_int_equal(g_b.margin_memo.valid, 1);
+    /* the vein reaches above the face: the margin counts some of it */
+    const float rest_vein = g_b.status.area_rest_mm2[SC_LABEL_VEIN];
+    assert_true(rest_vein > 40.0f);
+    expect_as_fresh(&d, &g_vol.v, &probe); /* held: the memo */
+    sc_nodes_reset_to_rest(&g_nodes, &g_mesh);
+    deform(SCN_DEFORM_DENT, 10.0f, 0); /* pressed deeper under the same pose */
+    expect_as_fresh(&d, &g_vol.v, &probe);
+    const sc_xform moved = scn_probe(21.0f, 10.0f, 12.0f, 0.0f);
+    expect_as_fresh(&d, &g_vol.v, &moved);
+    expect_as_fresh(&d, &g_vol.v, &probe);
+    /* another volume under the same pose: no vein above the face (its labels there muscle) */
+    memcpy(g_vol2.vox, g_vol.vox, sizeof g_vol2.vox);
+    memcpy(g_vol2.lab, g_vol.lab, sizeof g_vol2.lab);
+    g_vol2.v = g_vol.v;
+    g_vol2.v.voxels = g_vol2.vox;
+    g_vol2.v.labels = g_vol2.lab;
+    uint32_t changed = 0;
+    for (uint32_t k = 0; k < SCN_NZ; k++) {
+        const float z = g_vol.v.origin_mm[2] + (float)k * g_vol.v.spacing_mm[2];
+        for (uint32_t i = 0; i < SCN_NX * SCN_NY && z < 10.0f; i++) {
+            uint8_t *l = &g_vol2.lab[i + SCN_NX * SCN_NY * k];
+            if (*l == (uint8_t)SC_LABEL_VEIN) {
+                *l = (uint8_t)SC_LABEL_MUSCLE;
+                changed++;
+            }
+        }
+    }
+    assert_true(changed > 100u);
+    expect_as_fresh(&d, &g_vol2.v, &probe);
+    assert_true(g_b.status.area_rest_mm2[SC_LABEL_VEIN] < rest_vein - 5.0f);
+    expect_as_fresh(&d, &g_vol.v, &probe);
+    /* a changed margin (sc_bscan_set_def forgets the memo) */
+    d.rest_margin_mm = 0.0f;
+    assert_int_equal(sc_bscan_set_def(&g_b, &d), SC_OK);
+    assert_int_equal(g_b.margin_memo.valid, 0);
+    expect_as_fresh(&d, &g_vol.v, &probe);
+    assert_true(g_b.status.area_rest_mm2[SC_LABEL_VEIN] < rest_vein - 5.0f);
+}
+
 /* ---- determinism ------------------------------------------------------------------------- */
 
 /* Golden image: fixed scene, deformation and pose. A change of this value is a numerics
@@ -749,6 +827,7 @@ int main(void)
         cmocka_unit_test(squashed_vein_area_drops_while_artery_stays),
         cmocka_unit_test(rest_reference_counts_vessels_pushed_into_view),
         cmocka_unit_test(rest_reference_counts_vessels_far_above_a_deep_face),
+        cmocka_unit_test(rest_reference_kept_for_a_held_pose_equals_recomputed),
         cmocka_unit_test(golden_image_hash_is_stable),
         cmocka_unit_test(bad_arguments_are_refused),
     };
