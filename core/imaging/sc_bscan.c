@@ -1185,6 +1185,7 @@ typedef struct area_acc {
 /* Samples of the rest reference above the face are taken every SC_BSCAN_MARGIN_STEP. */
 #define SC_BSCAN_MARGIN_STEP 4u
 _Static_assert(SC_BSCAN_MARGIN_STEP == 4u, "the margin block sums in sample_line assume 4");
+_Static_assert(SC_LABEL_OUTSIDE < SC_LABEL_COUNT, "the margin counts the blocks outside too");
 /* Blocks of the margin labelled per call of the margin kernel (a buffer on the stack). */
 #define SC_BSCAN_MARGIN_CHUNK 64u
 
@@ -1713,9 +1714,23 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
     uint32_t run_label = SC_LABEL_COUNT, run_n = 0;
     int32_t run_k = 0;
     const uint32_t blocks = c->margin_n / SC_BSCAN_MARGIN_STEP;
+    /* the blocks far outside the volume (above the skin, most of them under a pressed face)
+     * are SC_LABEL_OUTSIDE: their counts in closed form (the sums are the same grouped any
+     * way), the blocks near or inside through the kernel */
+    uint32_t near_lo = 0, near_hi = 0;
+    sc_bscan_margin_near(v->dim, c->f0, c->fd, blocks, &near_lo, &near_hi);
+    {
+        /* blocks [0, near_lo) and [near_hi, blocks): n 4 each, k -(16 i + 10) each */
+        const uint32_t far_n = near_lo + (blocks - near_hi);
+        const uint32_t far_i = near_lo * (near_lo - 1u) / 2u + /* (0 for none: unsigned) */
+                               (blocks - near_hi) * (near_hi + blocks - 1u) / 2u;
+        acc->margin_n[SC_LABEL_OUTSIDE] += SC_BSCAN_MARGIN_STEP * far_n;
+        acc->margin_k[SC_LABEL_OUTSIDE] -= (int32_t)(16u * far_i + 10u * far_n);
+    }
     uint8_t mlab[SC_BSCAN_MARGIN_CHUNK];
-    for (uint32_t b0 = 0; b0 < blocks; b0 += SC_BSCAN_MARGIN_CHUNK) {
-        const uint32_t nb = blocks - b0 < SC_BSCAN_MARGIN_CHUNK ? blocks - b0 : SC_BSCAN_MARGIN_CHUNK;
+    for (uint32_t b0 = near_lo; b0 < near_hi; b0 += SC_BSCAN_MARGIN_CHUNK) {
+        const uint32_t nb =
+            near_hi - b0 < SC_BSCAN_MARGIN_CHUNK ? near_hi - b0 : SC_BSCAN_MARGIN_CHUNK;
         vc->margin(vc->lab, v->dim, c->f0, c->fd, b0 * SC_BSCAN_MARGIN_STEP, nb, mlab);
         for (uint32_t i = 0; i < nb; i++) {
             const uint32_t j0 = (b0 + i) * SC_BSCAN_MARGIN_STEP;

@@ -131,3 +131,40 @@ sc_bscan_margin_fn sc_bscan_margin_selected(void)
 #endif
     return sc_bscan_margin_labels_generic;
 }
+
+void sc_bscan_margin_near(const uint32_t dim[3], const float f0[3], const float fd[3],
+                          uint32_t blocks, uint32_t *lo, uint32_t *hi)
+{
+    *lo = 0u;
+    *hi = blocks;
+    const float big = 65536.0f, tmax = 4.0f * (float)blocks + 2.0f;
+    float tl = 0.0f, th = tmax; /* t = 4 i + 2 */
+    for (uint32_t d = 0; d < 3u; d++) {
+        const float a = f0[d], b = fd[d];
+        const float ab = a < 0.0f ? -a : a, bb = b < 0.0f ? -b : b;
+        if (!(ab < big && bb * tmax < big)) {
+            return; /* far out or not a number: label every block */
+        }
+        /* near: -3/2 <= a - t b <= dim + 1/2 */
+        const float pl = -1.5f, ph = (float)dim[d] + 0.5f;
+        if (b > 0.0f || b < 0.0f) {
+            const float t1 = (a - pl) / b, t2 = (a - ph) / b;
+            const float t_lo = t1 < t2 ? t1 : t2, t_hi = t1 < t2 ? t2 : t1;
+            tl = t_lo > tl ? t_lo : tl;
+            th = t_hi < th ? t_hi : th;
+        } else if (!(a >= pl && a <= ph)) {
+            th = -1.0f; /* parallel to this axis's faces and outside them */
+        }
+    }
+    if (!(th >= tl)) {
+        *hi = 0u; /* nowhere near */
+        return;
+    }
+    /* blocks (t - 2) / 4, one more each side */
+    const float il = (tl - 2.0f) / 4.0f - 1.0f, ih = (th - 2.0f) / 4.0f + 2.0f;
+    *lo = il <= 0.0f ? 0u : (il >= (float)blocks ? blocks : (uint32_t)il);
+    *hi = ih <= 0.0f ? 0u : (ih >= (float)blocks ? blocks : (uint32_t)ih);
+    if (*hi < *lo) {
+        *hi = *lo;
+    }
+}

@@ -205,6 +205,15 @@ void sc_bscan_margin_labels_x86_64_v3(const uint8_t *restrict lab, const uint32_
 #endif
 sc_bscan_margin_fn sc_bscan_margin_selected(void);
 
+/* The blocks [*lo, *hi) of [0, blocks) whose margin positions (as sc_bscan_margin_labels, s =
+ * -(4 i + 2)) may lie inside the grid: every block outside that range is more than a voxel
+ * outside [-1/2, dim - 1/2) on some axis, so its label is SC_LABEL_OUTSIDE without looking
+ * (the range is widened by a voxel and a block against the float roundings; far from the grid's
+ * origin, beyond 2^16 voxels, or not a number: the whole range). Above a pressed face most of
+ * the 60 mm margin is above the skin, outside the case volume. */
+void sc_bscan_margin_near(const uint32_t dim[3], const float f0[3], const float fd[3],
+                          uint32_t blocks, uint32_t *lo, uint32_t *hi);
+
 /* The acoustics pass's run kernel (sc_acoustics.h): the portable one there, the x86-64-v3
  * one here (AVX2: 16 samples per iteration, the same integer arithmetic, the same bytes). */
 void sc_acoustics_run_x86_64_v3(uint8_t *restrict out, uint32_t len, int32_t base, int32_t step);

@@ -385,6 +385,56 @@ static void test_margin_variants_agree(void **state)
     assert_true(inside > 10000u && outside > 10000u);
 }
 
+/* The margin's near range: every block outside it is labelled SC_LABEL_OUTSIDE by the generic
+ * kernel (so skipping it changes no count), on random lines through, beside and far outside the
+ * grid; and the range does cut most blocks of lines that leave the grid. */
+static void test_margin_near_range_only_skips_outside_blocks(void **state)
+{
+    (void)state;
+    fill();
+    const uint32_t dim[3] = {NX, NY, NZ};
+    uint32_t skipped = 0, labelled = 0, inside = 0;
+    static uint8_t o[1200];
+    for (uint32_t it = 0; it < 20000u; it++) {
+        const uint32_t blocks = rnd() % 1200u;
+        float f0[3], fd[3];
+        for (int a = 0; a < 3; a++) {
+            f0[a] = frnd(-30.0f, (float)dim[a] + 30.0f);
+            fd[a] = it % 5u == 0u ? frnd(-2.0f, 2.0f) : frnd(-0.3f, 0.3f);
+            if (rnd() % 16u == 0u) {
+                f0[a] = (float)(rnd() % dim[a]) - 0.5f;
+                fd[a] = 0.0f;
+            }
+            if (rnd() % 64u == 0u) {
+                f0[a] = frnd(-1.0e6f, 1.0e6f); /* far out: the whole range */
+            }
+        }
+        if (it == 11u) {
+            fd[2] = NAN;
+        }
+        uint32_t lo = 0, hi = 0;
+        sc_bscan_margin_near(dim, f0, fd, blocks, &lo, &hi);
+        assert_true(lo <= hi && hi <= blocks);
+        sc_bscan_margin_labels_generic(g_lab, dim, f0, fd, 0u, blocks, o);
+        for (uint32_t i = 0; i < blocks; i++) {
+            if (i < lo || i >= hi) {
+                assert_int_equal(o[i], SC_LABEL_OUTSIDE);
+                skipped++;
+            } else {
+                labelled++;
+            }
+        }
+        /* a block whose label is not OUTSIDE is inside the grid: in the range */
+        for (uint32_t i = 0; i < blocks; i++) {
+            inside += o[i] != (uint8_t)SC_LABEL_OUTSIDE;
+        }
+    }
+    print_message("margin blocks: %u skipped, %u labelled (%u inside)\n", skipped, labelled,
+                  inside);
+    assert_true(skipped > 4u * labelled); /* most of these lines leave the small grid */
+    assert_true(inside > 10000u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -394,6 +444,7 @@ int main(void)
         cmocka_unit_test(test_acoustics_run_variants_agree),
         cmocka_unit_test(test_nearest_variants_agree),
         cmocka_unit_test(test_margin_variants_agree),
+        cmocka_unit_test(test_margin_near_range_only_skips_outside_blocks),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
