@@ -314,9 +314,12 @@ void sc_bscan_labels_nearest_x86_64_v3(const uint8_t *restrict lab, size_t sy, s
     if (n >= 8u) {
         const int *labp = (const int *)(const void *)lab;
         const __m256i vsy = _mm256_set1_epi32((int32_t)sy), vsz = _mm256_set1_epi32((int32_t)sz);
-        __m256i x0 = _mm256_add_epi64(_mm256_set1_epi64x(X), _mm256_setr_epi64x(0, DX, 2 * DX, 3 * DX));
-        __m256i y0 = _mm256_add_epi64(_mm256_set1_epi64x(Y), _mm256_setr_epi64x(0, DY, 2 * DY, 3 * DY));
-        __m256i z0 = _mm256_add_epi64(_mm256_set1_epi64x(Z), _mm256_setr_epi64x(0, DZ, 2 * DZ, 3 * DZ));
+        __m256i x0 =
+            _mm256_add_epi64(_mm256_set1_epi64x(X), _mm256_setr_epi64x(0, DX, 2 * DX, 3 * DX));
+        __m256i y0 =
+            _mm256_add_epi64(_mm256_set1_epi64x(Y), _mm256_setr_epi64x(0, DY, 2 * DY, 3 * DY));
+        __m256i z0 =
+            _mm256_add_epi64(_mm256_set1_epi64x(Z), _mm256_setr_epi64x(0, DZ, 2 * DZ, 3 * DZ));
         const __m256i dx4 = _mm256_set1_epi64x(4 * DX), dy4 = _mm256_set1_epi64x(4 * DY),
                       dz4 = _mm256_set1_epi64x(4 * DZ);
         for (; k + 8u <= n; k += 8u) {
@@ -333,18 +336,19 @@ void sc_bscan_labels_nearest_x86_64_v3(const uint8_t *restrict lab, size_t sy, s
     }
     if (k < n) {
         const int64_t kk = (int64_t)k;
-        sc_bscan_labels_nearest(lab, sy, sz, out + k, n - k, X + kk * DX, Y + kk * DY,
-                                Z + kk * DZ, DX, DY, DZ);
+        sc_bscan_labels_nearest(lab, sy, sz, out + k, n - k, X + kk * DX, Y + kk * DY, Z + kk * DZ,
+                                DX, DY, DZ);
     }
 }
 
 void sc_bscan_margin_labels_x86_64_v3(const uint8_t *restrict lab, const uint32_t dim[3],
-                                      const float f0[3], const float fd[3], uint32_t j0,
-                                      uint32_t n, uint8_t *restrict out)
+                                      const float f0[3], const float fd[3], uint32_t j0, uint32_t n,
+                                      uint8_t *restrict out)
 {
     const int *labp = (const int *)(const void *)lab;
     const __m256 lo = _mm256_set1_ps(-0.5f), half = _mm256_set1_ps(0.5f);
-    const __m256 hx = _mm256_set1_ps((float)dim[0] - 0.5f), hy = _mm256_set1_ps((float)dim[1] - 0.5f),
+    const __m256 hx = _mm256_set1_ps((float)dim[0] - 0.5f),
+                 hy = _mm256_set1_ps((float)dim[1] - 0.5f),
                  hz = _mm256_set1_ps((float)dim[2] - 0.5f);
     const __m256 ax = _mm256_set1_ps(f0[0]), ay = _mm256_set1_ps(f0[1]), az = _mm256_set1_ps(f0[2]);
     const __m256 bx = _mm256_set1_ps(fd[0]), by = _mm256_set1_ps(fd[1]), bz = _mm256_set1_ps(fd[2]);
@@ -361,8 +365,10 @@ void sc_bscan_margin_labels_x86_64_v3(const uint8_t *restrict lab, const uint32_
         const __m256 fy = _mm256_add_ps(ay, _mm256_mul_ps(s, by));
         const __m256 fz = _mm256_add_ps(az, _mm256_mul_ps(s, bz));
         const __m256 in = _mm256_and_ps(
-            _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(fx, lo, _CMP_GE_OQ), _mm256_cmp_ps(fx, hx, _CMP_LT_OQ)),
-                          _mm256_and_ps(_mm256_cmp_ps(fy, lo, _CMP_GE_OQ), _mm256_cmp_ps(fy, hy, _CMP_LT_OQ))),
+            _mm256_and_ps(
+                _mm256_and_ps(_mm256_cmp_ps(fx, lo, _CMP_GE_OQ), _mm256_cmp_ps(fx, hx, _CMP_LT_OQ)),
+                _mm256_and_ps(_mm256_cmp_ps(fy, lo, _CMP_GE_OQ),
+                              _mm256_cmp_ps(fy, hy, _CMP_LT_OQ))),
             _mm256_and_ps(_mm256_cmp_ps(fz, lo, _CMP_GE_OQ), _mm256_cmp_ps(fz, hz, _CMP_LT_OQ)));
         const __m256i m = _mm256_castps_si256(in);
         const __m256i x = _mm256_cvttps_epi32(_mm256_add_ps(fx, half));
@@ -370,7 +376,9 @@ void sc_bscan_margin_labels_x86_64_v3(const uint8_t *restrict lab, const uint32_
         const __m256i z = _mm256_cvttps_epi32(_mm256_add_ps(fz, half));
         /* outside lanes: index 0 (their label is replaced) */
         const __m256i li = _mm256_and_si256(
-            _mm256_add_epi32(x, _mm256_mullo_epi32(d0, _mm256_add_epi32(y, _mm256_mullo_epi32(d1, z)))), m);
+            _mm256_add_epi32(
+                x, _mm256_mullo_epi32(d0, _mm256_add_epi32(y, _mm256_mullo_epi32(d1, z)))),
+            m);
         const __m256i label = _mm256_blendv_epi8(outside, gather_labels(labp, li), m);
         if (n - i >= 8u) {
             store_bytes(out + i, label);
