@@ -1541,7 +1541,7 @@ static void rest_labels(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
         /* a run is one tet crossed (about 13 samples) but the rest labels do not depend on the
          * tet: consecutive runs that touch are labelled as one, positions stepped from the
          * first one's start (a deliberate change: before, each run's start was rounded on its
-         * own; a label can differ only where a position lies within about 1e-5 voxel of a
+         * own; a label can differ only where a position lies within about 1e-4 voxel of a
          * voxel's boundary) */
         const uint32_t k0 = rs[i].k0;
         uint32_t k1 = rs[i].k1;
