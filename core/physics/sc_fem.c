@@ -100,6 +100,7 @@ static void init_template(sc_fem *f, const sc_mesh *m)
     }
     el->floor_ratio = f->def.floor_volume_ratio;
     el->floor_nmm2 = f->def.floor_pa * SC_FEM_PA_TO_NMM2;
+    el->floor_step_mm = fminf(m->cell_mm[0], fminf(m->cell_mm[1], m->cell_mm[2]));
     el->lamv = NULL;
     el->muv = NULL;
     el->corotated = 0;

@@ -116,7 +116,10 @@ typedef struct sc_fem {
  * (K_f = floor_pa) on top of its elastic energy, with the Gauss-Newton stiffness
  * K_f / V0 grad V grad V^T; a collapsed lumen's tets flatten to V_f instead of turning inside
  * out (an inverted tet overlaps its neighbours, and the B-scan then shows the lumen again).
- * The same term runs in the implicit MSDS (sc_msds_implicit.h). */
+ * Its deficit V - V_f is clamped at -floor_step |grad V| (the shortest cell edge): the step of
+ * a sliver crushed far through its floor is about a cell, not deficit / |grad V| (64x32x32: 72
+ * mm). The same term runs in the implicit MSDS (sc_msds_implicit.h). Every free node's step is
+ * held to two cell diagonals by sc_grid_solve (sc_grid.h: step_max_mm). */
 
 /* Defaults: beta 0.1 s (the MSDS damper ratio of Algorithm 1), alpha 0, linear (paper), floor
  * at 1% of the rest volume with 100 kPa, SC_PHYS_CG_ITERATIONS_DEFAULT CG iterations. */

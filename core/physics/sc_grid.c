@@ -205,6 +205,8 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
               g->asm_span > nxy + nx + SC_GRID_CELL_BLOCK &&
               (g->cell_end + g->asm_span - 1u) / g->asm_span <= SC_GRID_ASM_RANGES);
     g->sum_block = g->node_end > SC_GRID_SUM_BLOCK ? SC_GRID_SUM_BLOCK_BIG : SC_GRID_SUM_BLOCK;
+    g->step_max_mm = 2.0f * sqrtf(m->cell_mm[0] * m->cell_mm[0] + m->cell_mm[1] * m->cell_mm[1] +
+                                  m->cell_mm[2] * m->cell_mm[2]);
     init_slots(g);
     init_targets(g);
     /* the kernels' constant tables are this derivation */
@@ -362,6 +364,7 @@ typedef struct step_job {
     float dt, dta, warm, pull, cm, ck;
     int release;
     uint8_t loaded[SC_GRID_NODE_RANGES];
+    uint32_t clamped[SC_GRID_NODE_RANGES];
     float vsum[SC_GRID_SUM_BLOCKS];
 } step_job;
 
@@ -561,6 +564,32 @@ static void job_finish(void *arg, uint32_t r)
             nx[c][i] = g->x[c][h + i] + j->dt * v;
         }
     }
+    /* The step clamp: a free node moves at most step_max_mm in a step (its free components
+     * scaled down together; the prescribed ones are the probe's). Ten CG iterations on a
+     * stiff tissue around a crushed, nearly massless lumen can leave a lumen node's step
+     * tens of mm long (64x32x32, the probe lost at the deepest press); a node of a real
+     * tissue never moves two cells in one frame. Per node, so any split gives the same. */
+    const float lim2 = (g->step_max_mm * g->step_max_mm) / (j->dt * j->dt);
+    uint32_t clamped = 0;
+    for (uint32_t i = i0; i < i1; i++) {
+        float v2 = 0.0f;
+        for (uint32_t c = 0; c < 3u; c++) {
+            const float v = g->pc[c][h + i] > 0.0f ? g->v[c][h + i] : 0.0f;
+            v2 += v * v;
+        }
+        if (v2 > lim2) {
+            const float s = sqrtf(lim2 / v2);
+            for (uint32_t c = 0; c < 3u; c++) {
+                if (g->pc[c][h + i] > 0.0f) {
+                    const float v = g->v[c][h + i] * s;
+                    nv[c][i] = v;
+                    nx[c][i] = g->x[c][h + i] + j->dt * v;
+                }
+            }
+            clamped++;
+        }
+    }
+    j->clamped[r] = clamped;
 }
 
 int sc_grid_solve(sc_grid *g, sc_nodes *n, float dt_s, float beta_s, float alpha_per_s,
@@ -598,6 +627,12 @@ int sc_grid_solve(sc_grid *g, sc_nodes *n, float dt_s, float beta_s, float alpha
         return SC_ERR_PHYS_UNSTABLE;
     }
     sc_pool_run(g->pool, job_finish, &j, ranges);
+    uint32_t clamped = 0;
+    for (uint32_t r = 0; r < ranges && r < SC_GRID_NODE_RANGES; r++) {
+        clamped += j.clamped[r];
+    }
+    g->stats.clamped_nodes = clamped;
+    g->stats.clamped_steps += clamped != 0u ? 1u : 0u;
     return SC_OK;
 }
 

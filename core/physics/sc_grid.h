@@ -155,6 +155,8 @@ typedef struct sc_grid_stats {
     float residual_ratio;       /* sqrt(r.z) after / before the CG of the last step */
     uint32_t unloaded_steps;    /* steps that started from the release warm start */
     uint32_t unstable_steps;    /* steps refused because the solution was not finite */
+    uint32_t clamped_nodes;     /* free nodes whose step was cut to step_max_mm, last step */
+    uint32_t clamped_steps;     /* steps with such a node since sc_grid_init */
 } sc_grid_stats;
 
 typedef struct sc_grid {
@@ -165,6 +167,7 @@ typedef struct sc_grid {
     uint32_t cell_end;  /* cell origins 0 .. cell_end - 1 are visited (rounded up to a block) */
     uint32_t asm_span;  /* cell origins per range of the cell passes (SC_GRID_ASM_SPAN above) */
     uint32_t sum_block; /* nodes per block of the CG's dot products (SC_GRID_SUM_BLOCK above) */
+    float step_max_mm;  /* the most a free node moves in one step: two cell diagonals */
     uint32_t off[8];    /* node offset of cell corner c (bit 0 +x, bit 1 +y, bit 2 +z) */
     sc_grid_slot slot[18];
     int8_t slot_of[8][8]; /* edge slot of a template corner pair, -1 if none */
@@ -221,6 +224,8 @@ typedef struct sc_grid_fem_in {
     float floor_ratio;            /* a tet below this fraction of its rest volume meets the
                                      floor term; 0: off */
     float floor_nmm2;             /* the floor's modulus, N/mm^2 */
+    float floor_step_mm;          /* the most the floor's linearised step moves a node: its
+                                     deficit is clamped at floor_step_mm |grad V| (> 0) */
     int corotated;                /* 1: R = polar(F); 0: R = I (linear) */
 } sc_grid_fem_in;
 
@@ -245,7 +250,9 @@ void sc_grid_clear(sc_grid *g, uint32_t which);
 
 /* Finish the step begun with the same dt, beta and alpha: the preconditioner, cg_iterations
  * PCG iterations (fewer only if r.z is exactly 0 or p.Ap <= 0), and n->x, n->v from the
- * solution; fixed DOFs keep their position with zero velocity. A non-finite solution leaves n
+ * solution; fixed DOFs keep their position with zero velocity. A free node's step is held to
+ * step_max_mm (its free velocity components scaled together; counted in stats.clamped_nodes
+ * and clamped_steps): the truncated CG's error, not motion. A non-finite solution leaves n
  * unchanged, counts stats.unstable_steps and returns SC_ERR_PHYS_UNSTABLE; else 0.
  * Cost: cg_iterations mat-vecs, O(N) each (bounded by SC_MAX_NODES), plus O(N).
  * Preconditions (SC_ASSERT): 1 <= cg_iterations <= SC_PHYS_ITERATIONS_MAX. */

@@ -35,6 +35,12 @@
  * stiffness, the same term as the FEM's (sc_fem.h): a collapsed vein flattens to the floor
  * instead of turning its tets inside out.
  *
+ * Bounded steps on fine meshes: the volume and floor terms' deficits are clamped at the
+ * shortest cell edge x |grad D| (a Gauss-Newton volume step moves a node by about deficit /
+ * |grad D|: a sliver with tiny gradients threw one), and sc_grid_solve holds every free node's
+ * step to two cell diagonals (the fixed-count CG's error in the soft, light lumen nodes when a
+ * deep press is let go at once). docs/physics.md, "The finest meshes".
+ *
  * Cost per frame: the springs, family by family (9 N with one sqrt and one divide each), and
  * the volume and floor terms cell by cell (5 tets, their 10 rank-1 blocks each), vectorised
  * (sc_grid_kern.inc), plus cg_iterations grid mat-vecs; K v0 of r0 is formed in the same
