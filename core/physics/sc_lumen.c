@@ -236,6 +236,12 @@ static void split(sc_lumen *l, const sc_mesh *m)
     const uint32_t near = (m->nx - 1u) * (m->ny - 1u) + m->nx + 1u;
     uint32_t span = (cells + SC_LUMEN_RANGES - 1u) / SC_LUMEN_RANGES;
     span = span > near ? span : near;
+    /* an even number of ranges per phase (two workers: as many each), as sc_grid's cell ranges */
+    const uint32_t n = (cells + span - 1u) / span;
+    if (n >= 8u) {
+        const uint32_t want = n / 4u * 4u;
+        span = (cells + want - 1u) / want;
+    }
     l->ranges = (cells + span - 1u) / span;
     l->span_tets = 5u * span;
 }
@@ -581,15 +587,21 @@ void sc_lumen_apply(sc_lumen *l, const sc_mesh *m, sc_nodes *n)
               (uint64_t)l->ranges * l->span_tets >= m->tet_count);
     l->heart_phase = advance(l->heart_phase, l->drive.heart_rate_bpm, l->frame_s);
     l->resp_phase = advance(l->resp_phase, l->drive.resp_rate_bpm, l->frame_s);
-    lumen_job j = {l, l->part_vol, l->part_faces, m, n, NULL, 0u};
+#if SC_LUMEN_RANGES > 1
+    float(*part)[SC_LUMEN_MAX][SC_LUMEN_SLICES] = l->part_vol;
+#else
+    float part1[1][SC_LUMEN_MAX][SC_LUMEN_SLICES]; /* one range: on the stack */
+    float(*part)[SC_LUMEN_MAX][SC_LUMEN_SLICES] = part1;
+#endif
+    lumen_job j = {l, part, l->part_faces, m, n, NULL, 0u};
     sc_pool_run(l->pool, job_volume, &j, l->ranges);
-    /* the ranges' partial volumes in range order (one range: the serial loop's sum) */
-    float vol[SC_LUMEN_MAX][SC_LUMEN_SLICES];
-    memcpy(vol, l->part_vol[0], sizeof vol);
+    /* the ranges' partial volumes added to the first's in range order (one range: the serial
+     * loop's sum) */
+    float(*vol)[SC_LUMEN_SLICES] = part[0];
     for (uint32_t r = 1u; r < l->ranges; r++) {
         for (uint32_t k = 0; k < l->count; k++) {
             for (uint32_t i = 0; i < SC_LUMEN_SLICES; i++) {
-                vol[k][i] += l->part_vol[r][k][i];
+                vol[k][i] += part[r][k][i];
             }
         }
     }

@@ -99,12 +99,13 @@
  * SC_LUMEN_SERIAL_NODES nodes (up to 32x16x16: every phantom and the paper's meshes) is one
  * range, the serial loop's order exactly; a larger one is cut into ranges of at least
  * (nx - 1)(ny - 1) + nx + 1 cells (so that ranges two apart share no node) and at most
- * SC_LUMEN_RANGES of them (22 at 48x24x24, 30 at 64x32x32). The volumes: a partial sum per
+ * SC_LUMEN_RANGES of them, their count taken down to a multiple of four (an even number per
+ * phase: 20 at 48x24x24, 28 at 64x32x32, 24 at 40x16x28). The volumes: a partial sum per
  * range and vessel section in tet order, the partials added in range order by the caller; the
  * forces and the clear: the even ranges at the same time, then the odd ones (a node on a seam
  * after an odd range takes the next even range's faces first). A fixed order, the same for
- * every worker count; the per-range partials take SC_LUMEN_RANGES x 516 B (33 KB on the host,
- * 516 B on the MCU, whose limits keep one range). */
+ * every worker count; the per-range partials take SC_LUMEN_RANGES x 516 B (33 KB per tissue
+ * slot on the host; the MCU, whose limits keep one range, sums on the stack as before: 16 B). */
 #ifndef SC_LUMEN_SERIAL_NODES
 #define SC_LUMEN_SERIAL_NODES 16384u
 #endif
@@ -179,7 +180,9 @@ typedef struct sc_lumen {
     const sc_pool_dev *pool;
     uint32_t ranges;                /* 1 .. SC_LUMEN_RANGES */
     uint32_t span_tets;             /* tets per range (whole cells) */
+#if SC_LUMEN_RANGES > 1
     float part_vol[SC_LUMEN_RANGES][SC_LUMEN_MAX][SC_LUMEN_SLICES];
+#endif
     uint32_t part_faces[SC_LUMEN_RANGES];
     uint8_t region[SC_MAX_TETS];    /* vessel of each tet, 1..count; 0: none */
 } sc_lumen;

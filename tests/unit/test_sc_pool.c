@@ -5,7 +5,7 @@
  * mesh, 40 x 16 x 16 nodes (10,240), has two of the CG's sum blocks and ten mat-vec ranges, and
  * two ranges of the cell passes (sc_grid.h: SC_GRID_ASM_SPAN); 40 x 16 x 28 (17,920 nodes) has
  * three, so a seam where the even range's sums come before the odd one's (and, above two ranges
- * of SC_GRID_ASM_SPAN, the finer per-mesh split of sc_grid.asm_span: 17 ranges, and the CG's
+ * of SC_GRID_ASM_SPAN, the finer per-mesh split of sc_grid.asm_span: 16 ranges, and the CG's
  * sum blocks of 1,024 nodes whose p.Ap partials come from the mat-vec's job). The springs'
  * passes run on the pool at every size; the collider's detection (a tilted probe pressed into a
  * 40 x 30 x 20 grid of jittered nodes) gives the serial contact set on every pool; the lumen
