@@ -200,6 +200,15 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
         const uint32_t span = (apart + SC_GRID_CELL_BLOCK - 1u) / SC_GRID_CELL_BLOCK *
                               SC_GRID_CELL_BLOCK;
         g->asm_span = span > SC_GRID_ASM_SPAN_MIN ? span : SC_GRID_ASM_SPAN_MIN;
+        /* balance (sc_grid.h): the ranges' count down to a multiple of four, the span widened to
+         * match, so that each phase has an even number of ranges (two workers take as many of
+         * each phase's as the other: 11 per phase at 48x24x24 left one worker a range idle) */
+        const uint32_t n = (g->cell_end + g->asm_span - 1u) / g->asm_span;
+        if (n >= 8u) {
+            const uint32_t want = n / 4u * 4u;
+            const uint32_t wide = (g->cell_end + want - 1u) / want;
+            g->asm_span = (wide + SC_GRID_CELL_BLOCK - 1u) / SC_GRID_CELL_BLOCK * SC_GRID_CELL_BLOCK;
+        }
     }
     SC_ASSERT(g->asm_span % SC_GRID_CELL_BLOCK == 0u &&
               g->asm_span > nxy + nx + SC_GRID_CELL_BLOCK &&

@@ -116,8 +116,11 @@ _Static_assert(SC_GRID_POOL_RANGE % SC_GRID_CHUNK == 0u && SC_GRID_SUM_BLOCK % 1
 /* A mesh of more than two such ranges (more than 16,384 cell origins: 48x24x24, 64x32x32) is cut
  * into ranges of sc_grid.asm_span origins instead, chosen by the mesh alone: the smallest whole
  * number of cell blocks above nx ny + nx + SC_GRID_CELL_BLOCK (the two-apart rule above), at
- * least SC_GRID_ASM_SPAN_MIN: about one z-plane of cells per range, 22 ranges at 48x24x24 (four
- * of 8,192 before: the odd phase ran one full range beside a quarter one), 30 at 64x32x32. */
+ * least SC_GRID_ASM_SPAN_MIN: about one z-plane of cells per range (four of 8,192 before: the
+ * odd phase ran one full range beside a quarter one); then the count of ranges is taken down to
+ * a multiple of four and the span widened to match (whole cell blocks), so that each phase has
+ * an even number of ranges for two workers: 20 ranges of 1,328 origins at 48x24x24 (22 of
+ * 1,216 before, 11 per phase), 28 of 2,272 at 64x32x32 (30 before), 16 at 40x16x28. */
 #define SC_GRID_ASM_SPAN_MIN 1024u
 #define SC_GRID_ASM_RANGES ((SC_MAX_NODES + SC_GRID_ASM_SPAN_MIN - 1u) / SC_GRID_ASM_SPAN_MIN)
 

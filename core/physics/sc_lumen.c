@@ -5,6 +5,7 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "sc_assert.h"
 #include "sc_err.h"
 #include "sc_labels.h"
 #include "sc_materials.h"
@@ -220,6 +221,31 @@ static void sections(sc_lumen *l, const sc_mesh *m, uint32_t k)
     }
 }
 
+/* the passes' ranges (sc_lumen.h "Workers"): by the mesh alone */
+static void split(sc_lumen *l, const sc_mesh *m)
+{
+    const uint32_t cells = m->tet_count / 5u;
+    l->ranges = 1u;
+    l->span_tets = m->tet_count;
+    if (SC_LUMEN_RANGES < 2u || m->node_count <= SC_LUMEN_SERIAL_NODES || cells == 0u ||
+        m->nx < 2u || m->ny < 2u) {
+        return;
+    }
+    /* cells of index c and c + d share a node only if d <= (nx - 1)(ny - 1) + (nx - 1) + 1:
+     * a range of more cells keeps the ranges two apart from sharing one */
+    const uint32_t near = (m->nx - 1u) * (m->ny - 1u) + m->nx + 1u;
+    uint32_t span = (cells + SC_LUMEN_RANGES - 1u) / SC_LUMEN_RANGES;
+    span = span > near ? span : near;
+    /* an even number of ranges per phase (two workers: as many each), as sc_grid's cell ranges */
+    const uint32_t n = (cells + span - 1u) / span;
+    if (n >= 8u) {
+        const uint32_t want = n / 4u * 4u;
+        span = (cells + want - 1u) / want;
+    }
+    l->ranges = (cells + span - 1u) / span;
+    l->span_tets = 5u * span;
+}
+
 int sc_lumen_init(sc_lumen *l, const sc_mesh *m, const sc_material_table *mat)
 {
     if (l == NULL || m == NULL || mat == NULL || m->tet_count > SC_MAX_TETS) {
@@ -233,6 +259,9 @@ int sc_lumen_init(sc_lumen *l, const sc_mesh *m, const sc_material_table *mat)
     l->frame_s = 1.0f / (float)SC_FRAME_RATE_DEFAULT_HZ;
     l->wave_mean = wave_mean(l->drive.wave);
     l->enabled = 1u;
+    l->pool = NULL;
+    l->ranges = 1u;
+    l->span_tets = m->tet_count;
     const uint32_t nt = m->tet_count;
     for (uint32_t t = 0; t < nt; t++) {
         if (m->tet_label[t] >= mat->count) {
@@ -313,6 +342,7 @@ int sc_lumen_init(sc_lumen *l, const sc_mesh *m, const sc_material_table *mat)
         v->theta = 1.0f / (1.0f + v->bulk_pa * c);
         sections(l, m, k);
     }
+    split(l, m);
     sc_lumen_reset(l);
     return SC_OK;
 }
@@ -415,22 +445,165 @@ static uint32_t next_region_tet(const uint8_t *region, uint32_t t, uint32_t nt)
     return t;
 }
 
+/* one frame's passes on the pool: the lumen, the mesh, the state, the pressures, the phase */
+typedef struct lumen_job {
+    const sc_lumen *l;
+    float (*part_vol)[SC_LUMEN_MAX][SC_LUMEN_SLICES]; /* l->part_vol (NULL: the clear) */
+    uint32_t *part_faces;                              /* l->part_faces (NULL: the clear) */
+    const sc_mesh *m;
+    sc_nodes *n;
+    const float (*press)[SC_LUMEN_SLICES];
+    uint32_t phase; /* 0: the even ranges, 1: the odd ones (forces, clear) */
+} lumen_job;
+
+static void range_tets(const sc_lumen *l, const sc_mesh *m, uint32_t r, uint32_t *t0, uint32_t *t1)
+{
+    const uint32_t nt = m->tet_count;
+    const uint32_t a = r * l->span_tets;
+    *t0 = a < nt ? a : nt;
+    *t1 = nt - *t0 > l->span_tets ? *t0 + l->span_tets : nt;
+}
+
+/* range r's volumes per vessel and section, in tet order */
+static void job_volume(void *arg, uint32_t r)
+{
+    const lumen_job *j = (const lumen_job *)arg;
+    const sc_lumen *l = j->l;
+    const sc_mesh *m = j->m;
+    const sc_nodes *n = j->n;
+    float(*vol)[SC_LUMEN_SLICES] = j->part_vol[r];
+    memset(vol, 0, sizeof j->part_vol[r]);
+    uint32_t t0, t1;
+    range_tets(l, m, r, &t0, &t1);
+    for (uint32_t t = next_region_tet(l->region, t0, t1); t < t1;
+         t = next_region_tet(l->region, t + 1u, t1)) {
+        const uint8_t k = l->region[t];
+        vol[k - 1u][slice_of(&l->v[k - 1u], m, t)] +=
+            sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[t]);
+    }
+}
+
+/* range 2 i + phase's boundary forces (its faces counted in part_faces) */
+static void job_forces(void *arg, uint32_t i)
+{
+    const lumen_job *j = (const lumen_job *)arg;
+    const sc_lumen *l = j->l;
+    const sc_mesh *m = j->m;
+    sc_nodes *n = j->n;
+    const uint32_t r = 2u * i + j->phase;
+    uint32_t t0, t1;
+    range_tets(l, m, r, &t0, &t1);
+    uint32_t faces = 0;
+    for (uint32_t t = next_region_tet(l->region, t0, t1); t < t1;
+         t = next_region_tet(l->region, t + 1u, t1)) {
+        const uint8_t rg = l->region[t];
+        const float pk = j->press[rg - 1u][slice_of(&l->v[rg - 1u], m, t)];
+        const uint32_t *tv = m->tet[t];
+        if (!(sc_mesh_tet_volume_mm3(n->x, n->y, n->z, tv) > 0.0f)) {
+            continue; /* an inverted (crushed) lumen tet: its faces have no outward side */
+        }
+        for (uint32_t f = 0; f < 4u; f++) {
+            const int32_t nb = m->tet_nbr[t][f];
+            if (nb < 0 || l->region[nb] != 0u) {
+                /* hull (the vessel goes on), inside the lumen, or a wall shared with another
+                 * vessel (loaded by both lumens: an artery's pressure drove the filler of a
+                 * crushed vein beside it far off in the robustness test) */
+                continue;
+            }
+            if (!(sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[nb]) > 0.0f)) {
+                continue; /* the wall tet across is crushed: no face to push on */
+            }
+            uint32_t q[3];
+            face_nodes(tv, f, q);
+            const float ax = n->x[q[1]] - n->x[q[0]], ay = n->y[q[1]] - n->y[q[0]],
+                        az = n->z[q[1]] - n->z[q[0]];
+            const float bx = n->x[q[2]] - n->x[q[0]], by = n->y[q[2]] - n->y[q[0]],
+                        bz = n->z[q[2]] - n->z[q[0]];
+            float cx = 0.5f * (ay * bz - az * by), cy = 0.5f * (az * bx - ax * bz),
+                  cz = 0.5f * (ax * by - ay * bx);
+            /* outward: away from the tet's fourth vertex */
+            const uint32_t o = tv[f];
+            const float ox = n->x[q[0]] - n->x[o], oy = n->y[q[0]] - n->y[o],
+                        oz = n->z[q[0]] - n->z[o];
+            if (cx * ox + cy * oy + cz * oz < 0.0f) {
+                cx = -cx;
+                cy = -cy;
+                cz = -cz;
+            }
+            for (uint32_t a = 0; a < 3u; a++) {
+                n->fx[q[a]] += pk * cx;
+                n->fy[q[a]] += pk * cy;
+                n->fz[q[a]] += pk * cz;
+            }
+            faces++;
+        }
+    }
+    j->part_faces[r] = faces;
+}
+
+/* range 2 i + phase's boundary nodes' external forces back to zero */
+static void job_clear(void *arg, uint32_t i)
+{
+    const lumen_job *j = (const lumen_job *)arg;
+    const sc_lumen *l = j->l;
+    const sc_mesh *m = j->m;
+    sc_nodes *n = j->n;
+    uint32_t t0, t1;
+    range_tets(l, m, 2u * i + j->phase, &t0, &t1);
+    for (uint32_t t = next_region_tet(l->region, t0, t1); t < t1;
+         t = next_region_tet(l->region, t + 1u, t1)) {
+        for (uint32_t f = 0; f < 4u; f++) {
+            const int32_t nb = m->tet_nbr[t][f];
+            if (nb < 0 || l->region[nb] != 0u) {
+                continue;
+            }
+            uint32_t q[3];
+            face_nodes(m->tet[t], f, q);
+            for (uint32_t a = 0; a < 3u; a++) {
+                n->fx[q[a]] = 0.0f;
+                n->fy[q[a]] = 0.0f;
+                n->fz[q[a]] = 0.0f;
+            }
+        }
+    }
+}
+
+/* the even ranges' job, then the odd ranges' (ranges two apart share no node) */
+static void run_phases(const sc_lumen *l, sc_pool_job_fn fn, lumen_job *j)
+{
+    for (uint32_t p = 0; p < 2u; p++) {
+        j->phase = p;
+        sc_pool_run(l->pool, fn, j, l->ranges > p ? (l->ranges - p + 1u) / 2u : 0u);
+    }
+}
+
 void sc_lumen_apply(sc_lumen *l, const sc_mesh *m, sc_nodes *n)
 {
     l->faces = 0u;
     if (!l->enabled || l->count == 0u) {
         return;
     }
+    SC_ASSERT(l->ranges >= 1u && l->ranges <= SC_LUMEN_RANGES &&
+              (uint64_t)l->ranges * l->span_tets >= m->tet_count);
     l->heart_phase = advance(l->heart_phase, l->drive.heart_rate_bpm, l->frame_s);
     l->resp_phase = advance(l->resp_phase, l->drive.resp_rate_bpm, l->frame_s);
-    float vol[SC_LUMEN_MAX][SC_LUMEN_SLICES];
-    memset(vol, 0, sizeof vol);
-    const uint32_t nt = m->tet_count;
-    for (uint32_t t = next_region_tet(l->region, 0u, nt); t < nt;
-         t = next_region_tet(l->region, t + 1u, nt)) {
-        const uint8_t r = l->region[t];
-        vol[r - 1u][slice_of(&l->v[r - 1u], m, t)] +=
-            sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[t]);
+#if SC_LUMEN_RANGES > 1
+    float(*part)[SC_LUMEN_MAX][SC_LUMEN_SLICES] = l->part_vol;
+#else
+    float part1[1][SC_LUMEN_MAX][SC_LUMEN_SLICES]; /* one range: on the stack */
+    float(*part)[SC_LUMEN_MAX][SC_LUMEN_SLICES] = part1;
+#endif
+    lumen_job j = {l, part, l->part_faces, m, n, NULL, 0u};
+    sc_pool_run(l->pool, job_volume, &j, l->ranges);
+    /* the ranges' partial volumes added to the first's in range order (one range: the serial
+     * loop's sum) */
+    float(*vol)[SC_LUMEN_SLICES] = part[0];
+    for (uint32_t r = 1u; r < l->ranges; r++) {
+        for (uint32_t k = 0; k < l->count; k++) {
+            for (uint32_t i = 0; i < SC_LUMEN_SLICES; i++) {
+                vol[k][i] += part[r][k][i];
+            }
+        }
     }
     float press_nmm2[SC_LUMEN_MAX][SC_LUMEN_SLICES];
     for (uint32_t k = 0; k < l->count; k++) {
@@ -464,50 +637,11 @@ void sc_lumen_apply(sc_lumen *l, const sc_mesh *m, sc_nodes *n)
         }
         v->p_pa = isfinite(v->p_pa) ? v->p_pa : 0.0f;
     }
+    j.press = (const float(*)[SC_LUMEN_SLICES])press_nmm2;
+    run_phases(l, job_forces, &j);
     uint32_t faces = 0;
-    for (uint32_t t = next_region_tet(l->region, 0u, nt); t < nt;
-         t = next_region_tet(l->region, t + 1u, nt)) {
-        const uint8_t r = l->region[t];
-        const float pk = press_nmm2[r - 1u][slice_of(&l->v[r - 1u], m, t)];
-        const uint32_t *tv = m->tet[t];
-        if (!(sc_mesh_tet_volume_mm3(n->x, n->y, n->z, tv) > 0.0f)) {
-            continue; /* an inverted (crushed) lumen tet: its faces have no outward side */
-        }
-        for (uint32_t f = 0; f < 4u; f++) {
-            const int32_t nb = m->tet_nbr[t][f];
-            if (nb < 0 || l->region[nb] != 0u) {
-                /* hull (the vessel goes on), inside the lumen, or a wall shared with another
-                 * vessel (loaded by both lumens: an artery's pressure drove the filler of a
-                 * crushed vein beside it far off in the robustness test) */
-                continue;
-            }
-            if (!(sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[nb]) > 0.0f)) {
-                continue; /* the wall tet across is crushed: no face to push on */
-            }
-            uint32_t q[3];
-            face_nodes(tv, f, q);
-            const float ax = n->x[q[1]] - n->x[q[0]], ay = n->y[q[1]] - n->y[q[0]],
-                        az = n->z[q[1]] - n->z[q[0]];
-            const float bx = n->x[q[2]] - n->x[q[0]], by = n->y[q[2]] - n->y[q[0]],
-                        bz = n->z[q[2]] - n->z[q[0]];
-            float cx = 0.5f * (ay * bz - az * by), cy = 0.5f * (az * bx - ax * bz),
-                  cz = 0.5f * (ax * by - ay * bx);
-            /* outward: away from the tet's fourth vertex */
-            const uint32_t o = tv[f];
-            const float ox = n->x[q[0]] - n->x[o], oy = n->y[q[0]] - n->y[o],
-                        oz = n->z[q[0]] - n->z[o];
-            if (cx * ox + cy * oy + cz * oz < 0.0f) {
-                cx = -cx;
-                cy = -cy;
-                cz = -cz;
-            }
-            for (uint32_t i = 0; i < 3u; i++) {
-                n->fx[q[i]] += pk * cx;
-                n->fy[q[i]] += pk * cy;
-                n->fz[q[i]] += pk * cz;
-            }
-            faces++;
-        }
+    for (uint32_t r = 0; r < l->ranges; r++) {
+        faces += l->part_faces[r];
     }
     l->faces = faces;
 }
@@ -517,21 +651,6 @@ void sc_lumen_clear(const sc_lumen *l, const sc_mesh *m, sc_nodes *n)
     if (l->faces == 0u) {
         return;
     }
-    const uint32_t nt = m->tet_count;
-    for (uint32_t t = next_region_tet(l->region, 0u, nt); t < nt;
-         t = next_region_tet(l->region, t + 1u, nt)) {
-        for (uint32_t f = 0; f < 4u; f++) {
-            const int32_t nb = m->tet_nbr[t][f];
-            if (nb < 0 || l->region[nb] != 0u) {
-                continue;
-            }
-            uint32_t q[3];
-            face_nodes(m->tet[t], f, q);
-            for (uint32_t i = 0; i < 3u; i++) {
-                n->fx[q[i]] = 0.0f;
-                n->fy[q[i]] = 0.0f;
-                n->fz[q[i]] = 0.0f;
-            }
-        }
-    }
+    lumen_job j = {l, NULL, NULL, m, n, NULL, 0u};
+    run_phases(l, job_clear, &j);
 }

@@ -71,7 +71,8 @@
  * Memory: one label byte per tet (region) and SC_LUMEN_MAX vessels in the caller's sc_lumen
  * (SC_MAX_TETS + ~1.6 KB, of which 1 KB the sections: 8 B per section and vessel; the
  * Cortex-M7 image grew by 1,408 B with them and sc_msds.roller). Never allocates, never calls
- * the OS. Deterministic: fixed loop order over tets, float arithmetic only. Threads: one writer (the tissue step).
+ * the OS. Deterministic: fixed loop order over tets, float arithmetic only. Threads: one writer (the tissue step), whose
+ * passes' ranges may run on the worker pool ("Workers" above).
  */
 #ifndef SC_LUMEN_H
 #define SC_LUMEN_H
@@ -79,6 +80,7 @@
 #include <stdint.h>
 
 #include "sc_config.h"
+#include "sc_hal_pool.h"
 #include "sc_material.h"
 #include "sc_mesh.h"
 
@@ -90,6 +92,25 @@
 /* sections per artery along its axis (sc_lumen_vessel.slices; 8 B per section and vessel) */
 #ifndef SC_LUMEN_SLICES
 #define SC_LUMEN_SLICES 16u
+#endif
+
+/* Workers (hal/sc_hal_pool.h): the frame's passes (volumes, boundary forces, clear) run over
+ * ranges of whole cells (5 tets each) chosen by the mesh alone: a mesh of at most
+ * SC_LUMEN_SERIAL_NODES nodes (up to 32x16x16: every phantom and the paper's meshes) is one
+ * range, the serial loop's order exactly; a larger one is cut into ranges of at least
+ * (nx - 1)(ny - 1) + nx + 1 cells (so that ranges two apart share no node) and at most
+ * SC_LUMEN_RANGES of them, their count taken down to a multiple of four (an even number per
+ * phase: 20 at 48x24x24, 28 at 64x32x32, 24 at 40x16x28). The volumes: a partial sum per
+ * range and vessel section in tet order, the partials added in range order by the caller; the
+ * forces and the clear: the even ranges at the same time, then the odd ones (a node on a seam
+ * after an odd range takes the next even range's faces first). A fixed order, the same for
+ * every worker count; the per-range partials take SC_LUMEN_RANGES x 516 B (33 KB per tissue
+ * slot on the host; the MCU, whose limits keep one range, sums on the stack as before: 16 B). */
+#ifndef SC_LUMEN_SERIAL_NODES
+#define SC_LUMEN_SERIAL_NODES 16384u
+#endif
+#ifndef SC_LUMEN_RANGES
+#define SC_LUMEN_RANGES (SC_MAX_NODES > SC_LUMEN_SERIAL_NODES ? 64u : 1u)
 #endif
 
 typedef enum sc_lumen_kind {
@@ -154,6 +175,15 @@ typedef struct sc_lumen {
     float wave_mean;                /* mean of the arterial waveform over a cycle */
     uint32_t faces;                 /* lumen boundary faces loaded in the last frame */
     uint8_t enabled;                /* 0: the pass does nothing (vessels as solid filler) */
+    /* workers ("Workers" above): the pool (NULL: serial; set by the owner after init), the
+     * split (set by sc_lumen_init) and the per-range partials of the last frame */
+    const sc_pool_dev *pool;
+    uint32_t ranges;                /* 1 .. SC_LUMEN_RANGES */
+    uint32_t span_tets;             /* tets per range (whole cells) */
+#if SC_LUMEN_RANGES > 1
+    float part_vol[SC_LUMEN_RANGES][SC_LUMEN_MAX][SC_LUMEN_SLICES];
+#endif
+    uint32_t part_faces[SC_LUMEN_RANGES];
     uint8_t region[SC_MAX_TETS];    /* vessel of each tet, 1..count; 0: none */
 } sc_lumen;
 
@@ -170,7 +200,7 @@ int sc_lumen_drive_validate(const sc_lumen_drive *d);
 /* Find the vessels of a labelled mesh (flood fill over face neighbours, tets of a label with a
  * lumen law), their rest volumes and relaxations (theta from the softest tet across the
  * lumen's boundary, mat); pressures zero, phases zero, the default drive, frame_s 1 /
- * SC_FRAME_RATE_DEFAULT_HZ, enabled. Call at case load after sc_material_assign.
+ * SC_FRAME_RATE_DEFAULT_HZ, enabled, the split of the passes ("Workers"), no pool (NULL). Call at case load after sc_material_assign.
  * O(tets). Never allocates. Errors: SC_ERR_INVALID_ARG (NULL, a label outside the table). */
 int sc_lumen_init(sc_lumen *l, const sc_mesh *m, const sc_material_table *mat);
 
@@ -188,10 +218,12 @@ int sc_lumen_set_frame_s(sc_lumen *l, float frame_s);
 
 /* The frame's lumen pass, before the solver step: advance the drive by frame_s, measure each
  * vessel's volume in the current state, relax its pressure, and add the boundary forces to
- * n->fx/fy/fz (which the solvers read as external forces). O(tets). Deterministic. */
+ * n->fx/fy/fz (which the solvers read as external forces). O(tets), on l->pool ("Workers").
+ * Deterministic: the same bits for every worker count. */
 void sc_lumen_apply(sc_lumen *l, const sc_mesh *m, sc_nodes *n);
 
-/* Zero the external forces of every lumen boundary node (after the solver step). O(tets). */
+/* Zero the external forces of every lumen boundary node (after the solver step). O(tets), on
+ * l->pool. */
 void sc_lumen_clear(const sc_lumen *l, const sc_mesh *m, sc_nodes *n);
 
 /* The drive's blood pressure above the mean now, for a vessel kind (Pa). O(1). */

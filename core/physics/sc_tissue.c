@@ -122,6 +122,7 @@ int sc_tissue_build_step(sc_tissue *t)
 #if SC_PHYS_LUMEN
         if (rc == SC_OK) {
             rc = sc_lumen_init(&t->lumen, &t->mesh, &t->mat);
+            t->lumen.pool = t->pool;
         }
 #endif
         break;
@@ -524,6 +525,9 @@ void sc_tissue_set_pool(sc_tissue *t, const sc_pool_dev *pool)
     SC_ASSERT(t != NULL);
     t->pool = pool;
     t->collider.pool = pool; /* (the contact phase's init copies t->pool too) */
+#if SC_PHYS_LUMEN
+    t->lumen.pool = pool; /* (the labels phase's init copies t->pool too) */
+#endif
     if (t->build_phase > (uint8_t)SC_TISSUE_BUILD_FEM) {
         t->fem.grid.pool = pool; /* before: the FEM phase copies t->pool (and until then the
                                     FEM's storage holds the springs) */

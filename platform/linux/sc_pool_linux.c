@@ -40,8 +40,9 @@ static void futex_wake_all(_Atomic uint32_t *addr)
  * job's fields are read before a successful claim: a claim succeeds only while the claim word
  * still carries seq, and the caller resets that word (then a fence) before it writes the next
  * job's fields, so what was read is this job's. */
-static void run_ranges(sc_pool_linux *p, uint32_t seq)
+static void run_ranges(sc_pool_linux *p, uint32_t seq, uint32_t w)
 {
+    uint64_t finished = atomic_load_explicit(&p->done[w].n, memory_order_relaxed);
     for (;;) {
         const sc_pool_job_fn fn = atomic_load_explicit(&p->fn, memory_order_relaxed);
         void *const arg = atomic_load_explicit(&p->arg, memory_order_relaxed);
@@ -55,7 +56,7 @@ static void run_ranges(sc_pool_linux *p, uint32_t seq)
             continue;
         }
         fn(arg, (uint32_t)c);
-        atomic_fetch_add_explicit(&p->done, 1u, memory_order_acq_rel);
+        atomic_store_explicit(&p->done[w].n, ++finished, memory_order_release);
     }
 }
 
@@ -88,7 +89,7 @@ static void *worker_main(void *argp)
             return NULL;
         }
         seen = s;
-        run_ranges(p, s);
+        run_ranges(p, s, a->w);
     }
 }
 
@@ -103,7 +104,11 @@ static void pool_run(void *ctx, sc_pool_job_fn fn, void *arg, uint32_t ranges)
     atomic_store_explicit(&p->fn, fn, memory_order_relaxed);
     atomic_store_explicit(&p->arg, arg, memory_order_relaxed);
     atomic_store_explicit(&p->ranges, ranges, memory_order_relaxed);
-    atomic_store_explicit(&p->done, 0u, memory_order_relaxed);
+    /* every range of the previous job has finished: the counts are still */
+    uint64_t target = (uint64_t)ranges;
+    for (uint32_t w = 0; w < p->workers; w++) {
+        target += atomic_load_explicit(&p->done[w].n, memory_order_relaxed);
+    }
     atomic_store_explicit(&p->seq, seq, memory_order_seq_cst);
     p->jobs++;
     p->ranges_run += ranges;
@@ -111,10 +116,17 @@ static void pool_run(void *ctx, sc_pool_job_fn fn, void *arg, uint32_t ranges)
         p->wakes++;
         futex_wake_all(&p->seq);
     }
-    run_ranges(p, seq);
+    run_ranges(p, seq, 0u);
     /* a worker descheduled in the middle of its range makes this spin burn the caller's
      * time slice: past a few microseconds, yield to it */
-    for (uint32_t k = 0; atomic_load_explicit(&p->done, memory_order_acquire) != ranges; k++) {
+    for (uint32_t k = 0;; k++) {
+        uint64_t sum = 0;
+        for (uint32_t w = 0; w < p->workers; w++) {
+            sum += atomic_load_explicit(&p->done[w].n, memory_order_acquire);
+        }
+        if (sum == target) {
+            break;
+        }
         if (k < 4096u) {
             cpu_relax();
         } else {

@@ -34,15 +34,23 @@ typedef struct sc_pool_linux {
     uint32_t spin_us;
     pthread_t th[SC_POOL_LINUX_MAX_WORKERS];
     uint32_t started; /* threads started */
+    /* Cache lines (scale5): the job's read-mostly fields, the claim word and each worker's
+     * count of finished ranges on lines of their own, so that a claim or a finished range
+     * moves one line between the cores instead of the one line every field shared (the
+     * caller's spin on the old shared `done` pulled it back after every range). */
     /* the current job: written by the caller before seq is bumped, stable until all report */
-    _Atomic(sc_pool_job_fn) fn;
+    _Alignas(64) _Atomic(sc_pool_job_fn) fn;
     _Atomic(void *) arg;
     _Atomic uint32_t ranges;
     _Atomic uint32_t seq;   /* job sequence number (also the futex word) */
-    _Atomic uint64_t claim; /* job sequence << 32 | next range to claim */
-    _Atomic uint32_t done;  /* ranges of the current job finished */
     _Atomic uint32_t stop;
     _Atomic uint32_t sleeping; /* workers blocked on the futex */
+    _Alignas(64) _Atomic uint64_t claim; /* job sequence << 32 | next range to claim */
+    /* ranges finished since the start, per worker (worker w alone writes done[w]; the caller
+     * waits until their sum has grown by the job's ranges) */
+    struct {
+        _Alignas(64) _Atomic uint64_t n;
+    } done[SC_POOL_LINUX_MAX_WORKERS];
     int first_cpu;             /* worker w pinned to CPU first_cpu + w (-1: not pinned) */
     /* counters of the caller (run's thread alone writes them; read them between jobs) */
     uint64_t jobs;    /* run calls that went to the workers (ranges > 1) */

@@ -5,10 +5,11 @@
  * mesh, 40 x 16 x 16 nodes (10,240), has two of the CG's sum blocks and ten mat-vec ranges, and
  * two ranges of the cell passes (sc_grid.h: SC_GRID_ASM_SPAN); 40 x 16 x 28 (17,920 nodes) has
  * three, so a seam where the even range's sums come before the odd one's (and, above two ranges
- * of SC_GRID_ASM_SPAN, the finer per-mesh split of sc_grid.asm_span: 17 ranges, and the CG's
+ * of SC_GRID_ASM_SPAN, the finer per-mesh split of sc_grid.asm_span: 16 ranges, and the CG's
  * sum blocks of 1,024 nodes whose p.Ap partials come from the mat-vec's job). The springs'
  * passes run on the pool at every size; the collider's detection (a tilted probe pressed into a
- * 40 x 30 x 20 grid of jittered nodes) gives the serial contact set on every pool. */
+ * 40 x 30 x 20 grid of jittered nodes) gives the serial contact set on every pool; the lumen
+ * law's passes (40 x 16 x 28: many ranges) give the serial volumes, forces and clear. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -22,6 +23,7 @@
 #include "sc_err.h"
 #include "sc_hs_pool.h"
 #include "sc_labels.h"
+#include "sc_lumen.h"
 #include "sc_material.h"
 #include "sc_pool_linux.h"
 #include "sc_test_tissue_scene.h"
@@ -235,6 +237,82 @@ static void collider_on_the_pool_gives_the_serial_contacts(void **state)
     }
 }
 
+/* The lumen law's passes on the pool (sc_lumen.h "Workers"): on 40 x 16 x 28 (17,920 nodes,
+ * above SC_LUMEN_SERIAL_NODES) the passes run in many ranges; after a press, one frame's volumes,
+ * pressures, boundary forces and face count, and the clear after it, are bit for bit those of
+ * the same split run without a pool, for 1, 2, 4 host-pool workers and 2 real threads. */
+static sc_lumen g_lum0;
+static sc_nodes g_nodes0, g_ref;
+
+static void lumen_apply_and_clear(const sc_pool_dev *pool, sc_nodes *after_apply)
+{
+    g_t.lumen = g_lum0;
+    g_t.nodes = g_nodes0;
+    g_t.lumen.pool = pool;
+    sc_lumen_apply(&g_t.lumen, &g_t.mesh, &g_t.nodes);
+    *after_apply = g_t.nodes;
+    sc_lumen_clear(&g_t.lumen, &g_t.mesh, &g_t.nodes);
+}
+
+static void lumen_passes_give_the_serial_bits_for_1_2_and_4_workers(void **state)
+{
+    (void)state;
+    uint64_t ranges = 0u;
+    g_nz = 28u;
+    (void)scripted_run(RUN_MSDS, 0u, &ranges);
+    g_nz = 16u;
+    assert_true(g_t.lumen.count >= 2u);   /* the scene's vein and artery */
+    assert_true(g_t.lumen.ranges >= 8u);  /* split: the mesh is above SC_LUMEN_SERIAL_NODES */
+    assert_true(g_t.lumen.ranges <= SC_LUMEN_RANGES);
+    assert_true((uint64_t)g_t.lumen.ranges * g_t.lumen.span_tets >= g_t.mesh.tet_count);
+    /* a frame's external forces start at zero (the last frame's clear) */
+    g_lum0 = g_t.lumen;
+    g_nodes0 = g_t.nodes;
+    static sc_nodes serial_applied;
+    lumen_apply_and_clear(NULL, &serial_applied);
+    g_ref = g_t.nodes;
+    const sc_lumen serial = g_t.lumen;
+    const size_t nn = (size_t)g_t.mesh.node_count * sizeof(float);
+    print_message("lumen: %u vessels, %u ranges of %u tets, %u faces loaded\n", serial.count,
+                  serial.ranges, serial.span_tets, serial.faces);
+    assert_true(serial.faces > 100u);
+    uint32_t loaded = 0;
+    for (uint32_t i = 0; i < g_t.mesh.node_count; i++) {
+        loaded += fabsf(serial_applied.fx[i]) + fabsf(serial_applied.fy[i]) +
+                      fabsf(serial_applied.fz[i]) > 0.0f;
+        assert_false(fabsf(g_ref.fx[i]) + fabsf(g_ref.fy[i]) + fabsf(g_ref.fz[i]) > 0.0f);
+    }
+    assert_true(loaded > 100u);
+    static sc_nodes pooled_applied;
+    for (uint32_t w = 1u; w <= 5u; w++) {
+        sc_hs_pool hp;
+        static sc_pool_linux lp;
+        sc_pool_dev dev;
+        if (w == 3u) {
+            continue;
+        }
+        if (w <= 4u) {
+            sc_hs_pool_init(&hp, w, &dev);
+        } else {
+            assert_int_equal(sc_pool_linux_start(&lp, 2u, -1, 50u, &dev), 0);
+        }
+        lumen_apply_and_clear(&dev, &pooled_applied);
+        if (w <= 4u) {
+            assert_true(hp.ranges >= g_t.lumen.ranges); /* it did go through the pool */
+        } else {
+            sc_pool_linux_stop(&lp);
+        }
+        assert_int_equal(g_t.lumen.faces, serial.faces);
+        assert_memory_equal(g_t.lumen.v, serial.v, sizeof serial.v);
+        assert_memory_equal(pooled_applied.fx, serial_applied.fx, nn);
+        assert_memory_equal(pooled_applied.fy, serial_applied.fy, nn);
+        assert_memory_equal(pooled_applied.fz, serial_applied.fz, nn);
+        assert_memory_equal(g_t.nodes.fx, g_ref.fx, nn);
+        assert_memory_equal(g_t.nodes.fy, g_ref.fy, nn);
+        assert_memory_equal(g_t.nodes.fz, g_ref.fz, nn);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -243,6 +321,7 @@ int main(void)
         cmocka_unit_test(state_hash_is_the_same_for_1_2_3_and_4_workers),
         cmocka_unit_test(three_cell_ranges_give_the_same_hash_for_1_2_and_4_workers),
         cmocka_unit_test(linux_pool_threads_give_the_serial_state_hash),
+        cmocka_unit_test(lumen_passes_give_the_serial_bits_for_1_2_and_4_workers),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

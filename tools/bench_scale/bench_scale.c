@@ -15,7 +15,9 @@
  * is checked against the one-worker run of the same mesh and method: a mismatch is reported (and
  * the exit status is 1); then the state hash itself (compare binaries with it) and, with workers,
  * the pool's hand-overs per frame: jobs (each a barrier), ranges, futex wake-ups, and the step's
- * wall time outside the jobs (`alone ms`: the caller's serial work, median frame).
+ * wall time outside the jobs (`alone ms`: the caller's serial work, median frame). First, per
+ * worker count above one, the pool's own cost per job (28 ranges of fixed work, against the
+ * same work on the caller alone divided by the workers).
  *
  * Usage: bench-scale [--frames N] [--repeats R] [--workers 1,2] [--meshes 20x10x10,...]
  *                    [--methods msds,fem,corot] [--csv FILE]
@@ -146,6 +148,53 @@ static int bench_one(const uint32_t mesh[3], bench_method m, const sc_pool_dev *
     return 0;
 }
 
+/* The pool's own cost: jobs of 28 ranges (a 64x32x32 cell pass's count), each range a fixed
+ * computation of about 2 us (no memory traffic), min over 5 batches of the wall time per job,
+ * against the same ranges run on the caller alone (no pool) divided by the workers: the
+ * difference is the hand-over, the claims and the wait for the last range. */
+static volatile float g_sink[64];
+static void job_work(void *arg, uint32_t r)
+{
+    (void)arg;
+    float a = (float)r, b = 1.0001f;
+    for (int k = 0; k < 1500; k++) {
+        a = a * b + 0.5f;
+    }
+    g_sink[r & 63u] = a;
+}
+
+static double per_job_us(const sc_pool_dev *dev, uint32_t ranges)
+{
+    double best = 1e30;
+    for (int b = 0; b < 6; b++) {
+        const uint64_t t0 = bench_now_ns();
+        for (int k = 0; k < 1000; k++) {
+            sc_pool_run(dev, job_work, NULL, ranges);
+        }
+        const double us = (double)(bench_now_ns() - t0) / 1000.0 / 1000.0;
+        best = b > 0 && us < best ? us : best; /* the first batch warms up */
+    }
+    return best;
+}
+
+static void print_handover(uint32_t w)
+{
+    static sc_pool_linux lp;
+    sc_pool_dev dev = {0};
+    if (sc_pool_linux_start(&lp, w, 0, 200u, &dev) != 0) {
+        return;
+    }
+    const uint32_t ranges = 28u;
+    const double serial = per_job_us(NULL, ranges);
+    const double pooled = per_job_us(&dev, ranges);
+    const double ideal = serial / (double)w;
+    printf("pool, %u workers: a job of %u ranges of %.2f us: %.2f us (ideal %.2f; overhead "
+           "%.2f us per job, min of 5 x 1000 jobs)\n",
+           (unsigned)w, (unsigned)ranges, serial / (double)ranges, pooled, ideal,
+           pooled - ideal);
+    sc_pool_linux_stop(&lp);
+}
+
 int main(int argc, char **argv)
 {
     opts o;
@@ -163,6 +212,11 @@ int main(int argc, char **argv)
         }
         fprintf(csv, "mesh,nodes,tets,method,workers,run,median_frame_ms,median_collision_ms,"
                      "median_frame_cpu_ms\n");
+    }
+    for (int wi = 0; wi < o.b.nworkers; wi++) {
+        if (o.b.workers[wi] > 1u) {
+            print_handover(o.b.workers[wi]);
+        }
     }
     printf("bench-scale: %d runs x %d frames per row, wall clock; median (min..max of the runs' "
            "medians)\n",
