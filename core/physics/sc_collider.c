@@ -288,6 +288,7 @@ static uint32_t detect_rows(const detect_ctx *d, uint32_t row0, uint32_t row1, s
     ccd.mpr_tolerance = 1e-6;
     ccd_probe probe = {c, (double)d->infl, {0.0, 0.0, 0.0}};
     uint32_t count = 0, cand = 0, mpr = 0;
+    const int slide = c->def.shape == SC_COLLIDER_ROUNDED_BOX;
     const uint32_t nj = r1[1] - r0[1];
     for (uint32_t row = row0; row < row1; row++) {
         const uint32_t k = r0[2] + row / nj, j = r0[1] + row % nj;
@@ -304,6 +305,26 @@ static uint32_t detect_rows(const detect_ctx *d, uint32_t row0, uint32_t row1, s
             if (fabsf(l[0] - c->center_probe_mm[0]) > lim[0] ||
                 fabsf(l[1] - c->center_probe_mm[1]) > lim[1] ||
                 fabsf(l[2] - c->center_probe_mm[2]) > lim[2]) {
+                continue;
+            }
+            if (slide && l[2] < c->def.margin_mm) {
+                /* the sliding face's nodes (below) take the face plane whatever MPR finds: only
+                 * whether the node is in the inflated shape (the core box swept by a ball of
+                 * the inflation) matters, and that is exact in closed form; MPR for the rest */
+                float d2 = 0.0f;
+                for (uint32_t a = 0; a < 3u; a++) {
+                    const float e = fabsf(l[a] - c->center_probe_mm[a]) - c->core_half_mm[a];
+                    d2 += e > 0.0f ? e * e : 0.0f;
+                }
+                if (!(d2 < d->infl * d->infl)) {
+                    continue;
+                }
+                sc_contact *ct = &dst[count++];
+                ct->node = n;
+                const float lf[3] = {l[0], l[1], 0.0f};
+                const float nz[3] = {0.0f, 0.0f, 1.0f};
+                sc_xform_apply(&c->to_vol, lf, ct->p_mm);
+                sc_xform_rotate(&c->to_vol, nz, ct->n);
                 continue;
             }
             const ccd_point pt = {{(double)p[0], (double)p[1], (double)p[2]}};

@@ -11,7 +11,11 @@
  * Both are convex shapes given to libccd by their support functions; the narrow phase is
  * ccdMPRPenetration (MPR: penetration depth and direction) of each candidate node (a point)
  * against the shape inflated by margin_mm, so that nodes just outside the probe also get a
- * contact plane. A contact is a plane (surface point, outward normal); during the frame's
+ * contact plane. A rounded box's nodes above its face plane (or within the margin below it)
+ * take the face plane as their contact whatever MPR finds (the sliding face, sc_collider.c):
+ * for them only whether the node is inside is needed, and that is closed form (the distance to
+ * the core box below the inflation); this cut the collision of a 32x16x16 press frame from
+ * 0.25 to 0.016 ms with the same contact sets (every stored hash unchanged). A contact is a plane (surface point, outward normal); during the frame's
  * solver iterations the penetration of a node is measured against that plane, so the
  * repulsion force f = kappa * max(0, depth) * normal follows the node at O(1) per contact.
  *

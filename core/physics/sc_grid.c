@@ -566,21 +566,27 @@ static void job_finish(void *arg, uint32_t r)
     const uint32_t h = SC_GRID_HEAD;
     float *const nv[3] = {j->out->vx, j->out->vy, j->out->vz};
     float *const nx[3] = {j->out->x, j->out->y, j->out->z};
-    for (uint32_t c = 0; c < 3u; c++) {
-        for (uint32_t i = i0; i < i1; i++) {
-            const float v = g->v[c][h + i];
-            nv[c][i] = v;
-            nx[c][i] = g->x[c][h + i] + j->dt * v;
-        }
-    }
     /* The step clamp: a free node moves at most step_max_mm in a step (its free components
      * scaled down together; the prescribed ones are the probe's). Ten CG iterations on a
      * stiff tissue around a crushed, nearly massless lumen can leave a lumen node's step
      * tens of mm long (64x32x32, the probe lost at the deepest press); a node of a real
-     * tissue never moves two cells in one frame. Per node, so any split gives the same. */
+     * tissue never moves two cells in one frame. Per node, so any split gives the same. The
+     * copy-out notes whether any node (prescribed ones too) is faster than the bound; only
+     * such a range looks at its nodes' free components. */
     const float lim2 = (g->step_max_mm * g->step_max_mm) / (j->dt * j->dt);
-    uint32_t clamped = 0;
+    int over = 0;
     for (uint32_t i = i0; i < i1; i++) {
+        const float v0 = g->v[0][h + i], v1 = g->v[1][h + i], v2 = g->v[2][h + i];
+        nv[0][i] = v0;
+        nv[1][i] = v1;
+        nv[2][i] = v2;
+        nx[0][i] = g->x[0][h + i] + j->dt * v0;
+        nx[1][i] = g->x[1][h + i] + j->dt * v1;
+        nx[2][i] = g->x[2][h + i] + j->dt * v2;
+        over |= ((v0 * v0 + v1 * v1) + v2 * v2) > lim2;
+    }
+    uint32_t clamped = 0;
+    for (uint32_t i = i0; over && i < i1; i++) {
         float v2 = 0.0f;
         for (uint32_t c = 0; c < 3u; c++) {
             const float v = g->pc[c][h + i] > 0.0f ? g->v[c][h + i] : 0.0f;

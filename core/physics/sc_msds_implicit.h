@@ -35,8 +35,8 @@
  * stiffness, the same term as the FEM's (sc_fem.h): a collapsed vein flattens to the floor
  * instead of turning its tets inside out.
  *
- * Bounded steps on fine meshes: the volume and floor terms' deficits are clamped at the
- * shortest cell edge x |grad D| (a Gauss-Newton volume step moves a node by about deficit /
+ * Bounded steps on fine meshes: the floor term's deficit is clamped at the shortest cell
+ * edge x |grad D| (a Gauss-Newton volume step moves a node by about deficit /
  * |grad D|: a sliver with tiny gradients threw one), and sc_grid_solve holds every free node's
  * step to two cell diagonals (the fixed-count CG's error in the soft, light lumen nodes when a
  * deep press is let go at once). docs/physics.md, "The finest meshes".
