@@ -23,3 +23,11 @@ if(TARGET test_press_pulse AND TARGET cases)
   add_dependencies(test_press_pulse cases)
   set_tests_properties(test_press_pulse PROPERTIES TIMEOUT 2400)
 endif()
+# the robustness script on the largest mesh the limits allow (64x32x32), neck-ijv, the stable
+# MSDS: the deepest press with the tracker lost for a frame threw a lumen node there (the step
+# clamp, docs/physics.md "The finest meshes"); about 6 minutes under ASan
+if(TARGET test_physics_robust)
+  add_test(NAME test_physics_robust_64 COMMAND test_physics_robust)
+  set_tests_properties(test_physics_robust_64 PROPERTIES TIMEOUT 2400 LABELS hostsim
+    ENVIRONMENT "SC_ROBUST_MESH=64,32,32;SC_ROBUST_CASE=neck-ijv;SC_ROBUST_METHOD=msds")
+endif()
