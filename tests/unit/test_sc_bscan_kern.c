@@ -382,7 +382,8 @@ static void test_margin_variants_agree(void **state)
     print_message("margin label variants compared with the generic one: %u (%u in, %u out)\n",
                   tried, inside, outside);
     assert_true(tried >= 1u);
-    assert_true(inside > 10000u && outside > 10000u);
+    /* per variant compared (one where only the generic kernel is built, e.g. aarch64) */
+    assert_true(inside > 4000u * tried && outside > 4000u * tried);
 }
 
 /* The margin's near range: every block outside it is labelled SC_LABEL_OUTSIDE by the generic
