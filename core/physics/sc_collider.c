@@ -307,10 +307,21 @@ static uint32_t detect_rows(const detect_ctx *d, uint32_t row0, uint32_t row1, s
                 fabsf(l[2] - c->center_probe_mm[2]) > lim[2]) {
                 continue;
             }
+            /* Sliding face: a node inside the probe leaves through the face plane (the
+             * probe came from outside the body, through the skin; tissue slides under a
+             * gel-coated face), not through the nearest side wall or rounded edge: MPR's
+             * shortest way out lets a probe that moves sideways at depth, or jumps
+             * between two frames, bulldoze the tissue ahead of it until a node is pushed
+             * out of the box (the guard's displacement reset, measured with `--script
+             * sweep` on all three phantoms). */
+            /* (also a contact within the margin above the face plane: a node left on
+             * the face plane at the rounded rim lies just outside the rounding; with the
+             * rounding's own plane it would not be held, would spring back into the
+             * probe and chatter between the two every frame) */
             if (slide && l[2] < c->def.margin_mm) {
-                /* the sliding face's nodes (below) take the face plane whatever MPR finds: only
-                 * whether the node is in the inflated shape (the core box swept by a ball of
-                 * the inflation) matters, and that is exact in closed form; MPR for the rest */
+                /* such a node takes the face plane, so only whether it is in the inflated shape
+                 * (the core box swept by a ball of the inflation) matters: exact in closed
+                 * form, no MPR; MPR for the rest */
                 float d2 = 0.0f;
                 for (uint32_t a = 0; a < 3u; a++) {
                     const float e = fabsf(l[a] - c->center_probe_mm[a]) - c->core_half_mm[a];
@@ -349,23 +360,6 @@ static uint32_t detect_rows(const detect_ctx *d, uint32_t row0, uint32_t row1, s
                 const double u = dir.v[a] / dl;
                 ct->n[a] = (float)u;
                 ct->p_mm[a] = (float)((double)p[a] + d_real * u);
-            }
-            /* Sliding face: a node inside the probe leaves through the face plane (the
-             * probe came from outside the body, through the skin; tissue slides under a
-             * gel-coated face), not through the nearest side wall or rounded edge: MPR's
-             * shortest way out lets a probe that moves sideways at depth, or jumps
-             * between two frames, bulldoze the tissue ahead of it until a node is pushed
-             * out of the box (the guard's displacement reset, measured with `--script
-             * sweep` on all three phantoms). */
-            /* (also a contact within the margin above the face plane: a node left on
-             * the face plane at the rounded rim lies just outside the rounding; with the
-             * rounding's own plane it would not be held, would spring back into the
-             * probe and chatter between the two every frame) */
-            if (c->def.shape == SC_COLLIDER_ROUNDED_BOX && l[2] < c->def.margin_mm) {
-                const float lf[3] = {l[0], l[1], 0.0f};
-                const float nz[3] = {0.0f, 0.0f, 1.0f};
-                sc_xform_apply(&c->to_vol, lf, ct->p_mm);
-                sc_xform_rotate(&c->to_vol, nz, ct->n);
             }
         }
     }
