@@ -12,7 +12,8 @@
  * Usage: bench-physics [frames]   (default 200)
  *        bench-physics frames stable (the stable MSDS and the FEMs at 32x16x16 only)
  *        bench-physics frames msds   (the MSDS solver alone, see msds_only)
- *        bench-physics frames stages (32x16x16 per stage, see stages) */
+ *        bench-physics frames stages [NXxNYxNZ] (per stage, see stages; default 32x16x16)
+ *        bench-physics frames cg [NXxNYxNZ] (the CG alone, see cg_only; default 64x32x32) */
 #include <stdio.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -184,15 +185,15 @@ static uint64_t umin(uint64_t a, uint64_t b)
  * collision detection, and for the implicit methods the step's start and assembly
  * (sc_grid_begin and the method's element or spring and cell passes, timed again on the
  * frame's state); the CG with the rest of the frame is the frame minus those. */
-static int stages(int frames)
+static int stages(int frames, uint32_t nx, uint32_t ny, uint32_t nz)
 {
     const config cs[4] = {CFG_MSDS_STABLE, CFG_MSDS_EXPLICIT, CFG_FEM_LINEAR, CFG_FEM_COROTATED};
     static const char *const names[4] = {"MSDS stable", "MSDS explicit", "FEM linear",
                                          "FEM corotated"};
-    printf("32x16x16 per stage, ms, minimum over %d frames (kernels %s); stable MSDS and FEM: "
+    printf("%ux%ux%u per stage, ms, minimum over %d frames (kernels %s); stable MSDS and FEM: "
            "%u CG iterations; explicit MSDS: %u substeps of %.3f s (Algorithm 1 springs, volume "
            "ratio 6)\n",
-           frames, sc_simd_name(sc_simd_selected()), (unsigned)SC_PHYS_CG_ITERATIONS_DEFAULT,
+           (unsigned)nx, (unsigned)ny, (unsigned)nz, frames, sc_simd_name(sc_simd_selected()), (unsigned)SC_PHYS_CG_ITERATIONS_DEFAULT,
            (unsigned)SC_PHYS_ITERATIONS_DEFAULT, (double)SC_PHYS_DT_DEFAULT_S);
     printf("%-14s | %8s | %9s | %8s | %8s | %10s | %6s\n", "method", "frame", "collision", "start",
            "assembly", "solve+rest", "lumen");
@@ -200,11 +201,12 @@ static int stages(int frames)
         result a;
         const float ratio =
             cs[c] == CFG_MSDS_EXPLICIT ? PAPER_VOLUME_RATIO : sc_msds_default_def().volume_stiffness_ratio;
-        if (run_cfg(32u, 16u, 16u, cs[c], ratio, 1, &a) != 0) {
+        if (run_cfg(nx, ny, nz, cs[c], ratio, 1, &a) != 0) {
             return 1;
         }
         const sc_pose pose = g_pose;
         uint64_t best[5] = {UINT64_MAX, UINT64_MAX, UINT64_MAX, UINT64_MAX, UINT64_MAX};
+        uint64_t best_cells = UINT64_MAX; /* the stable MSDS's cell pass, inside the assembly */
         const sc_collider_grid gr = {
             g_t.mesh.nx,
             g_t.mesh.ny,
@@ -235,7 +237,9 @@ static int stages(int frames)
                 if (msds) {
                     sc_grid_clear(g, SC_GRID_CLEAR_DIAG);
                     k->msds_springs(g, &g_t.msds, dt, ck);
+                    const uint64_t ts = now_ns();
                     k->msds_cells(g, &g_t.msds, dt, ck);
+                    best_cells = umin(best_cells, now_ns() - ts);
                 } else {
                     sc_grid_fem_in in = g_t.fem.element;
                     in.lamv = &g_t.fem.lamv[0][0];
@@ -268,13 +272,50 @@ static int stages(int frames)
             best[3] = umin(best[3], t4 - t3);
         }
         const double rest = ms(best[0]) - ms(best[1]) - ms(best[2]) - ms(best[3]) - ms(best[4]);
-        printf("%-14s | %8.3f | %9.3f | %8.3f | %8.3f | %10.3f | %6.3f\n", names[c], ms(best[0]),
+        printf("%-14s | %8.3f | %9.3f | %8.3f | %8.3f | %10.3f | %6.3f", names[c], ms(best[0]),
                ms(best[1]), ms(best[2]), ms(best[3]), rest, ms(best[4]));
+        if (best_cells != UINT64_MAX) {
+            printf("   (assembly: springs %.3f, cells %.3f)", ms(best[3]) - ms(best_cells),
+                   ms(best_cells));
+        }
+        printf("\n");
     }
 #if SC_PHYS_LUMEN
     printf("lumen: %u vessels, %u boundary faces loaded in the last frame\n",
            (unsigned)g_t.lumen.count, (unsigned)g_t.lumen.faces);
 #endif
+    return 0;
+}
+
+/* The CG alone on one mesh (stable MSDS scene, the press's state), one thread: the mat-vec and
+ * the whole CG of the default iterations, min over `frames` calls each. */
+static int cg_only(int frames, uint32_t nx, uint32_t ny, uint32_t nz)
+{
+    result a;
+    if (run_cfg(nx, ny, nz, CFG_MSDS_STABLE, sc_msds_default_def().volume_stiffness_ratio, 3,
+                &a) != 0) {
+        return 1;
+    }
+    const sc_grid_kern *k = sc_grid_kern_selected();
+    sc_grid *g = &g_t.fem.grid;
+    const float ck = 1e-3f;
+    uint64_t best[2] = {UINT64_MAX, UINT64_MAX};
+    for (int f = 0; f < frames; f++) {
+        sc_grid_cg_out out;
+        uint64_t t0 = now_ns();
+        k->matvec(g, 1.0f, ck);
+        best[0] = umin(best[0], now_ns() - t0);
+        t0 = now_ns();
+        k->cg(g, 1.0f, ck, SC_PHYS_CG_ITERATIONS_DEFAULT, &out);
+        best[1] = umin(best[1], now_ns() - t0);
+    }
+    const double matrix_mb = (double)g->node_count * 60.0 * 4.0 / 1e6;
+    printf("%ux%ux%u, %u nodes (matrix %.1f MB), kernels %s, one thread, min of %d: mat-vec "
+           "%.3f ms (%.1f GB/s of matrix), CG of %u iterations %.3f ms\n",
+           (unsigned)nx, (unsigned)ny, (unsigned)nz, (unsigned)g->node_count, matrix_mb,
+           sc_simd_name(sc_simd_selected()), frames, ms(best[0]),
+           matrix_mb / 1e3 / (ms(best[0]) / 1e3), (unsigned)SC_PHYS_CG_ITERATIONS_DEFAULT,
+           ms(best[1]));
     return 0;
 }
 
@@ -301,8 +342,15 @@ int main(int argc, char **argv)
         }
         return 0;
     }
-    if (argc > 2 && strcmp(argv[2], "stages") == 0) {
-        return stages(frames);
+    const int cg = argc > 2 && strcmp(argv[2], "cg") == 0;
+    if (cg || (argc > 2 && strcmp(argv[2], "stages") == 0)) {
+        unsigned nx = cg ? 64u : 32u, ny = cg ? 32u : 16u, nz = cg ? 32u : 16u;
+        if (argc > 3 && (sscanf(argv[3], "%ux%ux%u", &nx, &ny, &nz) != 3 || nx < 2u ||
+                         ny < 2u || nz < 2u)) {
+            fprintf(stderr, "bench-physics: mesh '%s' is not NXxNYxNZ\n", argv[3]);
+            return 2;
+        }
+        return cg ? cg_only(frames, nx, ny, nz) : stages(frames, nx, ny, nz);
     }
     if (argc > 2 && strcmp(argv[2], "msds") == 0) {
         const int which = argc > 3 ? (strcmp(argv[3], "springs") == 0 ? 0 : 1) : -1;
