@@ -195,6 +195,7 @@ static void print_config(FILE *f, const sc_rtcfg *c)
     fprintf(f, "rt.priority = %u\n", (unsigned)c->rt_priority);
     fprintf(f, "rt.cpu = %d\n", (int)c->rt_cpu);
     fprintf(f, "rt.mlock = %s\n", c->rt_mlock ? "true" : "false");
+    fprintf(f, "rt.hugepages = %s\n", c->rt_hugepages ? "true" : "false");
     fprintf(f, "watchdog.device = %s\n", c->watchdog_device);
     fprintf(f, "watchdog.timeout_ms = %u\n", (unsigned)c->watchdog_timeout_ms);
     fprintf(f, "tracker.timeout_ms = %u\n", (unsigned)c->tracker_timeout_ms);
@@ -454,8 +455,9 @@ static void final_report(const sc_engine *e, double wall_s, const char *stop_rea
            (unsigned long long)s->misses,
            s->frames ? 100.0 * (double)s->misses / (double)s->frames : 0.0,
            (unsigned long long)s->periods_skipped);
-    printf("  real time: mlockall %s, SCHED_FIFO %s, pinned %s\n", rt->locked ? "yes" : "no",
-           rt->fifo ? "yes" : "no", rt->pinned ? "yes" : "no");
+    printf("  real time: mlockall %s, SCHED_FIFO %s, pinned %s, huge pages %s\n",
+           rt->locked ? "yes" : "no", rt->fifo ? "yes" : "no", rt->pinned ? "yes" : "no",
+           rt->huge ? "yes" : "no");
     printf("  %-16s %9s %9s %9s %9s %9s   (ms)\n", "", "count", "mean", "p50", "p99", "worst");
     print_stats_row("frame", &s->frame_stats);
     print_stats_row("wake-up latency", &s->lateness_stats);
@@ -687,6 +689,15 @@ int main(int argc, char **argv)
     if (sc_rt_install_signals() != 0) {
         sc_log_linux_msg(&g_log, SC_LOG_WARN, "signals", "reason=\"cannot install handlers\"");
     }
+    int hp = 1;
+    if (cfg.rt_hugepages) {
+        /* before mlockall faults the engine's pages in (sc_rt.h) */
+        hp = sc_rt_advise_hugepages(&g_engine, sizeof g_engine);
+        if (hp == SC_ERR_IO) {
+            sc_log_linux_msg(&g_log, SC_LOG_WARN, "rt_hugepages_refused",
+                             "errno=%s action=\"running on 4 KiB pages\"", strerror(errno));
+        }
+    }
     sc_rt_def rtd = sc_rt_default_def();
     rtd.mlock = (int)cfg.rt_mlock;
     rtd.sched_fifo = (int)cfg.rt_sched_fifo;
@@ -694,6 +705,7 @@ int main(int argc, char **argv)
     rtd.cpu = cfg.rt_cpu;
     sc_rt_report rtr;
     sc_rt_apply(&rtd, &rtr);
+    rtr.huge = hp == 0;
     if (rtd.mlock && !rtr.locked) {
         sc_log_linux_msg(&g_log, SC_LOG_WARN, "rt_mlock_refused",
                          "errno=%s action=\"running with pageable memory\"",

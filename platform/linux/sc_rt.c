@@ -67,6 +67,17 @@ sc_rt_def sc_rt_default_def(void)
     return d;
 }
 
+int sc_rt_advise_hugepages(void *p, size_t n)
+{
+    const uintptr_t huge = (uintptr_t)2u << 20;
+    const uintptr_t a = ((uintptr_t)p + huge - 1u) & ~(huge - 1u);
+    const uintptr_t e = ((uintptr_t)p + n) & ~(huge - 1u);
+    if (p == NULL || e <= a) {
+        return 1;
+    }
+    return madvise((void *)a, (size_t)(e - a), MADV_HUGEPAGE) == 0 ? 0 : SC_ERR_IO;
+}
+
 void sc_rt_prefault(void *p, size_t n)
 {
     const long page = sysconf(_SC_PAGESIZE);

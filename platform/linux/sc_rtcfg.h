@@ -76,6 +76,7 @@ typedef struct sc_rtcfg {
     uint32_t rt_priority;                    /* SCHED_FIFO priority 1..99 */
     int32_t rt_cpu;                          /* -1: no pinning */
     uint32_t rt_mlock;                       /* bool */
+    uint32_t rt_hugepages;                   /* bool: the engine's state on 2 MiB pages */
     char watchdog_device[SC_RTCFG_PATH_MAX]; /* "none", "soft" or a device path */
     uint32_t watchdog_timeout_ms;
     uint32_t tracker_timeout_ms;

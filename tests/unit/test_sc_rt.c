@@ -4,6 +4,7 @@
  * not make the test runner real-time; the sonocomp benchmark run reports it.) */
 #include "sc_test.h"
 
+#include <errno.h>
 #include <signal.h>
 #include <string.h>
 #include <time.h>
@@ -75,6 +76,27 @@ static void prefault_touches_every_page_without_harm(void **state)
     }
 }
 
+/* the advice covers whole 2 MiB pages inside the range only; a range without one is left as it
+ * is (1); the kernel takes it (0), or, built without transparent huge pages, refuses it with
+ * EINVAL (SC_ERR_IO); the data is untouched either way */
+static void hugepage_advice_takes_whole_pages_and_keeps_the_data(void **state)
+{
+    (void)state;
+    static uint8_t big[5u << 20]; /* holds at least one aligned 2 MiB page */
+    static uint8_t small[(1u << 20) + 4096u];
+    for (size_t i = 0; i < sizeof big; i += 4096u) {
+        big[i] = (uint8_t)(i >> 12);
+    }
+    assert_int_equal(sc_rt_advise_hugepages(small, sizeof small), 1);
+    assert_int_equal(sc_rt_advise_hugepages(NULL, sizeof big), 1);
+    errno = 0;
+    const int rc = sc_rt_advise_hugepages(big, sizeof big);
+    assert_true(rc == 0 || (rc == SC_ERR_IO && errno == EINVAL));
+    for (size_t i = 0; i < sizeof big; i += 4096u) {
+        assert_int_equal(big[i], (uint8_t)(i >> 12));
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -83,6 +105,7 @@ int main(void)
         cmocka_unit_test(unfed_software_watchdog_expires_and_counts),
         cmocka_unit_test(missing_watchdog_device_is_not_found),
         cmocka_unit_test(prefault_touches_every_page_without_harm),
+        cmocka_unit_test(hugepage_advice_takes_whole_pages_and_keeps_the_data),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -111,6 +111,7 @@ static void documented_default_file_sets_every_key_to_its_default(void **state)
     assert_int_equal(c.rt_priority, def.rt_priority);
     assert_int_equal(c.rt_cpu, def.rt_cpu);
     assert_int_equal(c.rt_mlock, def.rt_mlock);
+    assert_int_equal(c.rt_hugepages, def.rt_hugepages);
     assert_int_equal(c.watchdog_timeout_ms, def.watchdog_timeout_ms);
     assert_int_equal(c.tracker_timeout_ms, def.tracker_timeout_ms);
     assert_int_equal(c.log_level, def.log_level);
@@ -140,6 +141,7 @@ static void every_key_accepts_a_valid_non_default_value(void **state)
                        "rt.priority = 99\n"
                        "rt.cpu = 1\n"
                        "rt.mlock = off\n"
+                       "rt.hugepages = no\n"
                        "watchdog.device = /dev/watchdog0\n"
                        "watchdog.timeout_ms = 250\n"
                        "tracker.timeout_ms = 5000\n"
@@ -178,6 +180,7 @@ static void every_key_accepts_a_valid_non_default_value(void **state)
     assert_int_equal(c.rt_priority, 99);
     assert_int_equal(c.rt_cpu, 1);
     assert_int_equal(c.rt_mlock, 0);
+    assert_int_equal(c.rt_hugepages, 0);
     assert_string_equal(c.watchdog_device, "/dev/watchdog0");
     assert_int_equal(c.watchdog_timeout_ms, 250);
     assert_int_equal(c.tracker_timeout_ms, 5000);

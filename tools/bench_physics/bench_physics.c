@@ -20,6 +20,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_pages.h"
 #include "sc_err.h"
 #include "sc_cpu.h"
 #include "sc_grid_kern.h"
@@ -322,11 +323,13 @@ static int cg_only(int frames, uint32_t nx, uint32_t ny, uint32_t nz)
 int main(int argc, char **argv)
 {
     const int frames = argc > 1 ? atoi(argv[1]) : 200;
+    const char *pages = bench_pages(&g_t, sizeof g_t);
     if (sc_cpu_select_simd() != SC_OK) {
         fprintf(stderr, "bench-physics: SONOCOMP_SIMD not available here, using %s\n",
                 sc_simd_name(sc_simd_selected()));
     }
     printf("kernels: %s\n", sc_simd_name(sc_simd_selected()));
+    printf("pages: %s\n", pages);
     if (argc > 2 && strcmp(argv[2], "stable") == 0) {
         /* the stable MSDS and the FEMs at 32x16x16 only (the targets' measure) */
         const config cs[3] = {CFG_MSDS_STABLE, CFG_FEM_LINEAR, CFG_FEM_COROTATED};

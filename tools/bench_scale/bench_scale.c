@@ -29,6 +29,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bench_pages.h"
 #include "bench_scene.h"
 #include "sc_err.h"
 #include "sc_pool_linux.h"
@@ -203,6 +204,7 @@ int main(int argc, char **argv)
         return prc;
     }
     bench_select_kernels("bench-scale"); /* the engine's variant, as sonocomp selects it */
+    printf("pages: %s\n", bench_pages(&g_t, sizeof g_t));
     FILE *csv = NULL;
     if (o.csv) {
         csv = fopen(o.csv, "w");
