@@ -11,6 +11,9 @@
 #
 # usage: tools/rt_bench/rt_press.sh BUILD_DIR [SECONDS] [MESH NX,NY,NZ] [WORKERS] [OUT_DIR]
 #   defaults: 60 s, the phantom neck-ijv at its own mesh, 1 worker, out/rt_press
+# environment: RT_PRESS_LOAD=none leaves CPU 1 to the engine (a two-worker run uses both CPUs:
+#   the loop on CPU 0, its worker on CPU 1); RT_PRESS_RATES="60" runs only the rates listed
+#   (default "60 120").
 set -eu
 BUILD=$1
 SECS=${2:-60}
@@ -35,7 +38,10 @@ LOG=$OUT/tracker.log
 "$EMU" --script sweep --point -2,0,0 --depth-mm 8 --hover-mm 5 --length-mm 20 --period-s 4 \
     --duration-s $((SECS + 5)) --log "$LOG" 2> "$OUT/tracker.err"
 hog=""
-if command -v stress-ng > /dev/null 2>&1; then
+RATES=${RT_PRESS_RATES:-60 120}
+if [ "${RT_PRESS_LOAD:-stress}" = none ]; then
+    load="none (RT_PRESS_LOAD=none)"
+elif command -v stress-ng > /dev/null 2>&1; then
     stress-ng --cpu 1 --taskset 1 --timeout $((4 * (SECS + 10)))s > /dev/null 2>&1 &
     hog=$!
     load="stress-ng --cpu 1 --taskset 1"
@@ -49,7 +55,7 @@ echo "machine: $(nproc) CPUs, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f
     "load average $(cut -d' ' -f1-3 /proc/loadavg), kernel $(uname -r)"
 echo "second core: $load; mesh: ${MESH:-the phantom's own}; workers: $WORKERS; $SECS s per run"
 for method in fem msds; do
-    for rate in 60 120; do
+    for rate in $RATES; do
         echo "=== $method at $rate Hz ==="
         "$ENGINE" -s "case=$CASE" -s physics.method=$method -s frame_rate_hz=$rate \
             -s display.target=none -s rt.cpu=0 -s rt.sched_fifo=true -s rt.mlock=true \
