@@ -218,7 +218,7 @@ void sc_fem_step(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s, uint32_t 
     sc_fem_step_kinematic(f, m, n, dt_s, cg_iterations, NULL);
 }
 
-/* the linear step's r0 loops over a range of SC_GRID_POOL_RANGE nodes */
+/* the linear step's r0 loops over a range of sc_grid.range nodes */
 typedef struct r0_job {
     sc_grid *g;
     float dt, ck;
@@ -227,8 +227,8 @@ typedef struct r0_job {
 static void r0_span(const sc_grid *g, uint32_t r, uint32_t *i0, uint32_t *i1)
 {
     const uint32_t h = SC_GRID_HEAD, end = h + g->node_end;
-    *i0 = h + r * SC_GRID_POOL_RANGE;
-    *i1 = *i0 + SC_GRID_POOL_RANGE < end ? *i0 + SC_GRID_POOL_RANGE : end;
+    *i0 = h + r * g->range;
+    *i1 = *i0 + g->range < end ? *i0 + g->range : end;
 }
 
 /* p = dt (x - X) + ck v0 */
@@ -277,7 +277,7 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
         /* linear, the rest K in place: r -= K (dt (x - X) + ck v0), one mat-vec; the
          * element-wise loops and the mat-vec on the pool (every node its own: the same bits) */
         r0_job j = {g, dt_s, ck};
-        const uint32_t ranges = (g->node_end + SC_GRID_POOL_RANGE - 1u) / SC_GRID_POOL_RANGE;
+        const uint32_t ranges = (g->node_end + g->range - 1u) / g->range;
         sc_pool_run(g->pool, job_r0_p, &j, ranges);
         k->matvec(g, 0.0f, 1.0f);
         sc_pool_run(g->pool, job_r0_r, &j, ranges);

@@ -213,7 +213,16 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
     SC_ASSERT(g->asm_span % SC_GRID_CELL_BLOCK == 0u &&
               g->asm_span > nxy + nx + SC_GRID_CELL_BLOCK &&
               (g->cell_end + g->asm_span - 1u) / g->asm_span <= SC_GRID_ASM_RANGES);
-    g->sum_block = g->node_end > SC_GRID_SUM_BLOCK ? SC_GRID_SUM_BLOCK_BIG : SC_GRID_SUM_BLOCK;
+    g->range = SC_GRID_POOL_RANGE;
+    if (g->node_end > SC_GRID_SUM_BLOCK) {
+        /* a multiple of four ranges (sc_grid.h), whole chunks */
+        uint32_t count = (g->node_end + SC_GRID_POOL_RANGE - 1u) / SC_GRID_POOL_RANGE;
+        count = (count + 3u) / 4u * 4u;
+        const uint32_t size = (g->node_end + count - 1u) / count;
+        g->range = (size + SC_GRID_CHUNK - 1u) / SC_GRID_CHUNK * SC_GRID_CHUNK;
+    }
+    SC_ASSERT((g->node_end + g->range - 1u) / g->range <= SC_GRID_RANGES_MAX);
+    g->sum_block = g->node_end > SC_GRID_SUM_BLOCK ? g->range : SC_GRID_SUM_BLOCK;
     g->step_max_mm = 2.0f * sqrtf(m->cell_mm[0] * m->cell_mm[0] + m->cell_mm[1] * m->cell_mm[1] +
                                   m->cell_mm[2] * m->cell_mm[2]);
     init_slots(g);
@@ -359,11 +368,10 @@ static int rigid_motions_pinned(const sc_grid *g)
     return 1;
 }
 
-/* The step's node loops on the worker pool (sc_grid.h): ranges of SC_GRID_POOL_RANGE nodes,
+/* The step's node loops on the worker pool (sc_grid.h): ranges of sc_grid.range nodes,
  * every node's values its own (the serial loops' bits); the loaded test is an OR per range and
  * the solution's sum of squares is summed per sc_grid.sum_block nodes and added in block order
  * (one block up to 32x16x16: the serial sum). */
-#define SC_GRID_NODE_RANGES ((SC_MAX_NODES + SC_GRID_POOL_RANGE - 1u) / SC_GRID_POOL_RANGE)
 typedef struct step_job {
     sc_grid *g;
     const sc_mesh *m;
@@ -372,8 +380,8 @@ typedef struct step_job {
     const uint8_t *kinematic;
     float dt, dta, warm, pull, cm, ck;
     int release;
-    uint8_t loaded[SC_GRID_NODE_RANGES];
-    uint32_t clamped[SC_GRID_NODE_RANGES];
+    uint8_t loaded[SC_GRID_RANGES_MAX];
+    uint32_t clamped[SC_GRID_RANGES_MAX];
     float vsum[SC_GRID_SUM_BLOCKS];
 } step_job;
 
@@ -393,7 +401,7 @@ static void job_loaded(void *arg, uint32_t r)
 {
     step_job *j = (step_job *)arg;
     uint32_t i0, i1;
-    job_span(j, r, SC_GRID_POOL_RANGE, &i0, &i1);
+    job_span(j, r, j->g->range, &i0, &i1);
     const sc_nodes *n = j->n;
     int loaded = 0;
     for (uint32_t i = i0; i < i1 && !loaded; i++) {
@@ -409,7 +417,7 @@ static void job_flags(void *arg, uint32_t r)
     step_job *j = (step_job *)arg;
     sc_grid *g = j->g;
     uint32_t i0, i1;
-    job_span(j, r, SC_GRID_POOL_RANGE, &i0, &i1);
+    job_span(j, r, j->g->range, &i0, &i1);
     const uint32_t h = SC_GRID_HEAD;
     for (uint32_t i = i0; i < i1; i++) {
         uint8_t con = 0u;
@@ -432,7 +440,7 @@ static void job_start(void *arg, uint32_t r)
     sc_grid *g = j->g;
     const sc_nodes *n = j->n;
     uint32_t i0, i1;
-    job_span(j, r, SC_GRID_POOL_RANGE, &i0, &i1);
+    job_span(j, r, j->g->range, &i0, &i1);
     const uint32_t h = SC_GRID_HEAD;
     const float *const nv[3] = {n->vx, n->vy, n->vz};
     const float *const nx[3] = {n->x, n->y, n->z};
@@ -472,13 +480,13 @@ void sc_grid_begin(sc_grid *g, const sc_mesh *m, const sc_nodes *n, float dt_s, 
     j.warm = beta_s / (beta_s + dt_s);
     j.pull = -1.0f / (beta_s + dt_s);
     j.cm = j.ck = 0.0f;
-    const uint32_t ranges = job_ranges(g, SC_GRID_POOL_RANGE);
+    const uint32_t ranges = job_ranges(g, g->range);
     /* unloaded: no kinematic node and no external force (the probe is off the skin); the release
      * warm start needs the rest state to be the only unloaded equilibrium (checked below, after
      * the flags) */
     sc_pool_run(g->pool, job_loaded, &j, ranges);
     int loaded = 0;
-    for (uint32_t r = 0; r < ranges && r < SC_GRID_NODE_RANGES; r++) {
+    for (uint32_t r = 0; r < ranges && r < SC_GRID_RANGES_MAX; r++) {
         loaded |= j.loaded[r];
     }
     sc_pool_run(g->pool, job_flags, &j, ranges);
@@ -527,7 +535,7 @@ static void job_precond(void *arg, uint32_t r)
     step_job *j = (step_job *)arg;
     sc_grid *g = j->g;
     uint32_t i0, i1;
-    job_span(j, r, SC_GRID_POOL_RANGE, &i0, &i1);
+    job_span(j, r, j->g->range, &i0, &i1);
     const uint32_t h = SC_GRID_HEAD;
     static const uint32_t diag_entry[3] = {0u, 3u, 5u};
     for (uint32_t i = i0; i < i1; i++) {
@@ -562,7 +570,7 @@ static void job_finish(void *arg, uint32_t r)
     step_job *j = (step_job *)arg;
     const sc_grid *g = j->g;
     uint32_t i0, i1;
-    job_span(j, r, SC_GRID_POOL_RANGE, &i0, &i1);
+    job_span(j, r, j->g->range, &i0, &i1);
     const uint32_t h = SC_GRID_HEAD;
     float *const nv[3] = {j->out->vx, j->out->vy, j->out->vz};
     float *const nx[3] = {j->out->x, j->out->y, j->out->z};
@@ -623,7 +631,7 @@ int sc_grid_solve(sc_grid *g, sc_nodes *n, float dt_s, float beta_s, float alpha
     j.dt = dt_s;
     j.cm = cm;
     j.ck = ck;
-    const uint32_t ranges = job_ranges(g, SC_GRID_POOL_RANGE);
+    const uint32_t ranges = job_ranges(g, g->range);
     /* Jacobi preconditioner, zero on Dirichlet DOFs (projects the CG onto the free DOFs) */
     sc_pool_run(g->pool, job_precond, &j, ranges);
     sc_grid_cg_out out;
@@ -643,7 +651,7 @@ int sc_grid_solve(sc_grid *g, sc_nodes *n, float dt_s, float beta_s, float alpha
     }
     sc_pool_run(g->pool, job_finish, &j, ranges);
     uint32_t clamped = 0;
-    for (uint32_t r = 0; r < ranges && r < SC_GRID_NODE_RANGES; r++) {
+    for (uint32_t r = 0; r < ranges && r < SC_GRID_RANGES_MAX; r++) {
         clamped += j.clamped[r];
     }
     g->stats.clamped_nodes = clamped;

@@ -95,13 +95,16 @@ _Static_assert((SC_GRID_ROW / 16u) % 2u == 1u, "row stride an odd multiple of 16
  * workers is not. */
 #define SC_GRID_POOL_RANGE 1024u
 #define SC_GRID_SUM_BLOCK 8192u
-/* A mesh of more than SC_GRID_SUM_BLOCK nodes sums its dot products over blocks of
- * SC_GRID_SUM_BLOCK_BIG nodes instead (sc_grid.sum_block, chosen by the mesh alone): one block per
- * mat-vec range, so two workers share the blocks evenly (with 8,192-node blocks a 48x24x24 mesh
- * had four, the last 3,072 nodes: 3.4 blocks of work over two workers took the time of 2) and
- * the p.Ap partials are formed in the mat-vec's own job. */
-#define SC_GRID_SUM_BLOCK_BIG SC_GRID_POOL_RANGE
-#define SC_GRID_SUM_BLOCKS ((SC_MAX_NODES + SC_GRID_SUM_BLOCK_BIG - 1u) / SC_GRID_SUM_BLOCK_BIG)
+/* A mesh of more than SC_GRID_SUM_BLOCK nodes cuts its node loops into a multiple of four
+ * ranges of about SC_GRID_POOL_RANGE nodes (sc_grid.range, chosen by the mesh alone), so that
+ * two or four workers take as many ranges each (48x24x24: 28 ranges of 992 nodes, where 27 of
+ * 1,024 left one worker a range idle at every job's end; 64x32x32 keeps 64 of 1,024), and sums
+ * its dot products over blocks of one range (sc_grid.sum_block = range): two workers share
+ * the blocks evenly (with 8,192-node blocks a 48x24x24 mesh had four, the last 3,072 nodes: 3.4
+ * blocks of work over two workers took the time of 2) and the p.Ap partials are formed in the
+ * mat-vec's own job. */
+#define SC_GRID_RANGES_MAX ((SC_MAX_NODES + SC_GRID_POOL_RANGE - 1u) / SC_GRID_POOL_RANGE + 3u)
+#define SC_GRID_SUM_BLOCKS SC_GRID_RANGES_MAX
 _Static_assert(SC_GRID_POOL_RANGE % SC_GRID_CHUNK == 0u && SC_GRID_SUM_BLOCK % 16u == 0u,
                "pool ranges and sum blocks are whole chunks and whole partial-sum groups");
 
@@ -170,6 +173,7 @@ typedef struct sc_grid {
     uint32_t cell_end;  /* cell origins 0 .. cell_end - 1 are visited (rounded up to a block) */
     uint32_t asm_span;  /* cell origins per range of the cell passes (SC_GRID_ASM_SPAN above) */
     uint32_t sum_block; /* nodes per block of the CG's dot products (SC_GRID_SUM_BLOCK above) */
+    uint32_t range;     /* nodes per range of the node loops and the CG (SC_GRID_POOL_RANGE) */
     float step_max_mm;  /* the most a free node moves in one step: two cell diagonals */
     uint32_t off[8];    /* node offset of cell corner c (bit 0 +x, bit 1 +y, bit 2 +z) */
     sc_grid_slot slot[18];
