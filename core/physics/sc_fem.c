@@ -113,6 +113,7 @@ static sc_grid_fem_in element_in(const sc_fem *f, int corotated)
     in.lamv = &f->lamv[0][0];
     in.muv = &f->muv[0][0];
     in.corotated = corotated;
+    in.floor_only = 0;
     return in;
 }
 
@@ -198,6 +199,7 @@ int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat, const
     const sc_grid_fem_in in = element_in(f, 0);
     sc_grid_kern_selected()->fem_cells(g, &in, 0.0f, 0.0f);
     f->rest_k = 1u;
+    (void)sc_grid_save_rest(g); /* a big mesh keeps it aside (sc_grid.h) */
     return SC_OK;
 }
 
@@ -273,7 +275,17 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
     sc_grid_begin(g, m, n, dt_s, beta, alpha, kinematic);
     const int corotated = f->def.corotated != 0u;
     const sc_grid_fem_in in = element_in(f, corotated);
-    if (!corotated && f->rest_k && k->fem_below(g, &in) == 0u) {
+    uint32_t below = 0u;
+    if (!corotated && (f->rest_k || g->rest_saved)) {
+        below = k->fem_below(g, &in);
+        if (!f->rest_k) {
+            /* a big mesh: the rest K back from its copy (the last step left K + floor, or the
+             * MSDS its own matrix) */
+            (void)sc_grid_load_rest(g);
+            f->rest_k = 1u;
+        }
+    }
+    if (!corotated && f->rest_k && (below == 0u || g->rest_saved)) {
         /* linear, the rest K in place: r -= K (dt (x - X) + ck v0), one mat-vec; the
          * element-wise loops and the mat-vec on the pool (every node its own: the same bits) */
         r0_job j = {g, dt_s, ck};
@@ -282,6 +294,14 @@ void sc_fem_step_kinematic(sc_fem *f, const sc_mesh *m, sc_nodes *n, float dt_s,
         k->matvec(g, 0.0f, 1.0f);
         sc_pool_run(g->pool, job_r0_r, &j, ranges);
         f->stats.degenerate_tets = 0u;
+        if (below > 0u) {
+            /* the floor's blocks and residual onto the rest K, cells with a tet below it only
+             * (sc_grid.h, "rest K kept aside"); the grid then holds K + floor */
+            sc_grid_fem_in fo = in;
+            fo.floor_only = 1;
+            (void)k->fem_cells(g, &fo, dt_s, ck);
+            f->rest_k = 0u;
+        }
     } else {
         sc_grid_clear(g, SC_GRID_CLEAR_DIAG | SC_GRID_CLEAR_BLOCKS);
         f->stats.degenerate_tets = k->fem_cells(g, &in, dt_s, ck);

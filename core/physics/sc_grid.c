@@ -223,6 +223,7 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
     }
     SC_ASSERT((g->node_end + g->range - 1u) / g->range <= SC_GRID_RANGES_MAX);
     g->sum_block = g->node_end > SC_GRID_SUM_BLOCK ? g->range : SC_GRID_SUM_BLOCK;
+    g->rest_saved = 0u;
     g->step_max_mm = 2.0f * sqrtf(m->cell_mm[0] * m->cell_mm[0] + m->cell_mm[1] * m->cell_mm[1] +
                                   m->cell_mm[2] * m->cell_mm[2]);
     init_slots(g);
@@ -247,6 +248,7 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
         (void)k;
     }
     memset(&g->stats, 0, sizeof g->stats);
+    memset(g->below_n, 0, sizeof g->below_n);
     g->forces_vanish_at_rest = 0u;
     g->pool = NULL;
 
@@ -521,6 +523,65 @@ static void job_clear(void *arg, uint32_t r)
             memset(&g->f[0][0][0] + (size_t)k * SC_GRID_ROW + a, 0, bytes);
         }
     }
+}
+
+#if SC_GRID_REST_COPY
+/* the matrix rows to (save) or from (load) the rest copy, ranges as job_clear's */
+typedef struct rest_job {
+    sc_grid *g;
+    uint32_t used;
+    int save;
+} rest_job;
+
+static void job_rest(void *arg, uint32_t r)
+{
+    const rest_job *j = (const rest_job *)arg;
+    sc_grid *g = j->g;
+    const uint32_t a = r * SC_GRID_POOL_RANGE;
+    const uint32_t b = a + SC_GRID_POOL_RANGE < j->used ? a + SC_GRID_POOL_RANGE : j->used;
+    const size_t bytes = (size_t)(b - a) * sizeof(float);
+    float *mat = &g->d[0][0];
+    for (uint32_t k = 0; k < SC_GRID_MAT_ROWS; k++) {
+        float *m = mat + (size_t)k * SC_GRID_ROW + a, *s = &g->rest[k][a];
+        if (j->save) {
+            memcpy(s, m, bytes);
+        } else {
+            memcpy(m, s, bytes);
+        }
+    }
+}
+
+static void rest_copy(sc_grid *g, int save)
+{
+    rest_job j = {g, SC_GRID_HEAD + g->node_end + SC_GRID_PAD, save};
+    sc_pool_run(g->pool, job_rest, &j, (j.used + SC_GRID_POOL_RANGE - 1u) / SC_GRID_POOL_RANGE);
+}
+#endif
+
+int sc_grid_save_rest(sc_grid *g)
+{
+    SC_ASSERT(g != NULL);
+#if SC_GRID_REST_COPY
+    if (g->node_count > SC_GRID_REST_COPY_NODES) {
+        rest_copy(g, 1);
+        g->rest_saved = 1u;
+        return 1;
+    }
+#endif
+    g->rest_saved = 0u;
+    return 0;
+}
+
+int sc_grid_load_rest(sc_grid *g)
+{
+    SC_ASSERT(g != NULL);
+#if SC_GRID_REST_COPY
+    if (g->rest_saved) {
+        rest_copy(g, 0);
+        return 1;
+    }
+#endif
+    return 0;
 }
 
 void sc_grid_clear(sc_grid *g, uint32_t which)

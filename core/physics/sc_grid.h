@@ -62,6 +62,7 @@
 #ifndef SC_GRID_H
 #define SC_GRID_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "sc_config.h"
@@ -107,6 +108,23 @@ _Static_assert((SC_GRID_ROW / 16u) % 2u == 1u, "row stride an odd multiple of 16
 #define SC_GRID_SUM_BLOCKS SC_GRID_RANGES_MAX
 _Static_assert(SC_GRID_POOL_RANGE % SC_GRID_CHUNK == 0u && SC_GRID_SUM_BLOCK % 16u == 0u,
                "pool ranges and sum blocks are whole chunks and whole partial-sum groups");
+
+/* The linear FEM's rest K kept aside (meshes of more than SC_GRID_REST_COPY_NODES nodes: 48x24x24
+ * and up; sc_grid_save_rest, sc_grid_load_rest). The linear model's matrix is the rest K but for
+ * the floor term of the tets below their floor volume (a firm press that collapses a vein crushes
+ * 10^4 of a 64x32x32 mesh's tets). A step with the floor met re-assembled every cell: at
+ * 64x32x32 with two workers the linear FEM's step took 14.3 ms against 9.2 without (p50, the
+ * real loop pressing 8 mm and sweeping). A big mesh starts such a step from the kept copy and
+ * adds the floor's blocks and residual of the cell blocks that hold a tet below the floor
+ * (sc_grid_fem_in.floor_only); the rest K's part of the residual is one mat-vec, as in a step
+ * without the floor. The sums differ from the whole re-assembly's (the floor added after the
+ * rest K, not inside each cell's sum), the same for every worker count; meshes up to 32x16x16
+ * keep the whole re-assembly (every stored hash unchanged); the MCU's limits leave the copy out. */
+#ifndef SC_GRID_REST_COPY_NODES
+#define SC_GRID_REST_COPY_NODES 16384u
+#endif
+#define SC_GRID_REST_COPY (SC_MAX_NODES > SC_GRID_REST_COPY_NODES)
+#define SC_GRID_MAT_ROWS 60u /* d 6, e 27, f 27: row k of the matrix at &d[0][0] + k ROW */
 
 /* The cell passes (FEM assembly, the MSDS's volume terms) on the worker pool: the cell origins
  * are cut into ranges of SC_GRID_ASM_SPAN origins (whole cell blocks), each with its own block
@@ -174,6 +192,9 @@ typedef struct sc_grid {
     uint32_t asm_span;  /* cell origins per range of the cell passes (SC_GRID_ASM_SPAN above) */
     uint32_t sum_block; /* nodes per block of the CG's dot products (SC_GRID_SUM_BLOCK above) */
     uint32_t range;     /* nodes per range of the node loops and the CG (SC_GRID_POOL_RANGE) */
+    uint8_t rest_saved; /* 1: rest[] holds a rest K (sc_grid_save_rest; 0 after sc_grid_init) */
+    uint32_t below_n[SC_GRID_ASM_RANGES]; /* tets below the floor per cell range, as the last
+                                             fem_below counted them */
     float step_max_mm;  /* the most a free node moves in one step: two cell diagonals */
     uint32_t off[8];    /* node offset of cell corner c (bit 0 +x, bit 1 +y, bit 2 +z) */
     sc_grid_slot slot[18];
@@ -215,7 +236,14 @@ typedef struct sc_grid {
     /* ---- scratch of the cell kernels: one block of cells per assembly range, rows of
      * SC_GRID_CELL_BLOCK (one range, 15 KB, on the MCU's limits) ---- */
     SC_ALIGN_HOT float buf[SC_GRID_ASM_RANGES][SC_GRID_BUF_ROWS][SC_GRID_CELL_BLOCK];
+#if SC_GRID_REST_COPY
+    /* ---- the linear FEM's rest K, rows as d, e, f (above) ---- */
+    SC_ALIGN_HOT float rest[SC_GRID_MAT_ROWS][SC_GRID_ROW];
+#endif
 } sc_grid;
+_Static_assert(offsetof(sc_grid, e) == offsetof(sc_grid, d) + 6u * SC_GRID_ROW * sizeof(float) &&
+                   offsetof(sc_grid, f) == offsetof(sc_grid, e) + 27u * SC_GRID_ROW * sizeof(float),
+               "the matrix rows d, e, f follow each other: row k at &d[0][0] + k SC_GRID_ROW");
 
 /* The FEM's element data for the cell kernel (sc_fem.c fills it at init). Tet q of the cell with
  * lowest node t (template order, SC_MESH_CELL_TETS) has lambda V and mu V at
@@ -234,6 +262,9 @@ typedef struct sc_grid_fem_in {
     float floor_step_mm;          /* the most the floor's linearised step moves a node: its
                                      deficit is clamped at floor_step_mm |grad V| (> 0) */
     int corotated;                /* 1: R = polar(F); 0: R = I (linear) */
+    int floor_only;               /* 1: the floor term alone (lambda = mu = 0), and only the cell
+                                     blocks that hold a tet below it, in the cell ranges where the
+                                     last fem_below counted one (sc_grid_save_rest) */
 } sc_grid_fem_in;
 
 /* Layout for the mesh (which must be sc_mesh_build's regular grid: checked against its tets),
@@ -248,6 +279,13 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m);
  * O(N). Preconditions (SC_ASSERT): g initialised with m; dt_s > 0, beta, alpha >= 0, finite. */
 void sc_grid_begin(sc_grid *g, const sc_mesh *m, const sc_nodes *n, float dt_s, float beta_s,
                    float alpha_per_s, const uint8_t *kinematic);
+
+/* Keep the matrix (the linear FEM's rest K) aside, on a mesh of more than SC_GRID_REST_COPY_NODES
+ * nodes (above); returns 1 if kept, 0 if the mesh keeps none. On the pool. */
+int sc_grid_save_rest(sc_grid *g);
+
+/* The matrix back to the kept rest K (bit for bit); returns 0 if none is kept. On the pool. */
+int sc_grid_load_rest(sc_grid *g);
 
 /* Zero the diagonal blocks (SC_GRID_CLEAR_DIAG) and/or the edge and face blocks
  * (SC_GRID_CLEAR_BLOCKS). O(N). */

@@ -37,6 +37,12 @@ typedef enum run_kind { RUN_MSDS, RUN_FEM, RUN_FEM_COROTATED, RUN_KINDS } run_ki
 /* a press and a lift on the scene, `workers` 0: no pool (NULL), else the host pool of that
  * many workers; returns the state hash and the ranges the pool ran */
 static uint32_t g_nz = 16u; /* the mesh is 40 x 16 x g_nz */
+/* the linear FEM's floor (sc_grid.h, "rest K kept aside"): a floor ratio other than the
+ * default's (0: the default), and the whole re-assembly forced on a mesh that keeps the copy */
+static float g_floor_ratio = 0.0f;
+static int g_whole_matrix = 0;
+static float g_press_step_mm = 0.8f; /* the press's depth per frame (4 frames) */
+static uint32_t g_floor_frames; /* frames whose step added the floor onto the kept rest K */
 
 static uint64_t scripted_run_on(run_kind kind, uint32_t workers, const sc_pool_dev *thread_pool,
                                 uint64_t *ranges_run)
@@ -49,6 +55,9 @@ static uint64_t scripted_run_on(run_kind kind, uint32_t workers, const sc_pool_d
     sc_tissue_def d =
         sc_test_scene_tissue_def(&g_scene, kind == RUN_MSDS ? SC_TISSUE_MSDS : SC_TISSUE_FEM);
     d.fem.corotated = kind == RUN_FEM_COROTATED ? 1u : 0u;
+    if (g_floor_ratio > 0.0f) {
+        d.fem.floor_volume_ratio = g_floor_ratio;
+    }
     sc_material_table mat;
     sc_material_table_default(&mat);
     static sc_hs_pool pool;
@@ -64,10 +73,16 @@ static uint64_t scripted_run_on(run_kind kind, uint32_t workers, const sc_pool_d
     while ((rc = sc_tissue_build_step(&g_t)) == SC_OK) {
     }
     assert_int_equal(rc, 1);
+    if (g_whole_matrix) {
+        g_t.fem.grid.rest_saved = 0u;
+    }
+    g_floor_frames = 0u;
     for (int f = 0; f < 8; f++) {
-        const float depth = f < 5 ? 0.8f * (float)f : -1.0f; /* press 3.2 mm, then lift */
+        /* press 3.2 mm (by default), then lift */
+        const float depth = f < 5 ? g_press_step_mm * (float)f : -1.0f;
         const sc_pose pose = sc_test_scene_probe(&g_scene, depth);
         assert_int_equal(sc_tissue_step(&g_t, &pose), SC_OK);
+        g_floor_frames += (g_t.fem.grid.rest_saved && !g_t.fem.rest_k) ? 1u : 0u;
     }
     *ranges_run = (workers > 0u && thread_pool == NULL) ? pool.ranges : 0u;
     return sc_tissue_state_hash(&g_t);
@@ -119,6 +134,53 @@ static void three_cell_ranges_give_the_same_hash_for_1_2_and_4_workers(void **st
         }
         g_nz = 16u;
     }
+}
+
+/* The linear FEM with the floor met on a mesh that keeps its rest K aside (40 x 16 x 28, above
+ * SC_GRID_REST_COPY_NODES; a floor at half the rest volume, the largest allowed, and a 10 mm press,
+ * so that tets go below it): the steps that add the floor onto the kept copy give the same bits with no
+ * pool and 1, 2, 4 host-pool workers, and the same motion as the whole re-assembly within
+ * rounding (the two sum the floor in a different order). */
+static void linear_floor_on_the_kept_rest_k_matches_the_whole_reassembly(void **state)
+{
+    (void)state;
+    g_nz = 28u;
+    g_floor_ratio = 0.5f;
+    g_press_step_mm = 2.5f;
+    uint64_t ranges = 0u;
+    const uint64_t serial = scripted_run(RUN_FEM, 0u, &ranges);
+    const uint32_t floor_frames = g_floor_frames;
+    static float kept[3][SC_MAX_NODES];
+    const uint32_t nn = g_t.mesh.node_count;
+    memcpy(kept[0], g_t.nodes.x, nn * sizeof(float));
+    memcpy(kept[1], g_t.nodes.y, nn * sizeof(float));
+    memcpy(kept[2], g_t.nodes.z, nn * sizeof(float));
+    for (uint32_t w = 1u; w <= 4u; w *= 2u) {
+        const uint64_t h = scripted_run(RUN_FEM, w, &ranges);
+        assert_true(h == serial);
+    }
+    g_whole_matrix = 1;
+    (void)scripted_run(RUN_FEM, 0u, &ranges);
+    g_whole_matrix = 0;
+    assert_int_equal(g_floor_frames, 0u); /* the whole path kept no copy */
+    float diff = 0.0f, moved = 0.0f;
+    const float *now[3] = {g_t.nodes.x, g_t.nodes.y, g_t.nodes.z};
+    const float *rest[3] = {g_t.mesh.rest_x, g_t.mesh.rest_y, g_t.mesh.rest_z};
+    for (uint32_t c = 0; c < 3u; c++) {
+        for (uint32_t i = 0; i < nn; i++) {
+            diff = fmaxf(diff, fabsf(now[c][i] - kept[c][i]));
+            moved = fmaxf(moved, fabsf(kept[c][i] - rest[c][i]));
+        }
+    }
+    print_message("floor on the kept rest K: %u of 8 frames; the whole re-assembly's positions "
+                  "within %.3g mm (largest displacement %.3f mm)\n",
+                  (unsigned)floor_frames, (double)diff, (double)moved);
+    assert_true(floor_frames >= 3u);
+    assert_true(moved > 0.5f);
+    assert_true(diff < 1e-3f * moved);
+    g_floor_ratio = 0.0f;
+    g_press_step_mm = 0.8f;
+    g_nz = 16u;
 }
 
 /* The same with the appliance's pool: real threads (2 and 4, not pinned) */
@@ -322,6 +384,7 @@ int main(void)
         cmocka_unit_test(three_cell_ranges_give_the_same_hash_for_1_2_and_4_workers),
         cmocka_unit_test(linux_pool_threads_give_the_serial_state_hash),
         cmocka_unit_test(lumen_passes_give_the_serial_bits_for_1_2_and_4_workers),
+        cmocka_unit_test(linear_floor_on_the_kept_rest_k_matches_the_whole_reassembly),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
