@@ -224,6 +224,7 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
     SC_ASSERT((g->node_end + g->range - 1u) / g->range <= SC_GRID_RANGES_MAX);
     g->sum_block = g->node_end > SC_GRID_SUM_BLOCK ? g->range : SC_GRID_SUM_BLOCK;
     g->rest_saved = 0u;
+    g->rest_patched = 0u;
     g->step_max_mm = 2.0f * sqrtf(m->cell_mm[0] * m->cell_mm[0] + m->cell_mm[1] * m->cell_mm[1] +
                                   m->cell_mm[2] * m->cell_mm[2]);
     init_slots(g);
@@ -249,6 +250,7 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
     }
     memset(&g->stats, 0, sizeof g->stats);
     memset(g->below_n, 0, sizeof g->below_n);
+    memset(g->floor_dirty, 0, sizeof g->floor_dirty);
     g->forces_vanish_at_rest = 0u;
     g->pool = NULL;
 
@@ -576,6 +578,27 @@ int sc_grid_load_rest(sc_grid *g)
 {
     SC_ASSERT(g != NULL);
 #if SC_GRID_REST_COPY
+    if (g->rest_saved && g->rest_patched) {
+        /* the floor's additions only: the nodes range r's cells reach, c0 .. c1 - 1 + off[7] */
+        const uint32_t ranges = (g->cell_end + g->asm_span - 1u) / g->asm_span;
+        float *mat = &g->d[0][0];
+        for (uint32_t r = 0; r < ranges && r < SC_GRID_ASM_RANGES; r++) {
+            if (!g->floor_dirty[r]) {
+                continue;
+            }
+            const uint32_t c0 = r * g->asm_span;
+            const uint32_t c1 = c0 + g->asm_span < g->cell_end ? c0 + g->asm_span : g->cell_end;
+            const uint32_t a = SC_GRID_HEAD + c0, b = SC_GRID_HEAD + c1 + g->off[7];
+            SC_ASSERT(b <= SC_GRID_ROW);
+            for (uint32_t k = 0; k < SC_GRID_MAT_ROWS; k++) {
+                memcpy(mat + (size_t)k * SC_GRID_ROW + a, &g->rest[k][a],
+                       (size_t)(b - a) * sizeof(float));
+            }
+            g->floor_dirty[r] = 0u;
+        }
+        g->rest_patched = 0u;
+        return 1;
+    }
     if (g->rest_saved) {
         rest_copy(g, 0);
         return 1;
@@ -587,6 +610,7 @@ int sc_grid_load_rest(sc_grid *g)
 void sc_grid_clear(sc_grid *g, uint32_t which)
 {
     SC_ASSERT(g != NULL);
+    g->rest_patched = 0u;
     clear_job j = {g, which, SC_GRID_HEAD + g->node_end + SC_GRID_PAD};
     sc_pool_run(g->pool, job_clear, &j, (j.used + SC_GRID_POOL_RANGE - 1u) / SC_GRID_POOL_RANGE);
 }

@@ -193,6 +193,9 @@ typedef struct sc_grid {
     uint32_t sum_block; /* nodes per block of the CG's dot products (SC_GRID_SUM_BLOCK above) */
     uint32_t range;     /* nodes per range of the node loops and the CG (SC_GRID_POOL_RANGE) */
     uint8_t rest_saved; /* 1: rest[] holds a rest K (sc_grid_save_rest; 0 after sc_grid_init) */
+    uint8_t rest_patched; /* 1: the matrix is the rest K but for a floor_only pass's additions in
+                             the cell ranges marked in floor_dirty (0 after sc_grid_clear) */
+    uint8_t floor_dirty[SC_GRID_ASM_RANGES];
     uint32_t below_n[SC_GRID_ASM_RANGES]; /* tets below the floor per cell range, as the last
                                              fem_below counted them */
     float step_max_mm;  /* the most a free node moves in one step: two cell diagonals */
@@ -284,7 +287,9 @@ void sc_grid_begin(sc_grid *g, const sc_mesh *m, const sc_nodes *n, float dt_s, 
  * nodes (above); returns 1 if kept, 0 if the mesh keeps none. On the pool. */
 int sc_grid_save_rest(sc_grid *g);
 
-/* The matrix back to the kept rest K (bit for bit); returns 0 if none is kept. On the pool. */
+/* The matrix back to the kept rest K (bit for bit): only the nodes the last floor_only pass's
+ * cell ranges reach when that pass was the only change (rest_patched), else every row; returns
+ * 0 if none is kept. */
 int sc_grid_load_rest(sc_grid *g);
 
 /* Zero the diagonal blocks (SC_GRID_CLEAR_DIAG) and/or the edge and face blocks

@@ -42,6 +42,7 @@ static uint32_t g_nz = 16u; /* the mesh is 40 x 16 x g_nz */
 static float g_floor_ratio = 0.0f;
 static int g_whole_matrix = 0;
 static float g_press_step_mm = 0.8f; /* the press's depth per frame (4 frames) */
+static int g_full_restore = 0; /* every rest K restore copies every row (not the floor's ranges) */
 static uint32_t g_floor_frames; /* frames whose step added the floor onto the kept rest K */
 
 static uint64_t scripted_run_on(run_kind kind, uint32_t workers, const sc_pool_dev *thread_pool,
@@ -81,6 +82,9 @@ static uint64_t scripted_run_on(run_kind kind, uint32_t workers, const sc_pool_d
         /* press 3.2 mm (by default), then lift */
         const float depth = f < 5 ? g_press_step_mm * (float)f : -1.0f;
         const sc_pose pose = sc_test_scene_probe(&g_scene, depth);
+        if (g_full_restore) {
+            g_t.fem.grid.rest_patched = 0u;
+        }
         assert_int_equal(sc_tissue_step(&g_t, &pose), SC_OK);
         g_floor_frames += (g_t.fem.grid.rest_saved && !g_t.fem.rest_k) ? 1u : 0u;
     }
@@ -138,9 +142,10 @@ static void three_cell_ranges_give_the_same_hash_for_1_2_and_4_workers(void **st
 
 /* The linear FEM with the floor met on a mesh that keeps its rest K aside (40 x 16 x 28, above
  * SC_GRID_REST_COPY_NODES; a floor at half the rest volume, the largest allowed, and a 10 mm press,
- * so that tets go below it): the steps that add the floor onto the kept copy give the same bits with no
- * pool and 1, 2, 4 host-pool workers, and the same motion as the whole re-assembly within
- * rounding (the two sum the floor in a different order). */
+ * so that tets go below it): the steps that add the floor onto the kept copy give the same bits
+ * with no pool, 1, 2, 4 host-pool workers and every row restored from the copy each step (not
+ * only the floor's ranges), and the same motion as the whole re-assembly within rounding (the
+ * two sum the floor in a different order). */
 static void linear_floor_on_the_kept_rest_k_matches_the_whole_reassembly(void **state)
 {
     (void)state;
@@ -159,6 +164,10 @@ static void linear_floor_on_the_kept_rest_k_matches_the_whole_reassembly(void **
         const uint64_t h = scripted_run(RUN_FEM, w, &ranges);
         assert_true(h == serial);
     }
+    /* restoring the floor's ranges only is restoring the whole rest K */
+    g_full_restore = 1;
+    assert_true(scripted_run(RUN_FEM, 2u, &ranges) == serial);
+    g_full_restore = 0;
     g_whole_matrix = 1;
     (void)scripted_run(RUN_FEM, 0u, &ranges);
     g_whole_matrix = 0;
