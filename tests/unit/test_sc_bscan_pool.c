@@ -258,6 +258,9 @@ static void assert_same_run(const sc_bscan_def *def, const run_rec *a, const run
 static void compare_pools(const sc_bscan_def *def, const sc_xform *poses, uint32_t npose,
                           int with_hook)
 {
+    print_message("%ux%u, mapper %u, hook %d, acoustics %u\n", (unsigned)def->scan.lines_n,
+                  (unsigned)def->scan.samples_n, (unsigned)def->mapper, with_hook,
+                  (unsigned)def->acoustics);
     run_scene(def, poses, npose, with_hook, NULL, &g_ref);
     for (uint32_t f = 0; f < FRAMES; f++) {
         assert_int_equal(g_ref.order_errors[f], 0);
@@ -270,6 +273,7 @@ static void compare_pools(const sc_bscan_def *def, const sc_xform *poses, uint32
         sc_hs_pool_init(&hp, w, &dev);
         run_scene(def, poses, npose, with_hook, &dev, &g_run);
         assert_same_run(def, &g_ref, &g_run);
+        print_message("  host pool, %u worker(s): the serial record\n", (unsigned)w);
         /* more than one worker: the lines went through the pool (one job per frame at least) */
         assert_true(w == 1u || hp.jobs >= FRAMES);
     }
@@ -281,6 +285,7 @@ static void compare_pools(const sc_bscan_def *def, const sc_xform *poses, uint32
     sc_pool_linux_stop(&lp);
     assert_same_run(def, &g_ref, &g_run);
     assert_true(jobs >= FRAMES);
+    print_message("  2 threads: the serial record\n");
 }
 
 static void dented_mesh_straight_and_tilted_give_the_serial_image_on_every_pool(void **state)
