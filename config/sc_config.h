@@ -182,6 +182,22 @@ _Static_assert((1u << SC_SPRINGS_HASH_BITS) >= 2u * SC_MAX_SPRINGS,
 #ifndef SC_BSCAN_MAX_WALK_STEPS
 #define SC_BSCAN_MAX_WALK_STEPS 4096u
 #endif
+/* The B-scan's lines on the worker pool (sc_bscan_set_pool): ranges of lines with their own
+ * scratch (1: no pool path, the MCU's setting). Per range: the runs of its lines kept for the
+ * line hook until they leave in order (SC_BSCAN_RANGE_RUNS, 28 B each; a range that would
+ * overflow them hands its remaining lines to the caller) and the walker's active boundary
+ * segments (SC_BSCAN_RANGE_ACTIVE, 4 B each; the same). With more than one range the frame's
+ * displayed samples and labels are kept too (2 x SC_MAX_SCAN_LINES x SC_MAX_SCAN_SAMPLES B).
+ * Host default: 8 ranges, about 1.5 MB in all. */
+#ifndef SC_BSCAN_RANGES
+#define SC_BSCAN_RANGES 8u
+#endif
+#ifndef SC_BSCAN_RANGE_RUNS
+#define SC_BSCAN_RANGE_RUNS 4096u
+#endif
+#ifndef SC_BSCAN_RANGE_ACTIVE
+#define SC_BSCAN_RANGE_ACTIVE 1024u
+#endif
 
 /* ---- runtime configuration file (sc_rtcfg) ----------------------------------------------- */
 /* Longest line of the configuration file, and longest path or host value, in bytes. */
@@ -263,6 +279,10 @@ _Static_assert(SC_MAX_SCAN_LINES >= 2u && SC_MAX_SCAN_LINES <= 65535u &&
                "scan lines and samples travel as 16-bit numbers");
 _Static_assert(SC_BSCAN_TGC_BANDS >= 1u, "at least one TGC band");
 _Static_assert(SC_BSCAN_MAX_LINE_EVENTS >= 2u, "a scan line needs an entry and an exit event");
+_Static_assert(SC_BSCAN_RANGES >= 1u && SC_BSCAN_RANGES <= SC_MAX_SCAN_LINES,
+               "SC_BSCAN_RANGES: 1 .. SC_MAX_SCAN_LINES");
+_Static_assert(SC_BSCAN_RANGE_RUNS >= SC_MAX_SCAN_SAMPLES && SC_BSCAN_RANGE_RUNS <= 65535u,
+               "a range holds at least one line's runs; run offsets are 16-bit");
 
 _Static_assert(SC_RTCFG_PATH_MAX >= 16u && SC_RTCFG_PATH_MAX < SC_RTCFG_LINE_MAX,
                "a configuration path must fit a configuration line");

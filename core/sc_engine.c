@@ -750,6 +750,7 @@ static int build_begin(sc_engine *e, uint32_t slot)
         sc_tissue_build_begin(&e->tissue[slot], &td, &c->volume, &mat, (uint8_t)SC_LABEL_FAT);
     if (rc == SC_OK) {
         sc_tissue_set_pool(&e->tissue[slot], &e->hal->pool);
+        sc_bscan_set_pool(&e->bscan, &e->hal->pool); /* its lines in ranges on the same pool */
     }
     return rc;
 }

@@ -164,6 +164,8 @@ int sc_bscan_init(sc_bscan *b, const sc_bscan_def *def)
     memset(&b->status, 0, sizeof b->status);
     b->line_hook = NULL;
     b->line_hook_ctx = NULL;
+    b->pool = NULL;
+    b->regions_last = 0u;
     return sc_bscan_set_def(b, def);
 }
 
@@ -223,6 +225,13 @@ int sc_bscan_attach_mesh(sc_bscan *b, const sc_mesh *mesh)
     return SC_OK;
 }
 
+void sc_bscan_set_pool(sc_bscan *b, const sc_pool_dev *pool)
+{
+    if (b != NULL) {
+        b->pool = pool;
+    }
+}
+
 void sc_bscan_set_line_hook(sc_bscan *b, sc_bscan_line_hook_fn fn, void *ctx)
 {
     if (b != NULL) {
@@ -251,6 +260,30 @@ typedef struct frame_ctx {
     float f0[3], fd[3];
 } frame_ctx;
 
+/* The scratch of the line in flight and the walker's state along a run of lines: the
+ * sc_bscan's own on the serial path (and for a range the caller finishes), a range's own on the
+ * pool path (sc_bscan_set_pool). Everything a line writes goes through it; the sc_bscan is then
+ * read only, except by a serial one (the region bins built on first need, a plane tet's maps
+ * on its first test). */
+typedef struct line_w {
+    sc_bscan *b;
+    sc_bscan_run *runs; /* this line's runs, run_count of them */
+    uint32_t run_count;
+    uint8_t *label; /* this line's labels: deformed (what the hook sees) */
+    uint8_t *rest;  /* the rest labels for the counts: label itself (serial) or a copy */
+    uint8_t *out;   /* this line's displayed samples */
+    uint32_t (*pos_h)[SC_MAX_SCAN_SAMPLES + 8u];
+    sc_bscan_event *events;
+    uint32_t *active; /* the walker's boundary segments that reach the current line */
+    uint32_t active_n, active_cap;
+    sc_bscan_tcache *tcache; /* the walker's tet cache (a power-of-two slice) */
+    uint32_t tmask;
+    sc_bscan_counts *cnt;
+    uint32_t *regions_need; /* set when a line wanted the region bins */
+    int serial; /* nothing else runs: may build the region bins, call the hook, the speckle pass */
+    int stop;   /* a range's line needs what only a serial one may do: handed to the caller */
+} line_w;
+
 /* mm (volume frame) -> voxel-index units */
 static void to_vox(const frame_ctx *c, const float p_mm[3], float out[3])
 {
@@ -274,13 +307,13 @@ static uint32_t first_k(float s, uint32_t n)
 
 /* A run of samples [k0, k1) inside the mesh whose sampling position (voxel units) is
  * a + k b. Mappers emit runs in increasing k, without overlap. */
-static inline void emit_run(sc_bscan *b, uint32_t k0, uint32_t k1, const float a[3],
+static inline void emit_run(line_w *w, uint32_t k0, uint32_t k1, const float a[3],
                             const float bb[3])
 {
     /* runs are disjoint and increasing: at most one per sample */
-    SC_VALIDATE(k0 < k1 && k1 <= SC_MAX_SCAN_SAMPLES && b->run_count < SC_MAX_SCAN_SAMPLES);
-    SC_VALIDATE(b->run_count == 0u || b->runs[b->run_count - 1u].k1 <= k0);
-    sc_bscan_run *r = &b->runs[b->run_count++];
+    SC_VALIDATE(k0 < k1 && k1 <= SC_MAX_SCAN_SAMPLES && w->run_count < SC_MAX_SCAN_SAMPLES);
+    SC_VALIDATE(w->run_count == 0u || w->runs[w->run_count - 1u].k1 <= k0);
+    sc_bscan_run *r = &w->runs[w->run_count++];
     r->k0 = (uint16_t)k0;
     r->k1 = (uint16_t)k1;
     for (uint32_t d = 0; d < 3u; d++) {
@@ -452,21 +485,34 @@ static void build_segments(sc_bscan *b, const sc_mesh *m)
     b->seg_start[0] = 0u;
 }
 
+/* a sorts before b: by s, entries first on ties, then by segment index (a total order) */
+static inline int event_before(const sc_bscan_event *a, const sc_bscan_event *b)
+{
+    return a->s < b->s ||
+           (!(a->s > b->s) && (a->entry > b->entry || (a->entry == b->entry && a->seg < b->seg)));
+}
+
 /* Crossings of line l (ray O + s D in the image frame) with the active segments, sorted by s
  * (entries first on ties, then by segment index: deterministic). Returns the count. */
-static uint32_t line_events(sc_bscan *b, uint32_t l, uint32_t *active_n, const frame_ctx *c)
+static uint32_t line_events(line_w *w, uint32_t l, const frame_ctx *c)
 {
-    uint32_t na = *active_n;
+    const sc_bscan *b = w->b;
+    uint32_t na = w->active_n;
+    if (na + (b->seg_start[l + 1u] - b->seg_start[l]) > w->active_cap) {
+        w->stop = 1; /* a range's active list is full (a serial one holds every segment) */
+        return 0u;
+    }
     for (uint32_t i = b->seg_start[l]; i < b->seg_start[l + 1u]; i++) {
-        b->active[na++] = b->seg_sorted[i];
+        w->active[na++] = b->seg_sorted[i];
     }
     const float dd = c->dx * c->dx + c->dz * c->dz;
     uint32_t ne = 0;
+    int overflow = 0;
     for (uint32_t i = 0; i < na;) {
-        const uint32_t si = b->active[i];
+        const uint32_t si = w->active[i];
         const sc_bscan_seg *s = &b->segs[si];
         if (s->line_hi < (int32_t)l) {
-            b->active[i] = b->active[--na];
+            w->active[i] = w->active[--na];
             continue;
         }
         i++;
@@ -479,40 +525,66 @@ static uint32_t line_events(sc_bscan *b, uint32_t l, uint32_t *active_n, const f
         const float qx = s->ax + t * (s->bx - s->ax) - c->ox;
         const float qz = s->az + t * (s->bz - s->az) - c->oz;
         const float sp = (qx * c->dx + qz * c->dz) / dd;
-        if (sp < b->geom.s_min) {
+        if (!(sp >= b->geom.s_min)) { /* (a NaN too: the order below is then total) */
             continue;
-        }
-        if (ne >= SC_BSCAN_MAX_LINE_EVENTS) {
-            b->status.event_overflows++;
-            break;
         }
         sc_bscan_event ev = {
             .s = sp, .seg = si, .entry = (uint8_t)(s->nx * c->dx + s->nz * c->dz < 0.0f)};
+        if (ne >= SC_BSCAN_MAX_LINE_EVENTS) {
+            /* over the limit: the first SC_BSCAN_MAX_LINE_EVENTS in the order below are kept
+             * (whatever the order of the active list: a range of lines rebuilds it) */
+            overflow = 1;
+            if (!event_before(&ev, &w->events[ne - 1u])) {
+                continue;
+            }
+            ne--;
+        }
         /* insertion sort: lists are short (2..8 typically) */
         uint32_t j = ne++;
         while (j > 0u) {
-            const sc_bscan_event *p = &b->events[j - 1u];
-            const int after =
-                p->s < ev.s || (!(p->s > ev.s) &&
-                                (p->entry > ev.entry || (p->entry == ev.entry && p->seg < ev.seg)));
-            if (after) {
+            const sc_bscan_event *p = &w->events[j - 1u];
+            if (event_before(p, &ev)) {
                 break;
             }
-            b->events[j] = *p;
+            w->events[j] = *p;
             j--;
         }
-        b->events[j] = ev;
+        w->events[j] = ev;
     }
-    *active_n = na;
+    if (overflow) {
+        w->cnt->event_overflows++;
+    }
+    w->active_n = na;
     return ne;
+}
+
+/* The active list of line l before its own segments are added: the segments that start
+ * before l and reach it (as a run of lines from line 0 leaves it, in another order: the events
+ * do not depend on it). Returns 0 when they do not fit (a range's list). O(segments). */
+static int active_at(line_w *w, uint32_t l)
+{
+    const sc_bscan *b = w->b;
+    uint32_t na = 0;
+    for (uint32_t i = 0; i < b->seg_start[l]; i++) {
+        const uint32_t si = b->seg_sorted[i];
+        if (b->segs[si].line_hi >= (int32_t)l) {
+            if (na >= w->active_cap) {
+                return 0;
+            }
+            w->active[na++] = si;
+        }
+    }
+    w->active_n = na;
+    return 1;
 }
 
 /* The plane-affine maps of tet t for this frame, from a direct-mapped cache (adjacent scan
  * lines cross the same tets). Hit or miss, the values are the same: computed by one function
  * from the same inputs. */
-static const sc_bscan_tcache *tet_cached(sc_bscan *b, const sc_mesh *m, uint32_t t)
+static const sc_bscan_tcache *tet_cached(line_w *w, const sc_mesh *m, uint32_t t)
 {
-    sc_bscan_tcache *tc = &b->tcache[t & (SC_BSCAN_TET_CACHE - 1u)];
+    const sc_bscan *b = w->b;
+    sc_bscan_tcache *tc = &w->tcache[t & w->tmask];
     if (tc->epoch == b->epoch && tc->tet == t) {
         return tc;
     }
@@ -543,9 +615,9 @@ static const sc_bscan_tcache *tet_cached(sc_bscan *b, const sc_mesh *m, uint32_t
 }
 
 static int build_regions(sc_bscan *b, const sc_mesh *m);
-static void map_line_regions(sc_bscan *b, const sc_mesh *m, uint32_t l, const frame_ctx *c);
+static void map_line_regions(line_w *w, const sc_mesh *m, uint32_t l, const frame_ctx *c);
 static int32_t locate_deepest(sc_bscan *b, const sc_mesh *m, uint32_t r, float x, float z);
-static void fill_run(sc_bscan *b, const frame_ctx *c, uint32_t ta, uint32_t a, uint32_t z);
+static void fill_run(line_w *w, const frame_ctx *c, uint32_t ta, uint32_t a, uint32_t z);
 static uint32_t region_of_line(uint32_t l, uint32_t lines, uint32_t regions);
 
 /* Where the walk cannot go on through face neighbours (a fold: an inverted or flat tet next),
@@ -556,13 +628,28 @@ static uint32_t region_of_line(uint32_t l, uint32_t lines, uint32_t regions);
  * -1 when the region bins are over their limits (the caller falls back). fill_first: the first
  * sample is filled from the tet found whatever its orientation (a walk that relocated at this
  * sample and could not move on: no loop). O(samples located x tets of the line's region). */
-static int relocate(sc_bscan *b, const sc_mesh *m, const frame_ctx *c, uint32_t ks, uint32_t *k,
-                    int fill_first, uint32_t *t_out, float *s_out)
+/* The region bins for a line that wants them: built on first need by a serial run of lines;
+ * a range on the pool cannot build them (other ranges read them): it stops (w->stop) and the
+ * caller does this line and the rest of the range. Returns 1 when they are usable. */
+static int regions_ready(line_w *w, const sc_mesh *m)
 {
+    sc_bscan *b = w->b;
+    *w->regions_need = 1u;
     if (b->regions_state == 0u) {
+        if (!w->serial) {
+            w->stop = 1;
+            return 0;
+        }
         b->regions_state = build_regions(b, m) ? 1u : 2u;
     }
-    if (b->regions_state != 1u) {
+    return b->regions_state == 1u;
+}
+
+static int relocate(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t ks, uint32_t *k,
+                    int fill_first, uint32_t *t_out, float *s_out)
+{
+    sc_bscan *b = w->b;
+    if (!regions_ready(w, m)) {
         return -1;
     }
     const uint32_t r = region_of_line(c->line, b->def.scan.lines_n, b->def.regions_n);
@@ -579,7 +666,7 @@ static int relocate(sc_bscan *b, const sc_mesh *m, const frame_ctx *c, uint32_t 
             *s_out = (float)kk;
             return 1;
         }
-        fill_run(b, c, (uint32_t)pi, kk, kk);
+        fill_run(w, c, (uint32_t)pi, kk, kk);
         *k = kk + 1u;
         fill_first = 0;
     }
@@ -590,25 +677,25 @@ static int relocate(sc_bscan *b, const sc_mesh *m, const frame_ctx *c, uint32_t 
 /* Walk the current line from tet t, entered through local face f_in (4: none) at line
  * parameter s_in, writing the rest positions of the samples from *k on. Returns the parameter
  * where the walk left the mesh (or >= n when it reached the end of the line). */
-static float walk(sc_bscan *b, const sc_mesh *m, const frame_ctx *c, uint32_t t, uint32_t f_in,
+static float walk(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t t, uint32_t f_in,
                   float s_in, uint32_t *k, uint32_t *steps, int *trouble)
 {
     const uint32_t n = c->n;
     uint32_t reloc_k = UINT32_MAX; /* the sample of the last relocation */
     for (;;) {
         if (*steps >= SC_BSCAN_MAX_WALK_STEPS) {
-            b->status.walk_aborts++;
+            w->cnt->walk_aborts++;
             *trouble = 1;
             return (float)n;
         }
         (*steps)++;
-        const sc_bscan_tcache *tc = tet_cached(b, m, t);
+        const sc_bscan_tcache *tc = tet_cached(w, m, t);
         if (!tc->ok) {
             /* flat or inverted: a fold; locate the samples from here on and walk on */
             uint32_t tn = 0;
             float sn = 0.0f;
             const uint32_t ks = first_k(s_in, n);
-            const int rr = relocate(b, m, c, ks, k, ks == reloc_k && *k <= ks, &tn, &sn);
+            const int rr = relocate(w, m, c, ks, k, ks == reloc_k && *k <= ks, &tn, &sn);
             if (rr < 0) {
                 *trouble = 1;
                 return (float)n;
@@ -616,7 +703,7 @@ static float walk(sc_bscan *b, const sc_mesh *m, const frame_ctx *c, uint32_t t,
             if (rr == 0) {
                 return sn;
             }
-            b->status.walk_relocations++;
+            w->cnt->walk_relocations++;
             reloc_k = (uint32_t)sn;
             t = tn;
             f_in = 4u;
@@ -657,7 +744,7 @@ static float walk(sc_bscan *b, const sc_mesh *m, const frame_ctx *c, uint32_t t,
                 vb[d] = (tc->rest[d][1] * c->dx + tc->rest[d][2] * c->dz) * c->inv_sp[d];
             }
             to_vox(c, ra, va);
-            emit_run(b, k0, k1, va, vb);
+            emit_run(w, k0, k1, va, vb);
             *k = k1;
         }
         if (s_out >= (float)n) {
@@ -680,13 +767,13 @@ static float walk(sc_bscan *b, const sc_mesh *m, const frame_ctx *c, uint32_t t,
     }
 }
 
-static void map_line_walk(sc_bscan *b, const sc_mesh *m, uint32_t l, uint32_t *active_n,
-                          const frame_ctx *c)
+static void map_line_walk(line_w *w, const sc_mesh *m, uint32_t l, const frame_ctx *c)
 {
-    const uint32_t ne = line_events(b, l, active_n, c);
+    sc_bscan *const b = w->b;
+    const uint32_t ne = line_events(w, l, c);
     uint32_t k = 0, steps = 0, ei = 0;
     int trouble = 0;
-    if (ne > 0u && !b->events[0].entry) {
+    if (ne > 0u && !w->events[0].entry) {
         /* the line starts inside the mesh (behind the face) or the boundary is folded: the
          * walk starts by locating the first pixel. Also when that exit lies behind the first
          * pixel: under a pressed face the skin's boundary triangles lie in the face's plane,
@@ -696,20 +783,20 @@ static void map_line_walk(sc_bscan *b, const sc_mesh *m, uint32_t l, uint32_t *a
         ei = 1u;
         uint32_t t0 = 0;
         float s0 = 0.0f;
-        const int rr = relocate(b, m, c, 0u, &k, 0, &t0, &s0);
+        const int rr = relocate(w, m, c, 0u, &k, 0, &t0, &s0);
         float sx = s0;
         if (rr < 0) {
             trouble = 1;
         } else if (rr > 0) {
-            b->status.walk_relocations++;
-            sx = walk(b, m, c, t0, 4u, s0, &k, &steps, &trouble);
+            w->cnt->walk_relocations++;
+            sx = walk(w, m, c, t0, 4u, s0, &k, &steps, &trouble);
         }
-        while (ei < ne && b->events[ei].s < sx - 1e-3f) {
+        while (ei < ne && w->events[ei].s < sx - 1e-3f) {
             ei++;
         }
     }
     while (!trouble && ei < ne && k < c->n) {
-        const sc_bscan_event *e = &b->events[ei++];
+        const sc_bscan_event *e = &w->events[ei++];
         if (!e->entry) {
             continue;
         }
@@ -717,25 +804,22 @@ static void map_line_walk(sc_bscan *b, const sc_mesh *m, uint32_t l, uint32_t *a
             break;
         }
         const sc_bscan_seg *s = &b->segs[e->seg];
-        const float sx = walk(b, m, c, s->tet, s->face, e->s, &k, &steps, &trouble);
+        const float sx = walk(w, m, c, s->tet, s->face, e->s, &k, &steps, &trouble);
         /* boundary crossings before the exit are behind us */
-        while (ei < ne && b->events[ei].s < sx - 1e-3f) {
+        while (ei < ne && w->events[ei].s < sx - 1e-3f) {
             ei++;
         }
     }
-    b->status.walk_steps += steps;
-    if (trouble) {
+    w->cnt->walk_steps += steps;
+    if (trouble && !w->stop) {
         /* inverted or flat tets, a folded boundary, a line starting inside the mesh: this
          * line goes through point location (the region path), which needs none of it */
-        if (b->regions_state == 0u) {
-            b->regions_state = build_regions(b, m) ? 1u : 2u;
-        }
-        if (b->regions_state == 1u) {
-            b->run_count = 0u;
-            map_line_regions(b, m, l, c);
-            b->status.line_fallbacks++;
-        } else {
-            b->status.region_overflows++;
+        if (regions_ready(w, m)) {
+            w->run_count = 0u;
+            map_line_regions(w, m, l, c);
+            w->cnt->line_fallbacks++;
+        } else if (!w->stop) {
+            w->cnt->region_overflows++;
         }
     }
 }
@@ -1006,8 +1090,9 @@ static int32_t locate_deepest(sc_bscan *b, const sc_mesh *m, uint32_t r, float x
 }
 
 /* Rest positions of samples a..z (all in ptet ta), interpolated linearly between the ends. */
-static void fill_run(sc_bscan *b, const frame_ctx *c, uint32_t ta, uint32_t a, uint32_t z)
+static void fill_run(line_w *w, const frame_ctx *c, uint32_t ta, uint32_t a, uint32_t z)
 {
+    sc_bscan *const b = w->b;
     const sc_bscan_ptet *p = &b->ptets[ta];
     float ra[3], rz[3], va[3], vz[3];
     const float xa = c->ox + (float)a * c->dx, za = c->oz + (float)a * c->dz;
@@ -1025,11 +1110,12 @@ static void fill_run(sc_bscan *b, const frame_ctx *c, uint32_t ta, uint32_t a, u
         vd[d] = (vz[d] - va[d]) * inv;
         v0[d] = va[d] - (float)a * vd[d];
     }
-    emit_run(b, a, z + 1u, v0, vd);
+    emit_run(w, a, z + 1u, v0, vd);
 }
 
-static void map_line_regions(sc_bscan *b, const sc_mesh *m, uint32_t l, const frame_ctx *c)
+static void map_line_regions(line_w *w, const sc_mesh *m, uint32_t l, const frame_ctx *c)
 {
+    sc_bscan *const b = w->b;
     const uint32_t r = region_of_line(l, b->def.scan.lines_n, b->def.regions_n);
     const float *bx = b->region_box[r];
     struct {
@@ -1048,15 +1134,15 @@ static void map_line_regions(sc_bscan *b, const sc_mesh *m, uint32_t l, const fr
         const uint32_t a = st[sp].a, z = st[sp].z;
         const int32_t ta = st[sp].ta, tz = st[sp].tz;
         if (ta >= 0 && ta == tz) {
-            fill_run(b, c, (uint32_t)ta, a, z);
+            fill_run(w, c, (uint32_t)ta, a, z);
             continue;
         }
         if (z <= a + 1u) {
             if (ta >= 0) {
-                fill_run(b, c, (uint32_t)ta, a, a);
+                fill_run(w, c, (uint32_t)ta, a, a);
             }
             if (tz >= 0 && z != a) {
-                fill_run(b, c, (uint32_t)tz, z, z);
+                fill_run(w, c, (uint32_t)tz, z, z);
             }
             continue;
         }
@@ -1094,13 +1180,14 @@ static void map_line_regions(sc_bscan *b, const sc_mesh *m, uint32_t l, const fr
 /* Per pixel, in the volume frame with the deformed nodes as given: every tet is tried; the one
  * whose smallest barycentric coordinate is largest wins. Independent of the image-frame
  * node copy and of the walker. O(samples * tets). */
-static void map_line_oracle(sc_bscan *b, const sc_mesh *m, const sc_nodes *nd, uint32_t l,
+static void map_line_oracle(line_w *w, const sc_mesh *m, const sc_nodes *nd, uint32_t l,
                             const frame_ctx *c)
 {
-    float img[3], w[3];
+    sc_bscan *const b = w->b;
+    float img[3], wp[3];
     for (uint32_t k = 0; k < c->n; k++) {
         sc_scan_geom_pixel(&b->geom, l, k, img);
-        sc_xform_apply(&c->img2vol, img, w);
+        sc_xform_apply(&c->img2vol, img, wp);
         int32_t best = -1;
         int best_pos = 0; /* a positively oriented tet before an inverted one (sc_bscan.h) */
         float best_min = -SC_BSCAN_LAMBDA_EPS, best_l[4] = {0.0f, 0.0f, 0.0f, 0.0f};
@@ -1116,7 +1203,7 @@ static void map_line_oracle(sc_bscan *b, const sc_mesh *m, const sc_nodes *nd, u
             for (uint32_t d = 0; d < 3u && !out; d++) {
                 const float lo = fminf(fminf(p[0][d], p[1][d]), fminf(p[2][d], p[3][d]));
                 const float hi = fmaxf(fmaxf(p[0][d], p[1][d]), fmaxf(p[2][d], p[3][d]));
-                out = w[d] < lo - 1e-3f || w[d] > hi + 1e-3f;
+                out = wp[d] < lo - 1e-3f || wp[d] > hi + 1e-3f;
             }
             if (out) {
                 continue;
@@ -1127,7 +1214,7 @@ static void map_line_oracle(sc_bscan *b, const sc_mesh *m, const sc_nodes *nd, u
                 e[0][d] = p[1][d] - p[0][d];
                 e[1][d] = p[2][d] - p[0][d];
                 e[2][d] = p[3][d] - p[0][d];
-                r[d] = w[d] - p[0][d];
+                r[d] = wp[d] - p[0][d];
             }
 #define SC_DET3_(a, bb, cc)                                                                        \
     ((a)[0] * ((bb)[1] * (cc)[2] - (bb)[2] * (cc)[1]) -                                            \
@@ -1167,20 +1254,13 @@ static void map_line_oracle(sc_bscan *b, const sc_mesh *m, const sc_nodes *nd, u
             }
             to_vox(c, rp, v);
             const float zero[3] = {0.0f, 0.0f, 0.0f};
-            emit_run(b, k, k + 1u, v, zero);
+            emit_run(w, k, k + 1u, v, zero);
         }
     }
 }
 
 /* ---- sampling, display processing, label areas -------------------------------------------- */
 
-typedef struct area_acc {
-    uint32_t now_n[SC_LABEL_COUNT], now_k[SC_LABEL_COUNT];
-    uint32_t rest_n[SC_LABEL_COUNT], rest_k[SC_LABEL_COUNT];
-    /* rest reference above the probe face (negative sample indices, every 4th sample) */
-    uint32_t margin_n[SC_LABEL_COUNT];
-    int32_t margin_k[SC_LABEL_COUNT];
-} area_acc;
 
 /* Samples of the rest reference above the face are taken every SC_BSCAN_MARGIN_STEP. */
 #define SC_BSCAN_MARGIN_STEP 4u
@@ -1369,14 +1449,15 @@ typedef enum span_mode { SPAN_ALL = 0, SPAN_WORDS = 1, SPAN_REST = 2 } span_mode
 /* Samples [k0, k1) at voxel positions a + k b, all inside the volume box (the ends are, and the
  * box is convex). The part clear of the half-voxel border (no clamping: an interval) goes to the
  * selected span kernel, the ends clamped sample by sample: the same values either way. */
-static void sample_span_inside(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1,
+static void sample_span_inside(line_w *w, const vol_ctx *vc, uint32_t k0, uint32_t k1,
                                const float a[3], const float bb[3], span_mode mode)
 {
+    sc_bscan *const b = w->b;
     const vol_regs vr = {vc->vox, vc->lab, vc->stride[1], vc->stride[2], vc->la};
     const int64_t *restrict lut = b->lut_b_fx;
     const int64_t xm0 = vc->xmax[0], xm1 = vc->xmax[1], xm2 = vc->xmax[2];
-    uint8_t *restrict out = b->line_out;
-    uint8_t *restrict lab = b->line_label;
+    uint8_t *restrict out = w->out;
+    uint8_t *restrict lab = w->label;
     int64_t X = to_fx32(a[0] + (float)k0 * bb[0]), Y = to_fx32(a[1] + (float)k0 * bb[1]),
             Z = to_fx32(a[2] + (float)k0 * bb[2]);
     const int64_t DX = to_fx32(bb[0]), DY = to_fx32(bb[1]), DZ = to_fx32(bb[2]);
@@ -1398,12 +1479,12 @@ static void sample_span_inside(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint
                 /* the selected variant writes up to 7 words past the clear part: the span's
                  * clamped samples after it need theirs 0 again (the next span writes its own) */
                 const uint32_t w1 = k0 + (uint32_t)jhi;
-                vc->words(b->pos_h[0], b->pos_h[1], b->pos_h[2], k0 + (uint32_t)jlo, w1, X, Y, Z,
+                vc->words(w->pos_h[0], w->pos_h[1], w->pos_h[2], k0 + (uint32_t)jlo, w1, X, Y, Z,
                           DX, DY, DZ);
                 for (uint32_t k = w1; k < k1 && k < w1 + 7u; k++) {
-                    b->pos_h[0][k] = 0u;
-                    b->pos_h[1][k] = 0u;
-                    b->pos_h[2][k] = 0u;
+                    w->pos_h[0][k] = 0u;
+                    w->pos_h[1][k] = 0u;
+                    w->pos_h[2][k] = 0u;
                 }
             }
             const int64_t m = jhi - jlo;
@@ -1433,9 +1514,10 @@ static int in_volume_k(const vol_ctx *vc, const float a[3], const float bb[3], u
 /* Samples [k0, k1) at voxel positions a + k b: the part inside the volume box (an interval: the
  * line is straight, the box convex; its ends found from the slab intersection and confirmed by
  * the per-sample test) in fixed point, the parts beyond it continued (beyond_sample). */
-static int sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1, const float a[3],
+static int sample_span(line_w *w, const vol_ctx *vc, uint32_t k0, uint32_t k1, const float a[3],
                        const float bb[3], span_mode mode)
 {
+    sc_bscan *const b = w->b;
     {
         /* the common case first (a mesh run is one tet's crossing, a few samples): both ends
          * clear of the half-voxel border, so every sample is, and the per-sample box test below
@@ -1452,11 +1534,11 @@ static int sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1,
             Z <= vc->xmax[2] && ze <= vc->xmax[2]) {
             const vol_regs vr = {vc->vox, vc->lab, vc->stride[1], vc->stride[2], vc->la};
             if (mode == SPAN_ALL) {
-                vc->span(vr, b->lut_b_fx, k0, k1, X, Y, Z, DX, DY, DZ, b->line_out,
-                         b->line_label);
+                vc->span(vr, b->lut_b_fx, k0, k1, X, Y, Z, DX, DY, DZ, w->out,
+                         w->label);
             } else if (mode == SPAN_WORDS) {
                 /* (may write up to 7 words past k1: the next span writes its own after) */
-                vc->words(b->pos_h[0], b->pos_h[1], b->pos_h[2], k0, k1, X, Y, Z, DX, DY, DZ);
+                vc->words(w->pos_h[0], w->pos_h[1], w->pos_h[2], k0, k1, X, Y, Z, DX, DY, DZ);
             }
             return 1;
         }
@@ -1466,9 +1548,9 @@ static int sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1,
          * does not give words (clamped ends, beyond the volume) read voxel 0 until SPAN_REST
          * redoes them (a clear span above writes all of its own words) */
         for (uint32_t k = k0; k < k1; k++) {
-            b->pos_h[0][k] = 0u;
-            b->pos_h[1][k] = 0u;
-            b->pos_h[2][k] = 0u;
+            w->pos_h[0][k] = 0u;
+            w->pos_h[1][k] = 0u;
+            w->pos_h[2][k] = 0u;
         }
     }
     /* the line parameter range inside the box, per axis: -1/2 <= a + k b < hi */
@@ -1509,14 +1591,14 @@ static int sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1,
     const vol_regs vr = {vc->vox, vc->lab, vc->stride[1], vc->stride[2], vc->la};
     for (uint32_t k = k0; k < k1; k++) {
         if (k == ka) {
-            sample_span_inside(b, vc, ka, kb, a, bb, mode);
+            sample_span_inside(w, vc, ka, kb, a, bb, mode);
             k = kb - 1u;
             continue;
         }
         const float p[3] = {a[0] + (float)k * bb[0], a[1] + (float)k * bb[1],
                             a[2] + (float)k * bb[2]};
         if (mode != SPAN_WORDS) {
-            beyond_sample(vc, vr, b->lut_b_fx, k, p, b->line_out, b->line_label);
+            beyond_sample(vc, vr, b->lut_b_fx, k, p, w->out, w->label);
         }
     }
     return 0;
@@ -1525,9 +1607,9 @@ static int sample_span(sc_bscan *b, const vol_ctx *vc, uint32_t k0, uint32_t k1,
 /* The labels of the rigid slice (the compression measure's rest reference) at the samples of the
  * mesh runs, in place of their deformed labels. Every loop-invariant in a local: the label
  * stores (uint8_t) may alias anything, so the compiler would reload them after each store. */
-static void rest_labels(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, const frame_ctx *c)
+static void rest_labels(line_w *w, const vol_ctx *vc, const sc_volume *v, const frame_ctx *c)
 {
-    uint8_t *restrict out = b->line_label;
+    uint8_t *restrict out = w->rest;
     const uint8_t *restrict lab = vc->lab;
     const size_t sy = vc->stride[1], sz = vc->stride[2];
     const float f0[3] = {c->f0[0], c->f0[1], c->f0[2]}, fd[3] = {c->fd[0], c->fd[1], c->fd[2]};
@@ -1535,8 +1617,8 @@ static void rest_labels(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
     const int64_t DX = to_fx32(fd[0]), DY = to_fx32(fd[1]), DZ = to_fx32(fd[2]);
     const int64_t lx = (int64_t)v->dim[0] - 1, ly = (int64_t)v->dim[1] - 1,
                   lz = (int64_t)v->dim[2] - 1;
-    const uint32_t runs = b->run_count;
-    const sc_bscan_run *restrict rs = b->runs;
+    const uint32_t runs = w->run_count;
+    const sc_bscan_run *restrict rs = w->runs;
     for (uint32_t i = 0; i < runs; i++) {
         /* a run is one tet crossed (about 13 samples) but the rest labels do not depend on the
          * tet: consecutive runs that touch are labelled as one, positions stepped from the
@@ -1590,15 +1672,16 @@ static void rest_labels(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
 }
 
 static int emit_line(sc_bscan *b, const sc_display_dev *disp, uint32_t frame_no, uint32_t l,
-                     int rc);
+                     const uint8_t *out, int rc);
 
 #if SC_BSCAN_PSF
 /* The speckle pass's input (sc_psf.h): the line's rest positions, span by span, and its grey. */
-static void psf_line_in(sc_bscan *b, const frame_ctx *c)
+static void psf_line_in(line_w *w, const frame_ctx *c)
 {
+    sc_bscan *const b = w->b;
     uint32_t k = 0;
-    for (uint32_t i = 0; i < b->run_count; i++) {
-        const sc_bscan_run *r = &b->runs[i];
+    for (uint32_t i = 0; i < w->run_count; i++) {
+        const sc_bscan_run *r = &w->runs[i];
         if (k < r->k0) {
             sc_psf_span(&b->psf, k, r->k0, c->f0, c->fd);
         }
@@ -1606,7 +1689,7 @@ static void psf_line_in(sc_bscan *b, const frame_ctx *c)
         k = r->k1;
     }
     sc_psf_span(&b->psf, k, c->n, c->f0, c->fd);
-    sc_psf_line_in(&b->psf, c->line, b->line_out);
+    sc_psf_line_in(&b->psf, c->line, w->out);
 }
 
 /* After line l: hand the hook's drawing over, emit the lines whose neighbours are all in. */
@@ -1617,7 +1700,7 @@ static int psf_emit(sc_bscan *b, const sc_display_dev *disp, uint32_t frame_no, 
     int32_t m;
     while ((m = sc_psf_line_ready(&b->psf, l, *next_out)) >= 0) {
         sc_psf_line_out(&b->psf, (uint32_t)m, b->line_out);
-        rc = emit_line(b, disp, frame_no, (uint32_t)m, rc);
+        rc = emit_line(b, disp, frame_no, (uint32_t)m, b->line_out, rc);
         (*next_out)++;
     }
     return rc;
@@ -1625,9 +1708,10 @@ static int psf_emit(sc_bscan *b, const sc_display_dev *disp, uint32_t frame_no, 
 #endif
 
 /* The whole line: mesh runs at their rest positions, the gaps rigid; then label areas. */
-static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, const frame_ctx *c,
-                        area_acc *acc, int margin_known)
+static void sample_line(line_w *w, const vol_ctx *vc, const sc_volume *v, const frame_ctx *c,
+                        sc_bscan_area_acc *acc, int margin_known)
 {
+    sc_bscan *const b = w->b;
     const uint32_t n = c->n;
     /* the position words of every span's part clear of the volume's border (nearly every
      * sample), one call of the line sampler for them all, then the rest of the spans (clamped
@@ -1636,70 +1720,74 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
     /* spans in line order: the rigid gap before run i is span 2 i, run i span 2 i + 1, the
      * gap after the last run span 2 run_count; those between first and last need the rest */
     uint32_t k = 0, first = UINT32_MAX, last = 0;
-    for (uint32_t i = 0; i < b->run_count; i++) {
-        const sc_bscan_run *r = &b->runs[i];
-        if (k < r->k0 && !sample_span(b, vc, k, r->k0, c->f0, c->fd, SPAN_WORDS)) {
+    for (uint32_t i = 0; i < w->run_count; i++) {
+        const sc_bscan_run *r = &w->runs[i];
+        if (k < r->k0 && !sample_span(w, vc, k, r->k0, c->f0, c->fd, SPAN_WORDS)) {
             first = first < 2u * i ? first : 2u * i;
             last = 2u * i;
         }
-        if (!sample_span(b, vc, r->k0, r->k1, r->a, r->b, SPAN_WORDS)) {
+        if (!sample_span(w, vc, r->k0, r->k1, r->a, r->b, SPAN_WORDS)) {
             first = first < 2u * i + 1u ? first : 2u * i + 1u;
             last = 2u * i + 1u;
         }
         k = r->k1;
     }
-    if (k < n && !sample_span(b, vc, k, n, c->f0, c->fd, SPAN_WORDS)) {
-        first = first < 2u * b->run_count ? first : 2u * b->run_count;
-        last = 2u * b->run_count;
+    if (k < n && !sample_span(w, vc, k, n, c->f0, c->fd, SPAN_WORDS)) {
+        first = first < 2u * w->run_count ? first : 2u * w->run_count;
+        last = 2u * w->run_count;
     }
     {
         const vol_regs vr = {vc->vox, vc->lab, vc->stride[1], vc->stride[2], vc->la};
-        vc->line(vr, b->lut_b_fx, n, b->pos_h[0], b->pos_h[1], b->pos_h[2], b->line_out,
-                 b->line_label);
+        vc->line(vr, b->lut_b_fx, n, w->pos_h[0], w->pos_h[1], w->pos_h[2], w->out,
+                 w->label);
     }
     if (first != UINT32_MAX) {
         const uint32_t i0 = first / 2u;
-        k = i0 > 0u ? b->runs[i0 - 1u].k1 : 0u;
-        for (uint32_t i = i0; i < b->run_count && 2u * i <= last; i++) {
-            const sc_bscan_run *r = &b->runs[i];
+        k = i0 > 0u ? w->runs[i0 - 1u].k1 : 0u;
+        for (uint32_t i = i0; i < w->run_count && 2u * i <= last; i++) {
+            const sc_bscan_run *r = &w->runs[i];
             if (k < r->k0 && 2u * i >= first) {
-                (void)sample_span(b, vc, k, r->k0, c->f0, c->fd, SPAN_REST);
+                (void)sample_span(w, vc, k, r->k0, c->f0, c->fd, SPAN_REST);
             }
             if (2u * i + 1u >= first && 2u * i + 1u <= last) {
-                (void)sample_span(b, vc, r->k0, r->k1, r->a, r->b, SPAN_REST);
+                (void)sample_span(w, vc, r->k0, r->k1, r->a, r->b, SPAN_REST);
             }
             k = r->k1;
         }
-        if (k < n && last == 2u * b->run_count) {
-            (void)sample_span(b, vc, k, n, c->f0, c->fd, SPAN_REST);
+        if (k < n && last == 2u * w->run_count) {
+            (void)sample_span(w, vc, k, n, c->f0, c->fd, SPAN_REST);
         }
     }
     if (b->def.acoustics != 0u) {
         /* along the beam as it runs now: the labels are this frame's (deformed) ones */
-        sc_acoustics_line_k(&b->acou, b->line_label, b->line_out, n, vc->acou_run);
+        sc_acoustics_line_k(&b->acou, w->label, w->out, n, vc->acou_run);
     }
 #if SC_BSCAN_PSF
     if (b->def.psf != 0u) {
-        psf_line_in(b, c);
+        SC_ASSERT(w->serial); /* the pool path is not taken with it */
+        psf_line_in(w, c);
     }
 #endif
-    if (b->line_hook != NULL) {
+    if (b->line_hook != NULL && w->serial) { /* the pool path calls it as the line leaves */
         /* the labels are still this frame's (deformed) ones here */
         const sc_bscan_line_view lv = {
             .line = c->line, .lines_n = b->def.scan.lines_n, .samples_n = n,
-            .labels = b->line_label, .runs = b->runs, .run_count = b->run_count,
+            .labels = w->label, .runs = w->runs, .run_count = w->run_count,
             .f0 = {c->f0[0], c->f0[1], c->f0[2]}, .fd = {c->fd[0], c->fd[1], c->fd[2]},
-            .org_x = c->ox, .org_z = c->oz, .dir_x = c->dx, .dir_z = c->dz, .out = b->line_out,
+            .org_x = c->ox, .org_z = c->oz, .dir_x = c->dx, .dir_z = c->dz, .out = w->out,
             .img2vol = &c->img2vol};
         b->line_hook(b->line_hook_ctx, &lv);
     }
     if (vc->lab == NULL) {
         return;
     }
-    count_labels(b->line_label, n, acc->now_n, acc->now_k);
+    count_labels(w->label, n, acc->now_n, acc->now_k);
     /* rest areas: the rigid slice's labels; outside the mesh identical to the above */
-    rest_labels(b, vc, v, c);
-    count_labels(b->line_label, n, acc->rest_n, acc->rest_k);
+    if (w->rest != w->label) {
+        memcpy(w->rest, w->label, n); /* the deformed labels stay for the hook (pool path) */
+    }
+    rest_labels(w, vc, v, c);
+    count_labels(w->rest, n, acc->rest_n, acc->rest_k);
     /* the rest reference continues above the face by the margin: tissue the probe has pushed
      * into the image was there at rest (every 4th sample, each counting for 4) */
     /* blocks of 4 samples above the face, -(4i + 1) .. -(4i + 4), each sampled at -(4i + 2);
@@ -1754,6 +1842,292 @@ static void sample_line(sc_bscan *b, const vol_ctx *vc, const sc_volume *v, cons
     }
 }
 
+/* ---- lines: one after the other, or in ranges on the worker pool ------------------------ */
+
+typedef struct frame_args {
+    sc_bscan *b;
+    const sc_mesh *mesh;
+    const sc_nodes *nodes;
+    const sc_volume *volume;
+    const vol_ctx *vc;
+    frame_ctx c; /* the frame's part */
+    uint32_t mapper;
+    int margin_known;
+    const sc_display_dev *display;
+    uint32_t frame_no;
+} frame_args;
+
+/* Line l's origin and direction, in the image frame and in voxel units, into c. */
+static void line_setup(const sc_bscan *b, frame_ctx *c, uint32_t l)
+{
+    c->line = l;
+    c->ox = b->geom.start_x_mm[l];
+    c->oz = b->geom.start_z_mm[l];
+    c->dx = b->geom.step_x_mm[l];
+    c->dz = b->geom.step_z_mm[l];
+    const float o_img[3] = {c->ox, 0.0f, c->oz}, d_img[3] = {c->dx, 0.0f, c->dz};
+    float w0[3], wd[3];
+    sc_xform_apply(&c->img2vol, o_img, w0);
+    sc_xform_rotate(&c->img2vol, d_img, wd);
+    to_vox(c, w0, c->f0);
+    for (uint32_t d = 0; d < 3u; d++) {
+        c->fd[d] = wd[d] * c->inv_sp[d];
+    }
+}
+
+/* The mesh runs of line l (none without a mesh). */
+static void map_line(line_w *w, const frame_args *fa, uint32_t l, const frame_ctx *c)
+{
+    w->run_count = 0u;
+    if (fa->mesh == NULL) {
+        return;
+    }
+    switch (fa->mapper) {
+    case SC_BSCAN_MAP_WALK:
+        map_line_walk(w, fa->mesh, l, c);
+        break;
+    case SC_BSCAN_MAP_REGIONS:
+        map_line_regions(w, fa->mesh, l, c);
+        break;
+    case SC_BSCAN_MAP_ORACLE:
+        map_line_oracle(w, fa->mesh, fa->nodes, l, c);
+        break;
+    default:
+        SC_ASSERT(0);
+        break;
+    }
+    for (uint32_t i = 0; i < w->run_count; i++) {
+        w->cnt->pixels_in_mesh += (uint32_t)w->runs[i].k1 - w->runs[i].k0;
+    }
+}
+
+/* The sc_bscan's own scratch, for lines run on the caller alone. */
+static line_w serial_w(sc_bscan *b, sc_bscan_counts *cnt, uint32_t *regions_need)
+{
+    const line_w w = {.b = b,
+                      .runs = b->runs,
+                      .label = b->line_label,
+                      .rest = b->line_label,
+                      .out = b->line_out,
+                      .pos_h = b->pos_h,
+                      .events = b->events,
+                      .active = b->active,
+                      .active_cap = SC_BSCAN_MAX_HULL_FACES,
+                      .tcache = b->tcache,
+                      .tmask = SC_BSCAN_TET_CACHE - 1u,
+                      .cnt = cnt,
+                      .regions_need = regions_need,
+                      .serial = 1};
+    return w;
+}
+
+/* Lines [l0, l1) on the caller, each leaving as soon as it is computed. */
+static int lines_serial(line_w *w, const frame_args *fa, uint32_t l0, uint32_t l1,
+                        sc_bscan_area_acc *acc, int rc, uint32_t *psf_next)
+{
+    sc_bscan *b = fa->b;
+    frame_ctx c = fa->c;
+    (void)psf_next;
+    if (fa->mesh != NULL && fa->mapper == SC_BSCAN_MAP_WALK) {
+        (void)active_at(w, l0); /* every segment fits the sc_bscan's own list */
+    }
+    for (uint32_t l = l0; l < l1; l++) {
+        line_setup(b, &c, l);
+        map_line(w, fa, l, &c);
+        SC_ASSERT(!w->stop);
+        sample_line(w, fa->vc, fa->volume, &c, acc, fa->margin_known);
+#if SC_BSCAN_PSF
+        if (b->def.psf != 0u) {
+            rc = psf_emit(b, fa->display, fa->frame_no, l, psf_next, rc);
+            continue;
+        }
+#endif
+        rc = emit_line(b, fa->display, fa->frame_no, l, w->out, rc);
+    }
+    return rc;
+}
+
+#if SC_BSCAN_RANGES > 1
+/* The walker's tet cache slice of a range: SC_BSCAN_TET_CACHE / SC_BSCAN_RANGES entries,
+ * rounded down to a power of two (a hit or a miss gives the same values). */
+static uint32_t range_tcache_n(void)
+{
+    uint32_t n = 1u;
+    while (n * 2u <= SC_BSCAN_TET_CACHE / SC_BSCAN_RANGES) {
+        n *= 2u;
+    }
+    return n;
+}
+
+/* One range of lines on a worker: mapped and sampled into its own scratch, the displayed
+ * samples and labels into the frame's rows, the runs kept while a line hook needs them. A line
+ * that needs what only the caller may do (the region bins not built, the range's active list
+ * or runs full) stops the range there: done_to says how far it got, its counters are those of
+ * the lines before it. */
+static void range_job(void *arg, uint32_t r)
+{
+    const frame_args *fa = arg;
+    sc_bscan *b = fa->b;
+    sc_bscan_range *rg = &b->range[r];
+    const uint32_t n = fa->c.n, tn = range_tcache_n();
+    memset(&rg->counts, 0, sizeof rg->counts);
+    memset(&rg->acc, 0, sizeof rg->acc);
+    rg->regions_need = 0u;
+    rg->run_used = 0u;
+    rg->done_to = rg->l0;
+    rg->stopped = 0u;
+    line_w w = {.b = b,
+                .rest = rg->rest_label,
+                .pos_h = rg->pos_h,
+                .events = rg->events,
+                .active = rg->active,
+                .active_cap = SC_BSCAN_RANGE_ACTIVE,
+                .tcache = &b->tcache[r * tn],
+                .tmask = tn - 1u,
+                .cnt = &rg->counts,
+                .regions_need = &rg->regions_need,
+                .serial = 0};
+    if (fa->mesh != NULL && fa->mapper == SC_BSCAN_MAP_WALK && !active_at(&w, rg->l0)) {
+        rg->stopped = 1u;
+        return;
+    }
+    frame_ctx c = fa->c;
+    for (uint32_t l = rg->l0; l < rg->l1; l++) {
+        if (b->line_hook == NULL) {
+            rg->run_used = 0u; /* nobody reads a line's runs after it */
+        }
+        if (rg->run_used + n > SC_BSCAN_RANGE_RUNS) {
+            rg->stopped = 1u;
+            return;
+        }
+        w.runs = &rg->runs[rg->run_used];
+        w.out = &b->frame_out[(size_t)l * n];
+        w.label = &b->frame_label[(size_t)l * n];
+        const sc_bscan_counts before = rg->counts;
+        line_setup(b, &c, l);
+        map_line(&w, fa, l, &c);
+        if (w.stop) {
+            rg->counts = before;
+            rg->stopped = 1u;
+            return;
+        }
+        sample_line(&w, fa->vc, fa->volume, &c, &rg->acc, fa->margin_known);
+        b->line_run0[l] = (uint16_t)rg->run_used;
+        b->line_runs[l] = (uint16_t)w.run_count;
+        rg->run_used += w.run_count;
+        rg->done_to = l + 1u;
+    }
+}
+
+typedef struct ready_args {
+    sc_bscan *b;
+    const sc_mesh *mesh;
+} ready_args;
+
+#define SC_BSCAN_READY_SPAN 256u
+
+/* The maps of plane tets [256 r, 256 r + 256): computed up front for the ranges, which only
+ * read them (the same function of the same inputs as on first test). */
+static void ready_job(void *arg, uint32_t r)
+{
+    const ready_args *ra = arg;
+    sc_bscan *b = ra->b;
+    const uint32_t i1 = (r + 1u) * SC_BSCAN_READY_SPAN < b->ptet_count
+                            ? (r + 1u) * SC_BSCAN_READY_SPAN
+                            : b->ptet_count;
+    for (uint32_t i = r * SC_BSCAN_READY_SPAN; i < i1; i++) {
+        ptet_ready(b, ra->mesh, &b->ptets[i]);
+    }
+}
+
+/* A stored line leaves: the hook (in line order, as on the serial path) and the display. */
+static int emit_stored(const frame_args *fa, const sc_bscan_range *rg, uint32_t l, int rc)
+{
+    sc_bscan *b = fa->b;
+    const uint32_t n = fa->c.n;
+    uint8_t *out = &b->frame_out[(size_t)l * n];
+    if (b->line_hook != NULL) {
+        frame_ctx c = fa->c;
+        line_setup(b, &c, l);
+        const sc_bscan_line_view lv = {
+            .line = l, .lines_n = b->def.scan.lines_n, .samples_n = n,
+            .labels = &b->frame_label[(size_t)l * n], .runs = &rg->runs[b->line_run0[l]],
+            .run_count = b->line_runs[l],
+            .f0 = {c.f0[0], c.f0[1], c.f0[2]}, .fd = {c.fd[0], c.fd[1], c.fd[2]},
+            .org_x = c.ox, .org_z = c.oz, .dir_x = c.dx, .dir_z = c.dz, .out = out,
+            .img2vol = &fa->c.img2vol};
+        b->line_hook(b->line_hook_ctx, &lv);
+    }
+    return emit_line(b, fa->display, fa->frame_no, l, out, rc);
+}
+
+static void counts_add(sc_bscan_counts *t, const sc_bscan_counts *a)
+{
+    t->pixels_in_mesh += a->pixels_in_mesh;
+    t->walk_steps += a->walk_steps;
+    t->walk_aborts += a->walk_aborts;
+    t->event_overflows += a->event_overflows;
+    t->line_fallbacks += a->line_fallbacks;
+    t->walk_relocations += a->walk_relocations;
+    t->region_overflows += a->region_overflows;
+}
+
+static void acc_add(sc_bscan_area_acc *t, const sc_bscan_area_acc *a)
+{
+    for (uint32_t i = 0; i < SC_LABEL_COUNT; i++) {
+        t->now_n[i] += a->now_n[i];
+        t->now_k[i] += a->now_k[i];
+        t->rest_n[i] += a->rest_n[i];
+        t->rest_k[i] += a->rest_k[i];
+        t->margin_n[i] += a->margin_n[i];
+        t->margin_k[i] += a->margin_k[i];
+    }
+}
+
+/* The frame's lines on the pool: ranges fixed by the line count, run at the same time; then,
+ * in range order, each range's lines leave (hook, display) and a range that stopped is finished
+ * by the caller, line by line as on the serial path; the counters and label counts added in
+ * range order (integers). Lines leave once every range is done: the display sees them in order,
+ * later than on the serial path by up to the frame's sampling time. */
+static int lines_pool(const frame_args *fa, sc_bscan_area_acc *acc, sc_bscan_counts *cnt,
+                      uint32_t *regions_need, int rc)
+{
+    sc_bscan *b = fa->b;
+    const uint32_t lines = b->def.scan.lines_n;
+    const uint32_t nr = lines < SC_BSCAN_RANGES ? lines : SC_BSCAN_RANGES;
+    for (uint32_t r = 0; r < nr; r++) {
+        b->range[r].l0 = (uint32_t)(((uint64_t)r * lines) / nr);
+        b->range[r].l1 = (uint32_t)(((uint64_t)(r + 1u) * lines) / nr);
+    }
+    if (fa->mesh != NULL && fa->mapper == SC_BSCAN_MAP_WALK && b->regions_last != 0u &&
+        b->regions_state == 0u) {
+        /* the last frame's walker located across folds: this one likely does too, and a range
+         * cannot build the bins (the same bins whenever they are built) */
+        b->regions_state = build_regions(b, fa->mesh) ? 1u : 2u;
+    }
+    if (fa->mesh != NULL && b->regions_state == 1u) {
+        ready_args ra = {b, fa->mesh};
+        sc_pool_run(b->pool, ready_job, &ra,
+                    (b->ptet_count + SC_BSCAN_READY_SPAN - 1u) / SC_BSCAN_READY_SPAN);
+    }
+    sc_pool_run(b->pool, range_job, (void *)(uintptr_t)fa, nr);
+    for (uint32_t r = 0; r < nr; r++) {
+        sc_bscan_range *rg = &b->range[r];
+        for (uint32_t l = rg->l0; l < rg->done_to; l++) {
+            rc = emit_stored(fa, rg, l, rc);
+        }
+        if (rg->done_to < rg->l1) {
+            line_w w = serial_w(b, &rg->counts, &rg->regions_need);
+            rc = lines_serial(&w, fa, rg->done_to, rg->l1, &rg->acc, rc, NULL);
+        }
+        counts_add(cnt, &rg->counts);
+        acc_add(acc, &rg->acc);
+        *regions_need |= rg->regions_need;
+    }
+    return rc;
+}
+#endif
+
 /* ---- frame ------------------------------------------------------------------------------- */
 
 static int volume_ok(const sc_volume *v)
@@ -1770,10 +2144,11 @@ static int volume_ok(const sc_volume *v)
     return 1;
 }
 
-static int emit_line(sc_bscan *b, const sc_display_dev *disp, uint32_t frame_no, uint32_t l, int rc)
+static int emit_line(sc_bscan *b, const sc_display_dev *disp, uint32_t frame_no, uint32_t l,
+                     const uint8_t *out, int rc)
 {
     const int r =
-        sc_display_line(disp, frame_no, (uint16_t)l, b->line_out, (uint16_t)b->def.scan.samples_n);
+        sc_display_line(disp, frame_no, (uint16_t)l, out, (uint16_t)b->def.scan.samples_n);
     if (r != SC_OK) {
         b->status.display_errors++;
         return rc != SC_OK ? rc : r;
@@ -1849,7 +2224,7 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
     if (!contact) {
         memset(b->line_out, 0, n);
         for (uint32_t l = 0; l < lines; l++) {
-            rc = emit_line(b, display, frame_no, l, rc);
+            rc = emit_line(b, display, frame_no, l, b->line_out, rc);
         }
         st->areas_valid = 0u;
         for (uint32_t i = 0; i < SC_LABEL_COUNT; i++) {
@@ -1935,7 +2310,7 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
     vc.margin = sc_bscan_margin_selected();
     vc.sy32 = volume->dim[0];
     vc.sz32 = volume->dim[0] * volume->dim[1];
-    area_acc acc;
+    sc_bscan_area_acc acc;
     memset(&acc, 0, sizeof acc);
     sc_bscan_margin_memo *mm = &b->margin_memo;
     const int margin_known =
@@ -1944,57 +2319,42 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
         memcmp(mm->dim, volume->dim, sizeof mm->dim) == 0 &&
         memcmp(mm->origin_mm, volume->origin_mm, sizeof mm->origin_mm) == 0 &&
         memcmp(mm->spacing_mm, volume->spacing_mm, sizeof mm->spacing_mm) == 0;
-    uint32_t active_n = 0;
-    uint32_t psf_next = 0;
-    (void)psf_next;
-#if SC_BSCAN_PSF
-    if (b->def.psf != 0u) {
-        sc_psf_frame_begin(&b->psf, volume->spacing_mm);
-    }
+    const frame_args fa = {.b = b,
+                           .mesh = mesh,
+                           .nodes = nodes,
+                           .volume = volume,
+                           .vc = &vc,
+                           .c = c,
+                           .mapper = mapper,
+                           .margin_known = margin_known,
+                           .display = display,
+                           .frame_no = frame_no};
+    sc_bscan_counts cnt;
+    memset(&cnt, 0, sizeof cnt);
+    uint32_t regions_need = 0u;
+#if SC_BSCAN_RANGES > 1
+    if (b->pool != NULL && sc_pool_workers(b->pool) > 1u && b->def.psf == 0u) {
+        rc = lines_pool(&fa, &acc, &cnt, &regions_need, rc);
+    } else
 #endif
-    for (uint32_t l = 0; l < lines; l++) {
-        c.line = l;
-        c.ox = b->geom.start_x_mm[l];
-        c.oz = b->geom.start_z_mm[l];
-        c.dx = b->geom.step_x_mm[l];
-        c.dz = b->geom.step_z_mm[l];
-        const float o_img[3] = {c.ox, 0.0f, c.oz}, d_img[3] = {c.dx, 0.0f, c.dz};
-        float w0[3], wd[3];
-        sc_xform_apply(&c.img2vol, o_img, w0);
-        sc_xform_rotate(&c.img2vol, d_img, wd);
-        to_vox(&c, w0, c.f0);
-        for (uint32_t d = 0; d < 3u; d++) {
-            c.fd[d] = wd[d] * c.inv_sp[d];
-        }
-        b->run_count = 0u;
-        if (mesh != NULL) {
-            switch (mapper) {
-            case SC_BSCAN_MAP_WALK:
-                map_line_walk(b, mesh, l, &active_n, &c);
-                break;
-            case SC_BSCAN_MAP_REGIONS:
-                map_line_regions(b, mesh, l, &c);
-                break;
-            case SC_BSCAN_MAP_ORACLE:
-                map_line_oracle(b, mesh, nodes, l, &c);
-                break;
-            default:
-                SC_ASSERT(0);
-                break;
-            }
-            for (uint32_t i = 0; i < b->run_count; i++) {
-                st->pixels_in_mesh += (uint32_t)b->runs[i].k1 - b->runs[i].k0;
-            }
-        }
-        sample_line(b, &vc, volume, &c, &acc, margin_known);
+    {
+        uint32_t psf_next = 0;
 #if SC_BSCAN_PSF
         if (b->def.psf != 0u) {
-            rc = psf_emit(b, display, frame_no, l, &psf_next, rc);
-            continue;
+            sc_psf_frame_begin(&b->psf, volume->spacing_mm);
         }
 #endif
-        rc = emit_line(b, display, frame_no, l, rc);
+        line_w w = serial_w(b, &cnt, &regions_need);
+        rc = lines_serial(&w, &fa, 0u, lines, &acc, rc, &psf_next);
     }
+    b->regions_last = regions_need;
+    st->pixels_in_mesh = cnt.pixels_in_mesh;
+    st->walk_steps = cnt.walk_steps;
+    st->walk_aborts += cnt.walk_aborts;
+    st->event_overflows += cnt.event_overflows;
+    st->line_fallbacks += cnt.line_fallbacks;
+    st->walk_relocations += cnt.walk_relocations;
+    st->region_overflows += cnt.region_overflows;
     if (volume->labels != NULL) {
         if (margin_known) {
             memcpy(acc.margin_n, mm->n, sizeof acc.margin_n);

@@ -60,6 +60,7 @@
 #include "sc_acoustics.h"
 #include "sc_config.h"
 #include "sc_hal_display.h"
+#include "sc_hal_pool.h"
 #include "sc_labels.h"
 #include "sc_mesh.h"
 #include "sc_pose.h"
@@ -216,8 +217,47 @@ typedef struct sc_bscan_margin_memo {
     int32_t k[SC_LABEL_COUNT];
 } sc_bscan_margin_memo;
 
+/* Counters of one range of lines (the status's work counters), added to the status in range
+ * order after the frame's lines. */
+typedef struct sc_bscan_counts {
+    uint32_t pixels_in_mesh, walk_steps, walk_aborts, event_overflows, line_fallbacks,
+        walk_relocations, region_overflows;
+} sc_bscan_counts;
+
+/* Label counts of the compression measure (integers: their sums do not depend on the order). */
+typedef struct sc_bscan_area_acc {
+    uint32_t now_n[SC_LABEL_COUNT], now_k[SC_LABEL_COUNT];
+    uint32_t rest_n[SC_LABEL_COUNT], rest_k[SC_LABEL_COUNT];
+    /* rest reference above the probe face (negative sample indices, every 4th sample) */
+    uint32_t margin_n[SC_LABEL_COUNT];
+    int32_t margin_k[SC_LABEL_COUNT];
+} sc_bscan_area_acc;
+
+#if SC_BSCAN_RANGES > 1
+/* One range of a frame's lines on the worker pool (sc_bscan_set_pool): its own scratch, so that
+ * ranges run at the same time on different workers; the walker's tet cache is a slice of the
+ * shared one (SC_BSCAN_TET_CACHE / SC_BSCAN_RANGES entries each). About 6.6 KB plus
+ * SC_BSCAN_RANGE_RUNS x 28 B and SC_BSCAN_RANGE_ACTIVE x 4 B. */
+typedef struct sc_bscan_range {
+    uint32_t l0, l1;    /* lines [l0, l1) */
+    uint32_t done_to;   /* lines [l0, done_to) computed (their output stored) */
+    uint32_t stopped;   /* 1: the rest of the range needs the caller (see sc_bscan.c) */
+    uint32_t run_used;  /* runs of the stored lines (a line hook reads them at emission) */
+    uint32_t regions_need; /* a line of the range wanted the region bins */
+    sc_bscan_counts counts;
+    sc_bscan_area_acc acc;
+    uint32_t active_n;
+    uint32_t active[SC_BSCAN_RANGE_ACTIVE];
+    sc_bscan_event events[SC_BSCAN_MAX_LINE_EVENTS];
+    uint8_t rest_label[SC_MAX_SCAN_SAMPLES];
+    SC_ALIGN_HOT uint32_t pos_h[3][SC_MAX_SCAN_SAMPLES + 8u];
+    sc_bscan_run runs[SC_BSCAN_RANGE_RUNS];
+} sc_bscan_range;
+#endif
+
 typedef struct sc_bscan {
     sc_bscan_def def;
+    const sc_pool_dev *pool; /* NULL: lines one after the other on the caller */
     sc_bscan_line_hook_fn line_hook; /* NULL: none (sc_bscan_set_line_hook) */
     void *line_hook_ctx;
     sc_scan_geom geom;
@@ -266,6 +306,16 @@ typedef struct sc_bscan {
 #if SC_BSCAN_PSF
     sc_psf psf; /* speckle pass: kernels and the lines in flight */
 #endif
+    uint32_t regions_last; /* the last frame's walker built the region bins (pool path: built
+                              before the ranges run, as a range cannot build them) */
+#if SC_BSCAN_RANGES > 1
+    /* pool path: the ranges, and the frame's lines until they leave in order */
+    sc_bscan_range range[SC_BSCAN_RANGES];
+    uint16_t line_run0[SC_MAX_SCAN_LINES]; /* a stored line's first run in its range's runs */
+    uint16_t line_runs[SC_MAX_SCAN_LINES];
+    uint8_t frame_out[SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES];
+    uint8_t frame_label[SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES];
+#endif
     sc_bscan_status status;
 } sc_bscan;
 
@@ -310,6 +360,16 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
 /* Set (or clear with NULL) the per-line hook, e.g. colour Doppler (sc_doppler.h); kept across
  * sc_bscan_set_def, cleared by sc_bscan_init. O(1). Never fails (NULL b: nothing happens). */
 void sc_bscan_set_line_hook(sc_bscan *b, sc_bscan_line_hook_fn fn, void *ctx);
+
+/* Run the lines of the following frames on a worker pool (NULL: one after the other on the
+ * caller, as without a pool); kept across sc_bscan_set_def, cleared by sc_bscan_init. With a pool
+ * of more than one worker and SC_BSCAN_RANGES > 1 the lines are cut into ranges fixed by the line
+ * count alone (min(SC_BSCAN_RANGES, lines)), each mapped and sampled by one job with its own
+ * scratch, and leave through the display in line order (the line hook called there, in line
+ * order) once every range is done; the image and the status are bit-identical to the serial
+ * path's for every worker count. The speckle pass (def.psf) couples neighbouring lines: its
+ * frames stay serial. O(1). Never fails (NULL b: nothing happens). */
+void sc_bscan_set_pool(sc_bscan *b, const sc_pool_dev *pool);
 
 /* Status of the last frame (compression measure, work counters). O(1). */
 const sc_bscan_status *sc_bscan_status_get(const sc_bscan *b);

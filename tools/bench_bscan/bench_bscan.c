@@ -3,7 +3,7 @@
  * compression (a 10 mm dent of the generated scene); and PNGs of compression sweeps.
  *
  * Usage: bench_bscan [png_dir] [frames]     (defaults: bscan_png, 40)
- *        bench_bscan contact [cases_dir] [case] [frames] [msds|fem]
+ *        bench_bscan contact [cases_dir] [case] [frames] [msds|fem] [workers]
  *                    the engine's contact case (bench_contact.c): a host-simulated engine
  *                    presses a built case (default neck-ijv from the build's cases folder) and
  *                    the deformed mesh at the deepest point of the press script is imaged
@@ -344,6 +344,14 @@ int main(int argc, char **argv)
         const int method =
             argc > 5 ? (strcmp(argv[5], "fem") == 0 ? (int)SC_TISSUE_FEM : (int)SC_TISSUE_MSDS)
                      : -1;
+        if (argc > 6) {
+            const int w = atoi(argv[6]);
+            if (w < 1 || w > 16) {
+                fprintf(stderr, "bench_bscan: contact: workers 1..16, not %s\n", argv[6]);
+                return 2;
+            }
+            bench_contact_set_workers((uint32_t)w);
+        }
         return bench_contact_run(cases, name, method, n > 0 ? n : 40);
     }
     if (argc > 1 && strcmp(argv[1], "contact-walker") == 0) {

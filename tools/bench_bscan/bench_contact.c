@@ -13,7 +13,11 @@
  *    display calls (its frame_begin .. the end of its frame_end: the imaging stage; the rest:
  *    rx, physics, status, control, state stream); then the same frames again with the display
  *    a buffer instead of the host simulator's, which hashes every frame.
- * Thread CPU time throughout: the machine is shared.
+ * Thread CPU time throughout: the machine is shared. With workers > 1 (bench_contact_set_workers,
+ * `bench_bscan contact DIR CASE N METHOD WORKERS`) the engine's HAL gets a pool of that many
+ * threads (platform/linux/sc_pool_linux.h, not pinned) before the case loads, so the physics and
+ * the B-scan's lines run on it; with the argument given (1 too) every time is wall clock (a
+ * worker's CPU is not the frame thread's): read them on a quiet machine.
  */
 #define _POSIX_C_SOURCE 200809L
 #include "bench_contact.h"
@@ -26,16 +30,29 @@
 #include "sc_engine.h"
 #include "sc_err.h"
 #include "sc_hs_rig.h"
+#include "sc_pool_linux.h"
 #include "sc_storage_linux.h"
 #include "sc_trkemu.h"
 
 static sc_hs_rig g_rig; /* large: static */
 static sc_emu g_emu;
 
+static uint32_t g_workers = 1u;
+static int g_wall; /* the workers argument given: wall clock, whatever the count */
+static sc_pool_linux g_pool;
+
+void bench_contact_set_workers(uint32_t workers)
+{
+    g_wall = 1;
+    g_workers = workers < 1u ? 1u : (workers > SC_POOL_LINUX_MAX_WORKERS ? SC_POOL_LINUX_MAX_WORKERS
+                                                                          : workers);
+}
+
+/* thread CPU ms, or wall ms when the workers argument was given (1 too, to compare) */
 static double cpu_ms(void)
 {
     struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    clock_gettime(g_wall ? CLOCK_MONOTONIC : CLOCK_THREAD_CPUTIME_ID, &ts);
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
 }
 
@@ -148,6 +165,19 @@ int bench_contact_setup(const char *cases_dir, const char *case_name, int method
     if (rc != SC_OK) {
         fprintf(stderr, "bench_contact: engine init: %s\n", sc_err_str(rc));
         return rc;
+    }
+    if (g_workers > 1u) {
+        static int started;
+        static sc_pool_dev dev;
+        if (!started && sc_pool_linux_start(&g_pool, g_workers, -1, 200u, &dev) != 0) {
+            fprintf(stderr, "bench_contact: cannot start %u workers\n", (unsigned)g_workers);
+            return SC_ERR_STATE;
+        }
+        started = 1;
+        g_rig.hal.pool = dev; /* every setup: sc_hs_rig_init gives the rig its one-worker pool */
+    }
+    if (g_wall) {
+        printf("pool: %u worker(s) (times are wall clock)\n", (unsigned)g_workers);
     }
     static sc_storage_linux storage;
     sc_storage_linux_init(&storage, cases_dir);

@@ -15,6 +15,9 @@ const sc_display_dev *bench_contact_display(void);
 
 /* Print the contact table (imaging alone, walker and region path; whole frames of the hold).
  * Returns 0, or 1 when the case cannot be loaded. */
+/* Workers of the engine's pool (1: none, the default) for the following setups. */
+void bench_contact_set_workers(uint32_t workers);
+
 int bench_contact_run(const char *cases_dir, const char *case_name, int method, int frames);
 
 /* For instruction counts: the engine's walker imaging (the engine's settings) of the deepest
