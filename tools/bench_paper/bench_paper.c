@@ -47,6 +47,7 @@
 
 #include "bench_bullet.h"
 #include "bench_chart.h"
+#include "bench_pages.h"
 #include "bench_scene.h"
 #include "sc_bscan.h"
 #include "sc_collider.h"
@@ -675,6 +676,8 @@ int main(int argc, char **argv)
         return prc;
     }
     bench_select_kernels("bench-paper"); /* the engine's variant, as sonocomp selects it */
+    printf("pages: %s\n", bench_pages(&g_t, sizeof g_t));
+    (void)bench_pages(&g_bscan, sizeof g_bscan);
     if (mkparent(o.csv) != 0) {
         fprintf(stderr, "bench-paper: cannot create the folder of %s\n", o.csv);
         return 1;
