@@ -188,12 +188,15 @@ _Static_assert((1u << SC_SPRINGS_HASH_BITS) >= 2u * SC_MAX_SPRINGS,
  * overflow them hands its remaining lines to the caller) and the walker's active boundary
  * segments (SC_BSCAN_RANGE_ACTIVE, 4 B each; the same). With more than one range the frame's
  * displayed samples and labels are kept too (2 x SC_MAX_SCAN_LINES x SC_MAX_SCAN_SAMPLES B).
- * Host default: 8 ranges, about 1.5 MB in all. */
+ * The runs: with the engine's line hook on (colour Doppler, the needle) a range keeps every line's
+ * runs, up to one per sample: 32 lines of 512 samples (the default 256 lines in 8 ranges) need
+ * 16,384 (a range stops when its kept runs and one more line's worst case would not fit: with
+ * 4,096, past 3,584 kept runs). Host default: 8 ranges, about 4.3 MB in all. */
 #ifndef SC_BSCAN_RANGES
 #define SC_BSCAN_RANGES 8u
 #endif
 #ifndef SC_BSCAN_RANGE_RUNS
-#define SC_BSCAN_RANGE_RUNS 4096u
+#define SC_BSCAN_RANGE_RUNS 16384u
 #endif
 #ifndef SC_BSCAN_RANGE_ACTIVE
 #define SC_BSCAN_RANGE_ACTIVE 1024u
