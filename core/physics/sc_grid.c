@@ -499,17 +499,21 @@ void sc_grid_begin(sc_grid *g, const sc_mesh *m, const sc_nodes *n, float dt_s, 
     sc_pool_run(g->pool, job_start, &j, ranges);
 }
 
-/* sc_grid_clear on the pool: the used part of the rows cut into ranges of SC_GRID_POOL_RANGE
- * floats (zeros: any split gives the same bits; 60 rows of 262 KB each at 64x32x32 was a serial
- * 16 MB memset of the corotated step) */
-typedef struct clear_job {
+/* The matrix rows' passes on the pool (sc_grid_clear, and the rest K's copy to and from
+ * sc_grid.rest): the used part of the rows cut into ranges of SC_GRID_POOL_RANGE floats (each
+ * float its own: any split gives the same bits; 60 rows of 262 KB each at 64x32x32 was a
+ * serial 16 MB memset of the corotated step). which: SC_GRID_CLEAR_DIAG and/or
+ * SC_GRID_CLEAR_BLOCKS, or ROWS_SAVE / ROWS_LOAD (every row, to / from the rest copy). */
+#define ROWS_SAVE 4u
+#define ROWS_LOAD 8u
+typedef struct rows_job {
     sc_grid *g;
     uint32_t which, used;
-} clear_job;
+} rows_job;
 
-static void job_clear(void *arg, uint32_t r)
+static void job_rows(void *arg, uint32_t r)
 {
-    const clear_job *j = (const clear_job *)arg;
+    const rows_job *j = (const rows_job *)arg;
     sc_grid *g = j->g;
     const uint32_t a = r * SC_GRID_POOL_RANGE;
     const uint32_t b = a + SC_GRID_POOL_RANGE < j->used ? a + SC_GRID_POOL_RANGE : j->used;
@@ -525,47 +529,33 @@ static void job_clear(void *arg, uint32_t r)
             memset(&g->f[0][0][0] + (size_t)k * SC_GRID_ROW + a, 0, bytes);
         }
     }
-}
-
 #if SC_GRID_REST_COPY
-/* the matrix rows to (save) or from (load) the rest copy, ranges as job_clear's */
-typedef struct rest_job {
-    sc_grid *g;
-    uint32_t used;
-    int save;
-} rest_job;
-
-static void job_rest(void *arg, uint32_t r)
-{
-    const rest_job *j = (const rest_job *)arg;
-    sc_grid *g = j->g;
-    const uint32_t a = r * SC_GRID_POOL_RANGE;
-    const uint32_t b = a + SC_GRID_POOL_RANGE < j->used ? a + SC_GRID_POOL_RANGE : j->used;
-    const size_t bytes = (size_t)(b - a) * sizeof(float);
-    float *mat = &g->d[0][0];
-    for (uint32_t k = 0; k < SC_GRID_MAT_ROWS; k++) {
-        float *m = mat + (size_t)k * SC_GRID_ROW + a, *s = &g->rest[k][a];
-        if (j->save) {
-            memcpy(s, m, bytes);
-        } else {
-            memcpy(m, s, bytes);
+    if ((j->which & (ROWS_SAVE | ROWS_LOAD)) != 0u) {
+        float *mat = &g->d[0][0];
+        for (uint32_t k = 0; k < SC_GRID_MAT_ROWS; k++) {
+            float *m = mat + (size_t)k * SC_GRID_ROW + a, *s = &g->rest[k][a];
+            if ((j->which & ROWS_SAVE) != 0u) {
+                memcpy(s, m, bytes);
+            } else {
+                memcpy(m, s, bytes);
+            }
         }
     }
+#endif
 }
 
-static void rest_copy(sc_grid *g, int save)
+static void rows_run(sc_grid *g, uint32_t which)
 {
-    rest_job j = {g, SC_GRID_HEAD + g->node_end + SC_GRID_PAD, save};
-    sc_pool_run(g->pool, job_rest, &j, (j.used + SC_GRID_POOL_RANGE - 1u) / SC_GRID_POOL_RANGE);
+    rows_job j = {g, which, SC_GRID_HEAD + g->node_end + SC_GRID_PAD};
+    sc_pool_run(g->pool, job_rows, &j, (j.used + SC_GRID_POOL_RANGE - 1u) / SC_GRID_POOL_RANGE);
 }
-#endif
 
 int sc_grid_save_rest(sc_grid *g)
 {
     SC_ASSERT(g != NULL);
 #if SC_GRID_REST_COPY
     if (g->node_count > SC_GRID_REST_COPY_NODES) {
-        rest_copy(g, 1);
+        rows_run(g, ROWS_SAVE);
         g->rest_saved = 1u;
         return 1;
     }
@@ -600,7 +590,7 @@ int sc_grid_load_rest(sc_grid *g)
         return 1;
     }
     if (g->rest_saved) {
-        rest_copy(g, 0);
+        rows_run(g, ROWS_LOAD);
         return 1;
     }
 #endif
@@ -611,8 +601,7 @@ void sc_grid_clear(sc_grid *g, uint32_t which)
 {
     SC_ASSERT(g != NULL);
     g->rest_patched = 0u;
-    clear_job j = {g, which, SC_GRID_HEAD + g->node_end + SC_GRID_PAD};
-    sc_pool_run(g->pool, job_clear, &j, (j.used + SC_GRID_POOL_RANGE - 1u) / SC_GRID_POOL_RANGE);
+    rows_run(g, which & (SC_GRID_CLEAR_DIAG | SC_GRID_CLEAR_BLOCKS));
 }
 
 static void job_precond(void *arg, uint32_t r)
