@@ -44,6 +44,8 @@ static int g_whole_matrix = 0;
 static float g_press_step_mm = 0.8f; /* the press's depth per frame (4 frames) */
 static int g_full_restore = 0; /* every rest K restore copies every row (not the floor's ranges) */
 static uint32_t g_floor_frames; /* frames whose step added the floor onto the kept rest K */
+static float g_force[3];        /* the probe's force at the deepest frame (sc_tissue_probe_force_n) */
+static uint32_t g_force_contacts; /* and the contacts it summed */
 
 static uint64_t scripted_run_on(run_kind kind, uint32_t workers, const sc_pool_dev *thread_pool,
                                 uint64_t *ranges_run)
@@ -87,6 +89,10 @@ static uint64_t scripted_run_on(run_kind kind, uint32_t workers, const sc_pool_d
         }
         assert_int_equal(sc_tissue_step(&g_t, &pose), SC_OK);
         g_floor_frames += (g_t.fem.grid.rest_saved && !g_t.fem.rest_k) ? 1u : 0u;
+        if (f == 4) {
+            (void)sc_tissue_probe_force_n(&g_t, g_force);
+            g_force_contacts = g_t.contacts.count;
+        }
     }
     *ranges_run = (workers > 0u && thread_pool == NULL) ? pool.ranges : 0u;
     return sc_tissue_state_hash(&g_t);
@@ -112,6 +118,35 @@ static void state_hash_is_the_same_for_1_2_3_and_4_workers(void **state)
             assert_true(h == serial);
         }
     }
+}
+
+/* The probe's force on the pool (contacts in ranges of 256, sc_tissue.c): a press with more
+ * than one range of contacts gives the same bits with no pool and 1, 2 and 4 host-pool workers
+ * (and the appliance's threads), and the force pushes back against the press (+z up). */
+static void probe_force_is_the_same_for_every_worker_count(void **state)
+{
+    (void)state;
+    g_press_step_mm = 1.6f; /* 6.4 mm */
+    for (int k = 0; k < (int)RUN_KINDS; k += 1) {
+        uint64_t ranges = 0u;
+        (void)scripted_run((run_kind)k, 0u, &ranges);
+        const float want[3] = {g_force[0], g_force[1], g_force[2]};
+        print_message("%d: %u contacts, force %.4f %.4f %.4f N\n", k, (unsigned)g_force_contacts,
+                      (double)want[0], (double)want[1], (double)want[2]);
+        assert_true(g_force_contacts > 256u);
+        assert_true(want[2] * want[2] > want[0] * want[0] + want[1] * want[1]);
+        for (uint32_t w = 1u; w <= 4u; w *= 2u) {
+            (void)scripted_run((run_kind)k, w, &ranges);
+            assert_memory_equal(g_force, want, sizeof want);
+        }
+        static sc_pool_linux lp;
+        sc_pool_dev dev;
+        assert_int_equal(sc_pool_linux_start(&lp, 2u, -1, 50u, &dev), 0);
+        (void)scripted_run_on((run_kind)k, 2u, &dev, &ranges);
+        sc_pool_linux_stop(&lp);
+        assert_memory_equal(g_force, want, sizeof want);
+    }
+    g_press_step_mm = 0.8f;
 }
 
 /* Three ranges of the cell passes (40 x 16 x 28): 1, 2 and 4 host-pool workers give the serial
@@ -390,6 +425,7 @@ int main(void)
         cmocka_unit_test(host_pool_runs_every_range_once),
         cmocka_unit_test(collider_on_the_pool_gives_the_serial_contacts),
         cmocka_unit_test(state_hash_is_the_same_for_1_2_3_and_4_workers),
+        cmocka_unit_test(probe_force_is_the_same_for_every_worker_count),
         cmocka_unit_test(three_cell_ranges_give_the_same_hash_for_1_2_and_4_workers),
         cmocka_unit_test(linux_pool_threads_give_the_serial_state_hash),
         cmocka_unit_test(lumen_passes_give_the_serial_bits_for_1_2_and_4_workers),
