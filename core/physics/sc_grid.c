@@ -564,28 +564,53 @@ int sc_grid_save_rest(sc_grid *g)
     return 0;
 }
 
+#if SC_GRID_REST_COPY
+/* the partial restore's spans of nodes, one per dirty cell range (sc_grid_load_rest) */
+typedef struct load_job {
+    sc_grid *g;
+    uint32_t a[SC_GRID_ASM_RANGES], b[SC_GRID_ASM_RANGES];
+    uint32_t n;
+} load_job;
+
+static void job_load(void *arg, uint32_t r)
+{
+    const load_job *j = (const load_job *)arg;
+    float *mat = &j->g->d[0][0];
+    const uint32_t a = j->a[r];
+    for (uint32_t k = 0; k < SC_GRID_MAT_ROWS; k++) {
+        memcpy(mat + (size_t)k * SC_GRID_ROW + a, &j->g->rest[k][a],
+               (size_t)(j->b[r] - a) * sizeof(float));
+    }
+}
+#endif
+
 int sc_grid_load_rest(sc_grid *g)
 {
     SC_ASSERT(g != NULL);
 #if SC_GRID_REST_COPY
     if (g->rest_saved && g->rest_patched) {
-        /* the floor's additions only: the nodes range r's cells reach, c0 .. c1 - 1 + off[7] */
+        /* the floor's additions only: the nodes range r's cells reach, c0 .. c1 - 1 + off[7],
+         * on the pool: a dirty range followed by a dirty one stops where that one starts, so
+         * the copies are apart (off[7] < asm_span: a range's reach ends inside the next one) */
         const uint32_t ranges = (g->cell_end + g->asm_span - 1u) / g->asm_span;
-        float *mat = &g->d[0][0];
+        load_job j = {g, {0}, {0}, 0u};
         for (uint32_t r = 0; r < ranges && r < SC_GRID_ASM_RANGES; r++) {
             if (!g->floor_dirty[r]) {
                 continue;
             }
             const uint32_t c0 = r * g->asm_span;
             const uint32_t c1 = c0 + g->asm_span < g->cell_end ? c0 + g->asm_span : g->cell_end;
-            const uint32_t a = SC_GRID_HEAD + c0, b = SC_GRID_HEAD + c1 + g->off[7];
-            SC_ASSERT(b <= SC_GRID_ROW);
-            for (uint32_t k = 0; k < SC_GRID_MAT_ROWS; k++) {
-                memcpy(mat + (size_t)k * SC_GRID_ROW + a, &g->rest[k][a],
-                       (size_t)(b - a) * sizeof(float));
+            uint32_t b = SC_GRID_HEAD + c1 + g->off[7];
+            if (r + 1u < ranges && r + 1u < SC_GRID_ASM_RANGES && g->floor_dirty[r + 1u]) {
+                b = SC_GRID_HEAD + c1;
             }
+            SC_ASSERT(b <= SC_GRID_ROW);
+            j.a[j.n] = SC_GRID_HEAD + c0;
+            j.b[j.n] = b;
+            j.n++;
             g->floor_dirty[r] = 0u;
         }
+        sc_pool_run(g->pool, job_load, &j, j.n);
         g->rest_patched = 0u;
         return 1;
     }
