@@ -2173,6 +2173,31 @@ static int close_frame(sc_bscan *b, const sc_display_dev *disp, uint32_t frame_n
     return rc;
 }
 
+/* The nodes in the image frame (qx, qy, qz), on the pool in spans of SC_BSCAN_XFORM_SPAN nodes
+ * (each node its own: any split gives the same bits; 65,536 nodes at 64x32x32) */
+#define SC_BSCAN_XFORM_SPAN 4096u
+typedef struct xform_args {
+    sc_bscan *b;
+    const sc_nodes *n;
+    uint32_t count;
+    const sc_xform *vol2img;
+} xform_args;
+
+static void xform_job(void *arg, uint32_t s)
+{
+    const xform_args *a = (const xform_args *)arg;
+    sc_bscan *b = a->b;
+    const float *r = a->vol2img->r, *t = a->vol2img->t_mm;
+    const uint32_t i0 = s * SC_BSCAN_XFORM_SPAN;
+    const uint32_t i1 = i0 + SC_BSCAN_XFORM_SPAN < a->count ? i0 + SC_BSCAN_XFORM_SPAN : a->count;
+    for (uint32_t i = i0; i < i1; i++) {
+        const float x = a->n->x[i], y = a->n->y[i], z = a->n->z[i];
+        b->qx[i] = r[0] * x + r[1] * y + r[2] * z + t[0];
+        b->qy[i] = r[3] * x + r[4] * y + r[5] * z + t[1];
+        b->qz[i] = r[6] * x + r[7] * y + r[8] * z + t[2];
+    }
+}
+
 int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, const sc_volume *volume,
                    const sc_xform *probe_to_volume, int contact, const sc_display_dev *display,
                    uint32_t frame_no)
@@ -2255,13 +2280,9 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
     b->regions_state = 0u;
     if (mesh != NULL) {
         const sc_xform vol2img = sc_xform_inverse(&c.img2vol);
-        const float *r = vol2img.r, *t = vol2img.t_mm;
-        for (uint32_t i = 0; i < mesh->node_count; i++) {
-            const float x = nodes->x[i], y = nodes->y[i], z = nodes->z[i];
-            b->qx[i] = r[0] * x + r[1] * y + r[2] * z + t[0];
-            b->qy[i] = r[3] * x + r[4] * y + r[5] * z + t[1];
-            b->qz[i] = r[6] * x + r[7] * y + r[8] * z + t[2];
-        }
+        const xform_args xa = {b, nodes, mesh->node_count, &vol2img};
+        sc_pool_run(b->pool, xform_job, (void *)(uintptr_t)&xa,
+                    (mesh->node_count + SC_BSCAN_XFORM_SPAN - 1u) / SC_BSCAN_XFORM_SPAN);
         if (mapper == SC_BSCAN_MAP_REGIONS) {
             if (build_regions(b, mesh)) {
                 b->regions_state = 1u;
