@@ -17,7 +17,11 @@
  * the pool's hand-overs per frame: jobs (each a barrier), ranges, futex wake-ups, and the step's
  * wall time outside the jobs (`alone ms`: the caller's serial work, median frame). First, per
  * worker count above one, the pool's own cost per job (28 ranges of fixed work, against the
- * same work on the caller alone divided by the workers).
+ * same work on the caller alone divided by the workers). With workers, each row ends with the
+ * machine's own ceiling for that many workers, measured right after the row (`cpu ceil`: a
+ * register-only job, `mem ceil`: a 64 MiB streaming sum, both on the pool against the caller
+ * alone): on this shared VM two CPUs give from about 1.5x to 1.9x on code that never touches
+ * memory, so a row's speed-up is read against the ceiling beside it.
  *
  * Usage: bench-scale [--frames N] [--repeats R] [--workers 1,2] [--meshes 20x10x10,...]
  *                    [--methods msds,fem,corot] [--csv FILE]
@@ -196,6 +200,63 @@ static void print_handover(uint32_t w)
     sc_pool_linux_stop(&lp);
 }
 
+/* The machine's own ceiling for W workers, measured beside each row (a shared VM's two CPUs
+ * give two workers from about 1.5x to 1.9x of one, minute to minute, on code that never touches
+ * memory): the same job on the caller alone and on the pool, best of 3 batches each, alternated;
+ * the ratio. Two jobs of 28 ranges: `cpu` a register-only chain (about 100 us per range), `mem`
+ * a sum over 64 MiB (twice the L3: each range streams 2.3 MiB from memory, as the 64x32x32
+ * mat-vec streams its 15.7 MB matrix). */
+#define CEIL_RANGES 28u
+#define CEIL_WORDS (16u * 1024u * 1024u)
+static uint32_t g_stream[CEIL_WORDS];
+static volatile uint32_t g_isink[CEIL_RANGES];
+
+static void job_spin(void *arg, uint32_t r)
+{
+    (void)arg;
+    float a = (float)r, b = 1.0001f, c = (float)r + 1.0f, d = 0.9999f;
+    for (int k = 0; k < 50000; k++) {
+        a = a * b + 0.5f;
+        c = c * d + 0.25f;
+    }
+    g_sink[r & 63u] = a + c;
+}
+
+static void job_stream(void *arg, uint32_t r)
+{
+    (void)arg;
+    const uint32_t per = CEIL_WORDS / CEIL_RANGES;
+    const uint32_t *p = g_stream + (size_t)r * per;
+    uint32_t s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+    for (uint32_t i = 0; i + 4u <= per; i += 4u) {
+        s0 += p[i];
+        s1 += p[i + 1u];
+        s2 += p[i + 2u];
+        s3 += p[i + 3u];
+    }
+    g_isink[r] = s0 + s1 + s2 + s3;
+}
+
+static double batch_ns(const sc_pool_dev *dev, sc_pool_job_fn fn, int jobs)
+{
+    const uint64_t t0 = bench_now_ns();
+    for (int k = 0; k < jobs; k++) {
+        sc_pool_run(dev, fn, NULL, CEIL_RANGES);
+    }
+    return (double)(bench_now_ns() - t0);
+}
+
+static double ceiling(const sc_pool_dev *dev, sc_pool_job_fn fn, int jobs)
+{
+    double one = 1e300, many = 1e300;
+    for (int b = 0; b < 3; b++) {
+        const double a = batch_ns(NULL, fn, jobs), w = batch_ns(dev, fn, jobs);
+        one = a < one ? a : one;
+        many = w < many ? w : many;
+    }
+    return one / many;
+}
+
 int main(int argc, char **argv)
 {
     opts o;
@@ -205,6 +266,9 @@ int main(int argc, char **argv)
     }
     bench_select_kernels("bench-scale"); /* the engine's variant, as sonocomp selects it */
     printf("pages: %s\n", bench_pages(&g_t, sizeof g_t));
+    for (uint32_t i = 0; i < CEIL_WORDS; i++) {
+        g_stream[i] = i * 2654435761u; /* faulted in before any timing (the mem ceiling) */
+    }
     FILE *csv = NULL;
     if (o.csv) {
         csv = fopen(o.csv, "w");
@@ -223,9 +287,10 @@ int main(int argc, char **argv)
     printf("bench-scale: %d runs x %d frames per row, wall clock; median (min..max of the runs' "
            "medians)\n",
            o.b.repeats, o.b.frames);
-    printf("%-9s %6s %7s %-6s %3s %9s %19s %8s %8s %7s %9s %6s %16s %7s %8s %7s %8s\n", "mesh",
-           "nodes", "tets", "method", "w", "frame ms", "spread", "coll ms", "speedup", "60Hz",
-           "cpu ms", "hash", "state hash", "jobs/f", "ranges/f", "wakes/f", "alone ms");
+    printf("%-9s %6s %7s %-6s %3s %9s %19s %8s %8s %7s %9s %6s %16s %7s %8s %7s %8s %8s %8s\n",
+           "mesh", "nodes", "tets", "method", "w", "frame ms", "spread", "coll ms", "speedup",
+           "60Hz", "cpu ms", "hash", "state hash", "jobs/f", "ranges/f", "wakes/f", "alone ms",
+           "cpu ceil", "mem ceil");
     int status = 0;
     for (int mi = 0; mi < o.b.nmesh; mi++) {
         for (int m = 0; m < BENCH_METHODS; m++) {
@@ -242,11 +307,14 @@ int main(int argc, char **argv)
                     fprintf(stderr, "bench-scale: cannot start %u workers\n", (unsigned)w);
                     return 1;
                 }
-                run_out r;
+                run_out r = {0};
                 const int rc =
                     bench_one(o.b.mesh[mi], (bench_method)m, w > 1u ? &dev : NULL, &o, &r, csv, w,
                               w > 1u ? &lp : NULL);
+                double ceil_cpu = 1.0, ceil_mem = 1.0;
                 if (w > 1u) {
+                    ceil_cpu = ceiling(&dev, job_spin, 20);
+                    ceil_mem = ceiling(&dev, job_stream, 10);
                     sc_pool_linux_stop(&lp);
                 }
                 if (rc != 0) {
@@ -264,12 +332,12 @@ int main(int argc, char **argv)
                 status |= !same;
                 printf(
                     "%2ux%2ux%2u  %6u %7u %-6s %3u %9.3f %8.3f..%8.3f %8.3f %7.2fx %6.0f%% %9.3f "
-                    "%-7s %016llx %7.1f %8.1f %7.2f %8.3f\n",
+                    "%-7s %016llx %7.1f %8.1f %7.2f %8.3f %7.2fx %7.2fx\n",
                     o.b.mesh[mi][0], o.b.mesh[mi][1], o.b.mesh[mi][2], r.nodes, r.tets,
                     bench_method_name[m], (unsigned)w, r.med_ms, r.min_ms, r.max_ms, r.coll_ms,
                     one / r.med_ms, 100.0 * (1.0 - r.med_ms / (1000.0 / 60.0)), r.cpu_ms,
                     same ? "same" : "DIFFERS", (unsigned long long)r.hash, r.jobs, r.ranges,
-                    r.wakes, r.alone_ms);
+                    r.wakes, r.alone_ms, ceil_cpu, ceil_mem);
                 fflush(stdout);
             }
         }
