@@ -219,7 +219,9 @@ uint64_t sc_tissue_state_hash(const sc_tissue *t);
  * implicit step assembled (for the corotated FEM its rotated blocks: an estimate that is exact
  * for the linear FEM at equilibrium); the skin layer's share is not included. Returns 0 with no
  * contact, -1 (not available) for the explicit MSDS (it has no assembled K) or an unbuilt
- * tissue. O(contacts x 27) block reads, bounded by SC_MAX_CONTACTS. Never allocates. */
+ * tissue. O(contacts x 27) block reads, bounded by SC_MAX_CONTACTS, on the tissue's worker pool
+ * (ranges of 256 contacts summed in order: the same bits for any worker count; up to 256
+ * contacts the serial sum's). Never allocates. */
 float sc_tissue_probe_force_n(const sc_tissue *t, float out[3]);
 
 #if SC_PHYS_LUMEN
