@@ -109,21 +109,25 @@ _Static_assert((SC_GRID_ROW / 16u) % 2u == 1u, "row stride an odd multiple of 16
 _Static_assert(SC_GRID_POOL_RANGE % SC_GRID_CHUNK == 0u && SC_GRID_SUM_BLOCK % 16u == 0u,
                "pool ranges and sum blocks are whole chunks and whole partial-sum groups");
 
-/* The linear FEM's rest K kept aside (meshes of more than SC_GRID_REST_COPY_NODES nodes: 48x24x24
- * and up; sc_grid_save_rest, sc_grid_load_rest). The linear model's matrix is the rest K but for
- * the floor term of the tets below their floor volume (a firm press that collapses a vein crushes
- * 10^4 of a 64x32x32 mesh's tets). A step with the floor met re-assembled every cell: at
- * 64x32x32 with two workers the linear FEM's step took 14.3 ms against 9.2 without (p50, the
- * real loop pressing 8 mm and sweeping). A big mesh starts such a step from the kept copy and
- * adds the floor's blocks and residual of the cell blocks that hold a tet below the floor
+/* The linear FEM's rest K kept aside (sc_grid_save_rest, sc_grid_load_rest), in every build whose
+ * node capacity is above SC_GRID_REST_COPY_CAP (the appliance's and the host's; the MCU's limits
+ * leave the copy out and re-assemble), for meshes of more than SC_GRID_REST_COPY_NODES nodes.
+ * The linear model's matrix is the rest K but for the floor term of the tets below their floor
+ * volume (a firm press that collapses a vein crushes 10^4 of a 64x32x32 mesh's tets). A step with
+ * the floor met re-assembled every cell: at 64x32x32 with two workers the linear FEM's step took
+ * 14.3 ms against 9.2 without (p50, the real loop pressing 8 mm and sweeping); at 32x16x16 on one
+ * core the whole frame pressed 8 mm took 5.7-5.8 ms against 4.4-4.5 ms from the copy (min,
+ * bench_bscan contact, a loaded machine). Such a step starts from the kept copy and adds the
+ * floor's blocks and residual of the cell blocks that hold a tet below the floor
  * (sc_grid_fem_in.floor_only); the rest K's part of the residual is one mat-vec, as in a step
  * without the floor. The sums differ from the whole re-assembly's (the floor added after the
- * rest K, not inside each cell's sum), the same for every worker count; meshes up to 32x16x16
- * keep the whole re-assembly (every stored hash unchanged); the MCU's limits leave the copy out. */
+ * rest K, not inside each cell's sum: positions within 1.3e-5 mm, test_sc_pool), the same for
+ * every worker count. */
 #ifndef SC_GRID_REST_COPY_NODES
-#define SC_GRID_REST_COPY_NODES 16384u
+#define SC_GRID_REST_COPY_NODES 0u
 #endif
-#define SC_GRID_REST_COPY (SC_MAX_NODES > SC_GRID_REST_COPY_NODES)
+#define SC_GRID_REST_COPY_CAP 16384u
+#define SC_GRID_REST_COPY (SC_MAX_NODES > SC_GRID_REST_COPY_CAP)
 #define SC_GRID_MAT_ROWS 60u /* d 6, e 27, f 27: row k of the matrix at &d[0][0] + k ROW */
 
 /* The cell passes (FEM assembly, the MSDS's volume terms) on the worker pool: the cell origins

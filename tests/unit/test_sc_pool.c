@@ -175,12 +175,12 @@ static void three_cell_ranges_give_the_same_hash_for_1_2_and_4_workers(void **st
     }
 }
 
-/* The linear FEM with the floor met on a mesh that keeps its rest K aside (40 x 16 x 28, above
- * SC_GRID_REST_COPY_NODES; a floor at half the rest volume, the largest allowed, and a 10 mm press,
- * so that tets go below it): the steps that add the floor onto the kept copy give the same bits
- * with no pool, 1, 2, 4 host-pool workers and every row restored from the copy each step (not
- * only the floor's ranges), and the same motion as the whole re-assembly within rounding (the
- * two sum the floor in a different order). */
+/* The linear FEM with the floor met on a mesh that keeps its rest K aside (40 x 16 x 28, three
+ * cell ranges, as every mesh above SC_GRID_REST_COPY_NODES; a floor at half the rest volume, the
+ * largest allowed, and a 10 mm press, so that tets go below it): the steps that add the floor
+ * onto the kept copy give the same bits with no pool, 1, 2, 4 host-pool workers and every row
+ * restored from the copy each step (not only the floor's ranges), and the same motion as the
+ * whole re-assembly within rounding (the two sum the floor in a different order). */
 static void linear_floor_on_the_kept_rest_k_matches_the_whole_reassembly(void **state)
 {
     (void)state;
