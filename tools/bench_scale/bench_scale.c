@@ -158,25 +158,34 @@ static int bench_one(const uint32_t mesh[3], bench_method m, const sc_pool_dev *
  * against the same ranges run on the caller alone (no pool) divided by the workers: the
  * difference is the hand-over, the claims and the wait for the last range. */
 static volatile float g_sink[64];
+/* a register-only chain of *(const int *)arg steps per range (1500: about 2 us) */
 static void job_work(void *arg, uint32_t r)
 {
-    (void)arg;
+    const int steps = *(const int *)arg;
     float a = (float)r, b = 1.0001f;
-    for (int k = 0; k < 1500; k++) {
+    for (int k = 0; k < steps; k++) {
         a = a * b + 0.5f;
     }
     g_sink[r & 63u] = a;
 }
 
+/* wall ns of `jobs` jobs of fn(arg) over `ranges` ranges, on dev (NULL: the caller alone) */
+static double batch_ns(const sc_pool_dev *dev, sc_pool_job_fn fn, void *arg, uint32_t ranges,
+                       int jobs)
+{
+    const uint64_t t0 = bench_now_ns();
+    for (int k = 0; k < jobs; k++) {
+        sc_pool_run(dev, fn, arg, ranges);
+    }
+    return (double)(bench_now_ns() - t0);
+}
+
 static double per_job_us(const sc_pool_dev *dev, uint32_t ranges)
 {
+    static int steps = 1500;
     double best = 1e30;
     for (int b = 0; b < 6; b++) {
-        const uint64_t t0 = bench_now_ns();
-        for (int k = 0; k < 1000; k++) {
-            sc_pool_run(dev, job_work, NULL, ranges);
-        }
-        const double us = (double)(bench_now_ns() - t0) / 1000.0 / 1000.0;
+        const double us = batch_ns(dev, job_work, &steps, ranges, 1000) / 1000.0 / 1000.0;
         best = b > 0 && us < best ? us : best; /* the first batch warms up */
     }
     return best;
@@ -203,24 +212,13 @@ static void print_handover(uint32_t w)
 /* The machine's own ceiling for W workers, measured beside each row (a shared VM's two CPUs
  * give two workers from about 1.5x to 1.9x of one, minute to minute, on code that never touches
  * memory): the same job on the caller alone and on the pool, best of 3 batches each, alternated;
- * the ratio. Two jobs of 28 ranges: `cpu` a register-only chain (about 100 us per range), `mem`
- * a sum over 64 MiB (twice the L3: each range streams 2.3 MiB from memory, as the 64x32x32
- * mat-vec streams its 15.7 MB matrix). */
+ * the ratio. Two jobs of 28 ranges: `cpu` job_work's register-only chain (about 130 us per
+ * range), `mem` a sum over 64 MiB (twice the L3: each range streams 2.3 MiB from memory, as the
+ * 64x32x32 mat-vec streams its 15.7 MB matrix). */
 #define CEIL_RANGES 28u
 #define CEIL_WORDS (16u * 1024u * 1024u)
 static uint32_t g_stream[CEIL_WORDS];
 static volatile uint32_t g_isink[CEIL_RANGES];
-
-static void job_spin(void *arg, uint32_t r)
-{
-    (void)arg;
-    float a = (float)r, b = 1.0001f, c = (float)r + 1.0f, d = 0.9999f;
-    for (int k = 0; k < 50000; k++) {
-        a = a * b + 0.5f;
-        c = c * d + 0.25f;
-    }
-    g_sink[r & 63u] = a + c;
-}
 
 static void job_stream(void *arg, uint32_t r)
 {
@@ -237,20 +235,12 @@ static void job_stream(void *arg, uint32_t r)
     g_isink[r] = s0 + s1 + s2 + s3;
 }
 
-static double batch_ns(const sc_pool_dev *dev, sc_pool_job_fn fn, int jobs)
-{
-    const uint64_t t0 = bench_now_ns();
-    for (int k = 0; k < jobs; k++) {
-        sc_pool_run(dev, fn, NULL, CEIL_RANGES);
-    }
-    return (double)(bench_now_ns() - t0);
-}
-
-static double ceiling(const sc_pool_dev *dev, sc_pool_job_fn fn, int jobs)
+static double ceiling(const sc_pool_dev *dev, sc_pool_job_fn fn, void *arg, int jobs)
 {
     double one = 1e300, many = 1e300;
     for (int b = 0; b < 3; b++) {
-        const double a = batch_ns(NULL, fn, jobs), w = batch_ns(dev, fn, jobs);
+        const double a = batch_ns(NULL, fn, arg, CEIL_RANGES, jobs),
+                     w = batch_ns(dev, fn, arg, CEIL_RANGES, jobs);
         one = a < one ? a : one;
         many = w < many ? w : many;
     }
@@ -313,8 +303,9 @@ int main(int argc, char **argv)
                               w > 1u ? &lp : NULL);
                 double ceil_cpu = 1.0, ceil_mem = 1.0;
                 if (w > 1u) {
-                    ceil_cpu = ceiling(&dev, job_spin, 20);
-                    ceil_mem = ceiling(&dev, job_stream, 10);
+                    static int spin_steps = 50000; /* about 130 us per range */
+                    ceil_cpu = ceiling(&dev, job_work, &spin_steps, 20);
+                    ceil_mem = ceiling(&dev, job_stream, NULL, 10);
                     sc_pool_linux_stop(&lp);
                 }
                 if (rc != 0) {
