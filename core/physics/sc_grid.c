@@ -171,6 +171,36 @@ static void zero_rows(float *rows, uint32_t count, uint32_t used)
     }
 }
 
+uint32_t sc_grid_asm_span(uint32_t nx, uint32_t ny, uint32_t nz)
+{
+    const uint32_t nxy = nx * ny, nn = nxy * nz;
+    const uint32_t cells = nn - (1u + nx + nxy);
+    const uint32_t cell_end = (cells + SC_GRID_CELL_BLOCK - 1u) / SC_GRID_CELL_BLOCK *
+                              SC_GRID_CELL_BLOCK;
+    /* the pool's split, by the mesh alone (sc_grid.h): up to two ranges of SC_GRID_ASM_SPAN and
+     * one sum block the serial loops' sums, bigger meshes finer ranges for the workers */
+    if (cell_end <= 2u * SC_GRID_ASM_SPAN) {
+        return SC_GRID_ASM_SPAN;
+    }
+    const uint32_t apart = nxy + nx + SC_GRID_CELL_BLOCK + 1u;
+    const uint32_t span = (apart + SC_GRID_CELL_BLOCK - 1u) / SC_GRID_CELL_BLOCK *
+                          SC_GRID_CELL_BLOCK;
+    uint32_t asm_span = span > SC_GRID_ASM_SPAN_MIN ? span : SC_GRID_ASM_SPAN_MIN;
+    /* balance (sc_grid.h): the ranges' count down to a multiple of four, the span widened to
+     * match, so that each phase has an even number of ranges (two workers take as many of each
+     * phase's as the other: 11 per phase at 48x24x24 left one worker a range idle). A count
+     * that is a multiple of four already keeps its span: re-cut, the span rounded to whole cell
+     * blocks could come out narrower than the two-apart minimum above (52x26x26: 1,408 origins
+     * against 1,421; 1,330 of the meshes within the limits tripped sc_grid_init's assert). */
+    const uint32_t n = (cell_end + asm_span - 1u) / asm_span;
+    if (n >= 8u && n % 4u != 0u) {
+        const uint32_t want = n / 4u * 4u;
+        const uint32_t wide = (cell_end + want - 1u) / want;
+        asm_span = (wide + SC_GRID_CELL_BLOCK - 1u) / SC_GRID_CELL_BLOCK * SC_GRID_CELL_BLOCK;
+    }
+    return asm_span;
+}
+
 int sc_grid_init(sc_grid *g, const sc_mesh *m)
 {
     if (g == NULL || m == NULL || m->nx < 2u || m->ny < 2u || m->nz < 2u ||
@@ -192,24 +222,7 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
     /* cell origins 0 .. nn - off[7] - 1 (the last plane, row and column have none) */
     const uint32_t cells = nn - g->off[7];
     g->cell_end = (cells + SC_GRID_CELL_BLOCK - 1u) / SC_GRID_CELL_BLOCK * SC_GRID_CELL_BLOCK;
-    /* the pool's split, by the mesh alone (sc_grid.h): up to two ranges of SC_GRID_ASM_SPAN and
-     * one sum block the serial loops' sums, bigger meshes finer ranges for the workers */
-    g->asm_span = SC_GRID_ASM_SPAN;
-    if (g->cell_end > 2u * SC_GRID_ASM_SPAN) {
-        const uint32_t apart = nxy + nx + SC_GRID_CELL_BLOCK + 1u;
-        const uint32_t span = (apart + SC_GRID_CELL_BLOCK - 1u) / SC_GRID_CELL_BLOCK *
-                              SC_GRID_CELL_BLOCK;
-        g->asm_span = span > SC_GRID_ASM_SPAN_MIN ? span : SC_GRID_ASM_SPAN_MIN;
-        /* balance (sc_grid.h): the ranges' count down to a multiple of four, the span widened to
-         * match, so that each phase has an even number of ranges (two workers take as many of
-         * each phase's as the other: 11 per phase at 48x24x24 left one worker a range idle) */
-        const uint32_t n = (g->cell_end + g->asm_span - 1u) / g->asm_span;
-        if (n >= 8u) {
-            const uint32_t want = n / 4u * 4u;
-            const uint32_t wide = (g->cell_end + want - 1u) / want;
-            g->asm_span = (wide + SC_GRID_CELL_BLOCK - 1u) / SC_GRID_CELL_BLOCK * SC_GRID_CELL_BLOCK;
-        }
-    }
+    g->asm_span = sc_grid_asm_span(nx, ny, nz);
     SC_ASSERT(g->asm_span % SC_GRID_CELL_BLOCK == 0u &&
               g->asm_span > nxy + nx + SC_GRID_CELL_BLOCK &&
               (g->cell_end + g->asm_span - 1u) / g->asm_span <= SC_GRID_ASM_RANGES);

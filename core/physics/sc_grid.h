@@ -274,6 +274,12 @@ typedef struct sc_grid_fem_in {
                                      last fem_below counted one (sc_grid_save_rest) */
 } sc_grid_fem_in;
 
+/* The cell passes' range (sc_grid.asm_span) for a grid of nx x ny x nz nodes (each at least 2,
+ * the node count within SC_MAX_NODES): SC_GRID_ASM_SPAN up to two such ranges, else whole cell
+ * blocks, more than nx ny + nx + SC_GRID_CELL_BLOCK origins (two ranges apart write apart), at
+ * most SC_GRID_ASM_RANGES ranges (test_sc_grid_split checks every mesh within the limits). */
+uint32_t sc_grid_asm_span(uint32_t nx, uint32_t ny, uint32_t nz);
+
 /* Layout for the mesh (which must be sc_mesh_build's regular grid: checked against its tets),
  * rest positions, masks; matrix, masses and vectors zero. O(N + tets). Never allocates.
  * Errors: SC_ERR_INVALID_ARG (NULL, counts above the limits or not the grid of sc_mesh_build). */

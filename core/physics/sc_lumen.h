@@ -197,6 +197,13 @@ sc_lumen_drive sc_lumen_drive_default(void);
  * SC_ERR_NOT_FINITE, SC_ERR_RANGE. */
 int sc_lumen_drive_validate(const sc_lumen_drive *d);
 
+/* The passes' ranges ("Workers" above) of a grid mesh of nx x ny x nz nodes: *ranges (1 up to
+ * SC_LUMEN_SERIAL_NODES nodes) of *span_cells cells each (the last one shorter); ranges two
+ * apart share no node. By the mesh alone (test_sc_grid_split checks every mesh within the
+ * limits). */
+void sc_lumen_split(uint32_t nx, uint32_t ny, uint32_t nz, uint32_t *ranges,
+                    uint32_t *span_cells);
+
 /* Find the vessels of a labelled mesh (flood fill over face neighbours, tets of a label with a
  * lumen law), their rest volumes and relaxations (theta from the softest tet across the
  * lumen's boundary, mat); pressures zero, phases zero, the default drive, frame_s 1 /

@@ -36,7 +36,7 @@ typedef enum run_kind { RUN_MSDS, RUN_FEM, RUN_FEM_COROTATED, RUN_KINDS } run_ki
 
 /* a press and a lift on the scene, `workers` 0: no pool (NULL), else the host pool of that
  * many workers; returns the state hash and the ranges the pool ran */
-static uint32_t g_nz = 16u; /* the mesh is 40 x 16 x g_nz */
+static uint32_t g_ny = 16u, g_nz = 16u; /* the mesh is 40 x g_ny x g_nz */
 /* the linear FEM's floor (sc_grid.h, "rest K kept aside"): a floor ratio other than the
  * default's (0: the default), and the whole re-assembly forced on a mesh that keeps the copy */
 static float g_floor_ratio = 0.0f;
@@ -52,7 +52,7 @@ static uint64_t scripted_run_on(run_kind kind, uint32_t workers, const sc_pool_d
 {
     sc_test_scene_params p = sc_test_scene_default_params();
     p.nx = 40u;
-    p.ny = 16u;
+    p.ny = g_ny;
     p.nz = g_nz;
     sc_test_scene_build(&g_scene, &p);
     sc_tissue_def d =
@@ -360,12 +360,13 @@ static void lumen_apply_and_clear(const sc_pool_dev *pool, sc_nodes *after_apply
     sc_lumen_clear(&g_t.lumen, &g_t.mesh, &g_t.nodes);
 }
 
-static void lumen_passes_give_the_serial_bits_for_1_2_and_4_workers(void **state)
+static void lumen_check(uint32_t ny, uint32_t nz)
 {
-    (void)state;
     uint64_t ranges = 0u;
-    g_nz = 28u;
+    g_ny = ny;
+    g_nz = nz;
     (void)scripted_run(RUN_MSDS, 0u, &ranges);
+    g_ny = 16u;
     g_nz = 16u;
     assert_true(g_t.lumen.count >= 2u);   /* the scene's vein and artery */
     assert_true(g_t.lumen.ranges >= 8u);  /* split: the mesh is above SC_LUMEN_SERIAL_NODES */
@@ -419,6 +420,45 @@ static void lumen_passes_give_the_serial_bits_for_1_2_and_4_workers(void **state
     }
 }
 
+static void lumen_passes_give_the_serial_bits_for_1_2_and_4_workers(void **state)
+{
+    (void)state;
+    lumen_check(16u, 28u);
+    lumen_check(26u, 17u); /* ranges of exactly a multiple of four (test_sc_grid_split) */
+}
+
+/* 40 x 26 x 17 (17,680 nodes) cuts into a multiple of four cell ranges and lumen ranges as it
+ * is. Re-cutting them gave spans narrower than the two-apart minimum: sc_grid_init's assert
+ * stopped the case load, and the lumen's ranges two apart shared nodes (test_sc_grid_split: every
+ * mesh). It builds, and 1, 2 and 4 host-pool workers and two real threads give the serial state
+ * hash, MSDS and linear FEM. */
+static void a_mesh_of_four_ranges_exactly_builds_and_gives_the_serial_hash(void **state)
+{
+    (void)state;
+    g_ny = 26u;
+    g_nz = 17u;
+    for (int k = 0; k < (int)RUN_FEM_COROTATED; k++) {
+        uint64_t ranges = 0u;
+        const uint64_t serial = scripted_run((run_kind)k, 0u, &ranges);
+        assert_int_equal(g_t.fem.grid.asm_span, sc_grid_asm_span(40u, 26u, 17u));
+        assert_true(g_t.fem.grid.asm_span > 40u * 26u + 40u + SC_GRID_CELL_BLOCK);
+        for (uint32_t w = 1u; w <= 4u; w *= 2u) {
+            const uint64_t h = scripted_run((run_kind)k, w, &ranges);
+            print_message("%d, %u worker(s): state hash %016llx\n", k, (unsigned)w,
+                          (unsigned long long)h);
+            assert_true(h == serial);
+        }
+        static sc_pool_linux lp;
+        sc_pool_dev dev;
+        assert_int_equal(sc_pool_linux_start(&lp, 2u, -1, 50u, &dev), 0);
+        const uint64_t h = scripted_run_on((run_kind)k, 2u, &dev, &ranges);
+        sc_pool_linux_stop(&lp);
+        assert_true(h == serial);
+    }
+    g_ny = 16u;
+    g_nz = 16u;
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -430,6 +470,7 @@ int main(void)
         cmocka_unit_test(linux_pool_threads_give_the_serial_state_hash),
         cmocka_unit_test(lumen_passes_give_the_serial_bits_for_1_2_and_4_workers),
         cmocka_unit_test(linear_floor_on_the_kept_rest_k_matches_the_whole_reassembly),
+        cmocka_unit_test(a_mesh_of_four_ranges_exactly_builds_and_gives_the_serial_hash),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
