@@ -20,6 +20,7 @@
 #include <sys/stat.h>
 #include <time.h>
 
+#include "bench_machine.h"
 #include "bench_contact.h"
 #include "sc_cpu.h"
 #include "sc_simd.h"
@@ -337,6 +338,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "bench_bscan: SONOCOMP_SIMD names no variant of this CPU\n");
     }
     printf("kernels: %s\n", sc_simd_name(sc_simd_selected()));
+    bench_print_machine();
     if (argc > 1 && strcmp(argv[1], "contact") == 0) {
         const char *cases = argc > 2 ? argv[2] : SC_DEFAULT_CASES_DIR;
         const char *name = argc > 3 ? argv[3] : "neck-ijv";

@@ -1,4 +1,5 @@
 /* bench_scene.c: see bench_scene.h. */
+#include "bench_machine.h"
 #include "bench_scene.h"
 
 #include <errno.h>
@@ -25,6 +26,7 @@ void bench_select_kernels(const char *prog)
                 sc_simd_name(sc_simd_selected()));
     }
     printf("kernels: %s\n", sc_simd_name(sc_simd_selected()));
+    bench_print_machine();
 }
 
 static uint64_t clock_ns(clockid_t id)

@@ -20,6 +20,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_machine.h"
 #include "bench_pages.h"
 #include "sc_err.h"
 #include "sc_cpu.h"
@@ -329,6 +330,7 @@ int main(int argc, char **argv)
                 sc_simd_name(sc_simd_selected()));
     }
     printf("kernels: %s\n", sc_simd_name(sc_simd_selected()));
+    bench_print_machine();
     printf("pages: %s\n", pages);
     if (argc > 2 && strcmp(argv[2], "stable") == 0) {
         /* the stable MSDS and the FEMs at 32x16x16 only (the targets' measure) */
