@@ -1,8 +1,9 @@
 /* bench_machine.h: the line a benchmark prints about the machine it ran on, beside its kernels
  * line. Every figure of docs/performance.md is only meaningful against its machine. These VMs
- * have not always been the same CPU: the figures up to the scale6 session came from an x86-64-v4
- * EPYC, the scale7 session's from a family 25 model 1 EPYC (512 KiB L2, AVX2 only). They were
- * 1.5x slower and were first read as a loaded host. Reads /proc/cpuinfo and
+ * have not always been the same CPU. The figures up to the scale6 session came from an x86-64-v4
+ * EPYC. The scale7 session measured everything about 1.5x slower and read that as a loaded host.
+ * The next session found a family 25 model 1 EPYC (512 KiB L2, AVX2 only) that gave the same
+ * slower figures. Reads /proc/cpuinfo and
  * /sys/devices/system/cpu/cpu0/cache (Linux); whatever it cannot read it leaves out. */
 #ifndef BENCH_MACHINE_H
 #define BENCH_MACHINE_H
