@@ -128,6 +128,17 @@ _Static_assert(SC_GRID_POOL_RANGE % SC_GRID_CHUNK == 0u && SC_GRID_SUM_BLOCK % 1
 #endif
 #define SC_GRID_REST_COPY_CAP 16384u
 #define SC_GRID_REST_COPY (SC_MAX_NODES > SC_GRID_REST_COPY_CAP)
+/* The software prefetches of the mat-vec, the springs and the cell passes (sc_grid_kern.inc) run
+ * only on meshes of more than this many nodes (sc_grid.prefetch, by the mesh alone; a hint changes
+ * no result). On the x86-64-v4 EPYC of the earlier sessions they were worth 2x on the 64x32x32
+ * mat-vec and 1.35x at 48x24x24, and nothing at 32x16x16. On the family 25 model 1 EPYC
+ * (512 KiB L2) of the 25 Nov sessions they cost the L3-resident meshes issue slots: a 32x16x16
+ * mat-vec took 0.112 ms with them and 0.098 ms without, and the stable MSDS frame 2.61-2.64 ms
+ * against 2.40-2.44 ms (`bench-physics 100 stages`, alternated). 48x24x24 there: 0.42 against
+ * 0.38 ms. 64x32x32 still needs them: 1.17-1.23 ms against 1.55-2.12 ms. */
+#ifndef SC_GRID_PREFETCH_NODES
+#define SC_GRID_PREFETCH_NODES 8192u
+#endif
 #define SC_GRID_MAT_ROWS 60u /* d 6, e 27, f 27: row k of the matrix at &d[0][0] + k ROW */
 
 /* The cell passes (FEM assembly, the MSDS's volume terms) on the worker pool: the cell origins
@@ -197,6 +208,7 @@ typedef struct sc_grid {
     uint32_t sum_block; /* nodes per block of the CG's dot products (SC_GRID_SUM_BLOCK above) */
     uint32_t range;     /* nodes per range of the node loops and the CG (SC_GRID_POOL_RANGE) */
     uint8_t rest_saved; /* 1: rest[] holds a rest K (sc_grid_save_rest; 0 after sc_grid_init) */
+    uint8_t prefetch;   /* 1: the kernels prefetch (node_count > SC_GRID_PREFETCH_NODES) */
     uint8_t rest_patched; /* 1: the matrix is the rest K but for a floor_only pass's additions in
                              the cell ranges marked in floor_dirty (0 after sc_grid_clear) */
     uint8_t floor_dirty[SC_GRID_ASM_RANGES];
