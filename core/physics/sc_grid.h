@@ -133,8 +133,8 @@ _Static_assert(SC_GRID_POOL_RANGE % SC_GRID_CHUNK == 0u && SC_GRID_SUM_BLOCK % 1
  * no result). On the x86-64-v4 EPYC of the earlier sessions they were worth 2x on the 64x32x32
  * mat-vec and 1.35x at 48x24x24, and nothing at 32x16x16. On the family 25 model 1 EPYC
  * (512 KiB L2) of the 25 Nov sessions they cost the L3-resident meshes issue slots: a 32x16x16
- * mat-vec took 0.112 ms with them and 0.098 ms without, and the stable MSDS frame 2.61-2.64 ms
- * against 2.40-2.44 ms (`bench-physics 100 stages`, alternated). 48x24x24 there: 0.42 against
+ * mat-vec took 0.112 ms with them and 0.098 ms without, and the stable MSDS frame 2.62-2.67 ms
+ * against 2.45-2.48 ms (`bench-physics 100 stages`, alternated). 48x24x24 there: 0.42 against
  * 0.38 ms. 64x32x32 still needs them: 1.17-1.23 ms against 1.55-2.12 ms. */
 #ifndef SC_GRID_PREFETCH_NODES
 #define SC_GRID_PREFETCH_NODES 8192u
