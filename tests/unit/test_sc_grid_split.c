@@ -13,38 +13,50 @@
 #include "sc_grid.h"
 #include "sc_lumen.h"
 
+/* The next mesh within the limits after m (nx fastest), skipping node counts above SC_MAX_NODES;
+ * start from {1, 2, 2}. Returns 0 past the last one. */
+static int next_mesh(uint32_t m[3])
+{
+    static const uint32_t max[3] = {SC_MAX_MESH_NX, SC_MAX_MESH_NY, SC_MAX_MESH_NZ};
+    do {
+        uint32_t a = 0;
+        while (a < 3u && ++m[a] > max[a]) {
+            m[a] = 2u;
+            a++;
+        }
+        if (a == 3u) {
+            return 0;
+        }
+    } while ((uint64_t)m[0] * m[1] * m[2] > SC_MAX_NODES);
+    return 1;
+}
+
 static void cell_pass_ranges_are_two_apart_for_every_mesh(void **state)
 {
     (void)state;
     uint32_t meshes = 0, split = 0, balanced = 0;
-    for (uint32_t nz = 2u; nz <= SC_MAX_MESH_NZ; nz++) {
-        for (uint32_t ny = 2u; ny <= SC_MAX_MESH_NY; ny++) {
-            for (uint32_t nx = 2u; nx <= SC_MAX_MESH_NX; nx++) {
-                if ((uint64_t)nx * ny * nz > SC_MAX_NODES) {
-                    continue;
-                }
-                meshes++;
-                const uint32_t nxy = nx * ny, nn = nxy * nz;
-                const uint32_t cells = nn - (1u + nx + nxy);
-                const uint32_t cell_end =
-                    (cells + SC_GRID_CELL_BLOCK - 1u) / SC_GRID_CELL_BLOCK * SC_GRID_CELL_BLOCK;
-                const uint32_t span = sc_grid_asm_span(nx, ny, nz);
-                const uint32_t ranges = (cell_end + span - 1u) / span;
-                if (span % SC_GRID_CELL_BLOCK != 0u || span <= nxy + nx + SC_GRID_CELL_BLOCK ||
-                    ranges > SC_GRID_ASM_RANGES || ranges == 0u) {
-                    fail_msg("%ux%ux%u: cell span %u, %u ranges (two apart needs > %u, at "
-                             "most %u ranges)",
-                             nx, ny, nz, span, ranges, nxy + nx + SC_GRID_CELL_BLOCK,
-                             (unsigned)SC_GRID_ASM_RANGES);
-                }
-                if (cell_end <= 2u * SC_GRID_ASM_SPAN) {
-                    /* up to two ranges: the serial loop's sums (every stored hash) */
-                    assert_int_equal(span, SC_GRID_ASM_SPAN);
-                } else {
-                    split++;
-                    balanced += ranges % 4u == 0u;
-                }
-            }
+    for (uint32_t m[3] = {1u, 2u, 2u}; next_mesh(m);) {
+        const uint32_t nx = m[0], ny = m[1], nz = m[2];
+        meshes++;
+        const uint32_t nxy = nx * ny, nn = nxy * nz;
+        const uint32_t cells = nn - (1u + nx + nxy);
+        const uint32_t cell_end =
+            (cells + SC_GRID_CELL_BLOCK - 1u) / SC_GRID_CELL_BLOCK * SC_GRID_CELL_BLOCK;
+        const uint32_t span = sc_grid_asm_span(nx, ny, nz);
+        const uint32_t ranges = (cell_end + span - 1u) / span;
+        if (span % SC_GRID_CELL_BLOCK != 0u || span <= nxy + nx + SC_GRID_CELL_BLOCK ||
+            ranges > SC_GRID_ASM_RANGES || ranges == 0u) {
+            fail_msg("%ux%ux%u: cell span %u, %u ranges (two apart needs > %u, at most %u "
+                     "ranges)",
+                     nx, ny, nz, span, ranges, nxy + nx + SC_GRID_CELL_BLOCK,
+                     (unsigned)SC_GRID_ASM_RANGES);
+        }
+        if (cell_end <= 2u * SC_GRID_ASM_SPAN) {
+            /* up to two ranges: the serial loop's sums (every stored hash) */
+            assert_int_equal(span, SC_GRID_ASM_SPAN);
+        } else {
+            split++;
+            balanced += ranges % 4u == 0u;
         }
     }
     print_message("%u meshes, %u split finer, %u of those into a multiple of four ranges\n", meshes,
@@ -56,32 +68,25 @@ static void lumen_ranges_are_two_apart_for_every_mesh(void **state)
 {
     (void)state;
     uint32_t meshes = 0, split = 0;
-    for (uint32_t nz = 2u; nz <= SC_MAX_MESH_NZ; nz++) {
-        for (uint32_t ny = 2u; ny <= SC_MAX_MESH_NY; ny++) {
-            for (uint32_t nx = 2u; nx <= SC_MAX_MESH_NX; nx++) {
-                if ((uint64_t)nx * ny * nz > SC_MAX_NODES) {
-                    continue;
-                }
-                meshes++;
-                const uint32_t cells = (nx - 1u) * (ny - 1u) * (nz - 1u);
-                uint32_t ranges = 0u, span = 0u;
-                sc_lumen_split(nx, ny, nz, &ranges, &span);
-                if (ranges == 0u || ranges > SC_LUMEN_RANGES || (uint64_t)ranges * span < cells ||
-                    (uint64_t)(ranges - 1u) * span >= cells) {
-                    fail_msg("%ux%ux%u: %u lumen ranges of %u cells for %u cells", nx, ny, nz,
-                             ranges, span, cells);
-                }
-                if (ranges == 1u) {
-                    continue;
-                }
-                split++;
-                /* cells c and c + d share a node only if d <= (nx - 1)(ny - 1) + nx; the
-                 * nearest cells of ranges two apart are span + 1 apart */
-                if (span + 1u <= (nx - 1u) * (ny - 1u) + nx) {
-                    fail_msg("%ux%ux%u: lumen ranges of %u cells, two apart share nodes", nx, ny,
-                             nz, span);
-                }
-            }
+    for (uint32_t m[3] = {1u, 2u, 2u}; next_mesh(m);) {
+        const uint32_t nx = m[0], ny = m[1], nz = m[2];
+        meshes++;
+        const uint32_t cells = (nx - 1u) * (ny - 1u) * (nz - 1u);
+        uint32_t ranges = 0u, span = 0u;
+        sc_lumen_split(nx, ny, nz, &ranges, &span);
+        if (ranges == 0u || ranges > SC_LUMEN_RANGES || (uint64_t)ranges * span < cells ||
+            (uint64_t)(ranges - 1u) * span >= cells) {
+            fail_msg("%ux%ux%u: %u lumen ranges of %u cells for %u cells", nx, ny, nz, ranges, span,
+                     cells);
+        }
+        if (ranges == 1u) {
+            continue;
+        }
+        split++;
+        /* cells c and c + d share a node only if d <= (nx - 1)(ny - 1) + nx; the nearest cells
+         * of ranges two apart are span + 1 apart */
+        if (span + 1u <= (nx - 1u) * (ny - 1u) + nx) {
+            fail_msg("%ux%ux%u: lumen ranges of %u cells, two apart share nodes", nx, ny, nz, span);
         }
     }
     print_message("%u meshes, %u with the lumen's passes split\n", meshes, split);
