@@ -6,9 +6,10 @@
 
 #include "sc_assert.h"
 #include "sc_err.h"
+#include "sc_simd.h"
+#include "sc_skin_kern.h"
 #include "sc_springs.h"
 
-#define SC_SKIN_MIN_LEN2_MM2 1e-12f
 
 sc_skin_def sc_skin_default_def(void)
 {
@@ -127,79 +128,24 @@ int sc_skin_init(sc_skin *s, const sc_skin_def *def)
     return SC_OK;
 }
 
-/* springs per chunk of the spring pass (stack: 3 x 4 x SC_SKIN_CHUNK bytes) */
-#define SC_SKIN_CHUNK 64u
-
+/* one Euler substep in the variant sc_simd_selected() names (sc_skin_kern.inc) */
 static void skin_substep(sc_skin *s)
 {
-    const uint32_t nn = s->count;
-    const float dt = s->def.dt_s, g = SC_SPRINGS_GAMMA_PER_K_S, ka = s->def.k_anchor_n_per_mm;
-    float *restrict x = s->x, *restrict y = s->y, *restrict z = s->z;
-    float *restrict vx = s->vx, *restrict vy = s->vy, *restrict vz = s->vz;
-    float *restrict ax_ = s->ax, *restrict ay_ = s->ay, *restrict az_ = s->az;
-    for (uint32_t n = 0; n < nn; n++) {
-        /* zero-length anchor (Voigt): -k (x - x0) - gamma v */
-        ax_[n] = s->fx[n] - ka * (x[n] - s->rest_x[n]) - g * ka * vx[n];
-        ay_[n] = s->fy[n] - ka * (y[n] - s->rest_y[n]) - g * ka * vy[n];
-        az_[n] = s->fz[n] - ka * (z[n] - s->rest_z[n]) - g * ka * vz[n];
+    const sc_simd v = sc_simd_selected();
+    (void)v;
+#if defined(SC_SIMD_X86_64_V4_BUILT)
+    if (v == SC_SIMD_X86_64_V4) {
+        sc_skin_substep_x86_64_v4(s);
+        return;
     }
-    /* Springs in chunks: the chunk's forces first (no dependence between springs: the loop
-     * vectorises), then the far ends' subtractions, then the origins' additions. A node j
-     * gets -F(j - o) before +F(j), as in the one-pass loop it replaces (spring j - o is in
-     * j's chunk or an earlier one), so the sums are bit-identical to it. */
-    float tx[SC_SKIN_CHUNK], ty[SC_SKIN_CHUNK], tz[SC_SKIN_CHUNK];
-    for (uint32_t f = 0; f < SC_SKIN_FAMILIES; f++) {
-        const uint32_t o = s->off[f];
-        const float *restrict k = s->k_fam[f], *restrict l0 = s->l0_fam[f];
-        const uint32_t end = o < nn ? nn - o : 0u;
-        for (uint32_t n0 = 0; n0 < end; n0 += SC_SKIN_CHUNK) {
-            const uint32_t c = end - n0 < SC_SKIN_CHUNK ? end - n0 : SC_SKIN_CHUNK;
-            for (uint32_t i = 0; i < c; i++) {
-                const uint32_t n = n0 + i, m = n + o;
-                const float dx = x[m] - x[n], dy = y[m] - y[n], dz = z[m] - z[n];
-                const float len2 = dx * dx + dy * dy + dz * dz;
-                const float len = sqrtf(len2 + SC_SKIN_MIN_LEN2_MM2);
-                const float inv = 1.0f / len;
-                const float rate = (dx * (vx[m] - vx[n]) + dy * (vy[m] - vy[n]) +
-                                    dz * (vz[m] - vz[n])) * inv;
-                const float sc = k[n] * ((len - l0[n]) + g * rate) * inv;
-                tx[i] = sc * dx;
-                ty[i] = sc * dy;
-                tz[i] = sc * dz;
-            }
-            { /* the far ends (each block's pointers are its only access to those rows) */
-                float *restrict ex = ax_ + n0 + o, *restrict ey = ay_ + n0 + o,
-                                *restrict ez = az_ + n0 + o;
-                for (uint32_t i = 0; i < c; i++) {
-                    ex[i] -= tx[i];
-                    ey[i] -= ty[i];
-                    ez[i] -= tz[i];
-                }
-            }
-            { /* the origins */
-                float *restrict bx = ax_ + n0, *restrict by = ay_ + n0, *restrict bz = az_ + n0;
-                for (uint32_t i = 0; i < c; i++) {
-                    bx[i] += tx[i];
-                    by[i] += ty[i];
-                    bz[i] += tz[i];
-                }
-            }
-        }
+#endif
+#if defined(SC_SIMD_X86_64_V3_BUILT)
+    if (v == SC_SIMD_X86_64_V3) {
+        sc_skin_substep_x86_64_v3(s);
+        return;
     }
-    const float keep = 1.0f - dt * s->def.drag_per_s;
-    for (uint32_t n = 0; n < nn; n++) {
-        const float w = s->inv_mass[n] * dt;
-        vx[n] = keep * vx[n] + w * ax_[n];
-        vy[n] = keep * vy[n] + w * ay_[n];
-        vz[n] = keep * vz[n] + w * az_[n];
-        /* keep decaying velocities out of the (slow) subnormal range, as sc_msds */
-        vx[n] = fabsf(vx[n]) < 1e-12f ? 0.0f : vx[n];
-        vy[n] = fabsf(vy[n]) < 1e-12f ? 0.0f : vy[n];
-        vz[n] = fabsf(vz[n]) < 1e-12f ? 0.0f : vz[n];
-        x[n] += dt * vx[n];
-        y[n] += dt * vy[n];
-        z[n] += dt * vz[n];
-    }
+#endif
+    sc_skin_substep_generic(s);
 }
 
 float sc_skin_max_displacement_mm(const sc_skin *s)

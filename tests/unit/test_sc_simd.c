@@ -16,7 +16,9 @@
 #include "sc_mesh.h"
 #include "sc_msds.h"
 #include "sc_msds_implicit.h"
+#include "sc_collider.h"
 #include "sc_simd.h"
+#include "sc_skin.h"
 #include "sc_springs.h"
 
 static sc_mesh g_mesh;
@@ -26,6 +28,7 @@ static sc_msds g_msds;
 static sc_material_table g_mat;
 static sc_fem g_fem;
 static uint8_t g_kin[SC_MAX_NODES];
+static sc_skin g_skin;
 
 static uint64_t fnv_floats(uint64_t h, const float *p, uint32_t n)
 {
@@ -220,6 +223,72 @@ static void implicit_solver_variants_give_identical_bits(void **state)
     printf("# %d implicit comparisons (best variant here: %s)\n", compared, sc_simd_name(best));
 }
 
+/* The skin (sc_skin_kern.inc) pressed by a sphere, held and lifted, on a grid whose rows and
+ * spring families are no multiple of any vector width (the tails run). Returns the hash of the
+ * positions and velocities; *dent_mm: the deepest displacement while pressed. */
+static uint64_t run_skin(uint32_t nx, uint32_t ny, float *dent_mm)
+{
+    sc_skin_def d = sc_skin_default_def();
+    d.nx = nx;
+    d.ny = ny;
+    assert_int_equal(sc_skin_init(&g_skin, &d), SC_OK);
+    sc_collider_def cd = sc_collider_default_def();
+    cd.shape = SC_COLLIDER_SPHERE;
+    cd.sphere_radius_mm = 8.0f;
+    sc_collider c;
+    assert_int_equal(sc_collider_init(&c, &cd), SC_OK);
+    *dent_mm = 0.0f;
+    for (int f = 0; f < 60; f++) {
+        sc_pose p = sc_pose_identity();
+        p.pos_mm[0] = 17.0f + 0.1f * (float)f; /* sliding sideways as it presses */
+        p.pos_mm[1] = 9.0f;
+        p.pos_mm[2] = f < 40 ? -0.5f + 3.0f * (float)(f + 1) / 40.0f : -5.0f;
+        assert_int_equal(sc_collider_set_pose(&c, &p), SC_OK);
+        sc_skin_step(&g_skin, &c);
+        if (f < 40) {
+            const float m = sc_skin_max_displacement_mm(&g_skin);
+            *dent_mm = m > *dent_mm ? m : *dent_mm;
+        }
+    }
+    uint64_t h = 1469598103934665603ull;
+    h = fnv_floats(h, g_skin.x, g_skin.count);
+    h = fnv_floats(h, g_skin.y, g_skin.count);
+    h = fnv_floats(h, g_skin.z, g_skin.count);
+    h = fnv_floats(h, g_skin.vx, g_skin.count);
+    h = fnv_floats(h, g_skin.vy, g_skin.count);
+    return fnv_floats(h, g_skin.vz, g_skin.count);
+}
+
+/* Every variant gives the generic variant's bits for the skin's substep. */
+static void skin_variants_give_identical_bits(void **state)
+{
+    (void)state;
+    const sc_simd best = sc_cpu_best_simd();
+    static const uint32_t shapes[2][2] = {{32u, 16u}, {37u, 19u}};
+    int compared = 0;
+    for (uint32_t sh = 0; sh < 2u; sh++) {
+        assert_int_equal(sc_simd_select(SC_SIMD_GENERIC), SC_OK);
+        float dent = 0.0f;
+        const uint64_t ref = run_skin(shapes[sh][0], shapes[sh][1], &dent);
+        assert_true(dent > 1.0f); /* the sphere did press the skin */
+        for (int v = 1; v < (int)SC_SIMD_COUNT; v++) {
+            if (!sc_simd_built((sc_simd)v) || v > (int)best) {
+                continue;
+            }
+            assert_int_equal(sc_simd_select((sc_simd)v), SC_OK);
+            float dv = 0.0f;
+            const uint64_t h = run_skin(shapes[sh][0], shapes[sh][1], &dv);
+            printf("# skin %ux%u: generic %016llx (dent %.3f mm), %s %016llx\n", shapes[sh][0],
+                   shapes[sh][1], (unsigned long long)ref, (double)dent,
+                   sc_simd_name((sc_simd)v), (unsigned long long)h);
+            assert_true(h == ref);
+            compared++;
+        }
+    }
+    assert_int_equal(sc_simd_select(SC_SIMD_GENERIC), SC_OK);
+    printf("# %d skin comparisons (best variant here: %s)\n", compared, sc_simd_name(best));
+}
+
 static void selection_refuses_what_is_not_there(void **state)
 {
     (void)state;
@@ -257,6 +326,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(variants_give_identical_bits),
         cmocka_unit_test(implicit_solver_variants_give_identical_bits),
+        cmocka_unit_test(skin_variants_give_identical_bits),
         cmocka_unit_test(selection_refuses_what_is_not_there),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -1,0 +1,10 @@
+/* sc_skin_kern_x86_64_v4.c: the skin's substep (sc_skin_kern.inc) for the x86-64-v4 level
+ * (AVX-512: 16-float vectors), built with -march=x86-64-v4 where the compiler takes it
+ * (SC_SIMD_X86_64_V4_BUILT); elsewhere this unit is empty. The same source, so the same bits. */
+#if defined(SC_SIMD_X86_64_V4_BUILT)
+#define SC_VEC_W           16u
+#define SC_SKIN_SUBSTEP_FN sc_skin_substep_x86_64_v4
+#include "sc_skin_kern.inc"
+#else
+typedef int sc_skin_kern_x86_64_v4_unused; /* ISO C: a translation unit is not empty */
+#endif
