@@ -239,6 +239,7 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
     g->rest_saved = 0u;
     g->rest_patched = 0u;
     g->prefetch = (uint8_t)(nn > SC_GRID_PREFETCH_NODES);
+    g->springs_fused = (uint8_t)(nn > SC_GRID_SPRINGS_FUSED_NODES);
     g->step_max_mm = 2.0f * sqrtf(m->cell_mm[0] * m->cell_mm[0] + m->cell_mm[1] * m->cell_mm[1] +
                                   m->cell_mm[2] * m->cell_mm[2]);
     init_slots(g);

@@ -141,6 +141,16 @@ _Static_assert(SC_GRID_POOL_RANGE % SC_GRID_CHUNK == 0u && SC_GRID_SUM_BLOCK % 1
 #ifndef SC_GRID_PREFETCH_NODES
 #define SC_GRID_PREFETCH_NODES 8192u
 #endif
+/* The stable MSDS's springs in one pass over the nodes (sc_grid_kern.inc, springs_range: each
+ * spring evaluated at both its ends, no scratch rows) on meshes of more than this many nodes, per
+ * family in two passes through scratch rows on the others: the same bits either way, a speed
+ * choice by the mesh alone. The one pass reads and writes about a sixth of the rows and does
+ * 2.3x the spring arithmetic: `bench-physics 20 stages 64x32x32`, one worker, springs 4.47 ->
+ * 3.98 ms; `bench-physics 100 stages 32x16x16` 0.33-0.34 -> 0.43 ms (the rows stay in cache
+ * there, the arithmetic shows). */
+#ifndef SC_GRID_SPRINGS_FUSED_NODES
+#define SC_GRID_SPRINGS_FUSED_NODES 8192u
+#endif
 #define SC_GRID_MAT_ROWS 60u /* d 6, e 27, f 27: row k of the matrix at &d[0][0] + k ROW */
 
 /* The cell passes (FEM assembly, the MSDS's volume terms) on the worker pool: the cell origins
@@ -211,6 +221,8 @@ typedef struct sc_grid {
     uint32_t range;     /* nodes per range of the node loops and the CG (SC_GRID_POOL_RANGE) */
     uint8_t rest_saved; /* 1: rest[] holds a rest K (sc_grid_save_rest; 0 after sc_grid_init) */
     uint8_t prefetch;   /* 1: the kernels prefetch (node_count > SC_GRID_PREFETCH_NODES) */
+    uint8_t springs_fused; /* 1: the MSDS's springs in one pass (node_count >
+                              SC_GRID_SPRINGS_FUSED_NODES; either value gives the same bits) */
     uint8_t rest_patched; /* 1: the matrix is the rest K but for a floor_only pass's additions in
                              the cell ranges marked in floor_dirty (0 after sc_grid_clear) */
     uint8_t floor_dirty[SC_GRID_ASM_RANGES];
