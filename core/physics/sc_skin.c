@@ -10,7 +10,6 @@
 #include "sc_skin_kern.h"
 #include "sc_springs.h"
 
-
 sc_skin_def sc_skin_default_def(void)
 {
     sc_skin_def d;
