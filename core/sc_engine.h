@@ -23,15 +23,17 @@
  *            assembly, plausibility; commands authenticated (AES-CMAC and freshness, at most
  *            one 2-block CMAC per frame drained) and queued, not applied), the newest valid
  *            pose carried tracker -> volume frame with the case's registration. O(burst).
- *   physics  sc_probe_in -> sc_tissue_out (contact, node state of the tet mesh).
- *            One tissue step (sc_tissue.h): MSDS O(iterations x nodes) or FEM O(iterations x
- *            nonzeros), collider O(contact candidates), skin, stability guard O(nodes).
+ *   physics  sc_probe_in -> sc_tissue_out (contact, node state of the tet mesh, the probe's
+ *            force). One tissue step (sc_tissue.h): MSDS O(iterations x nodes) or FEM
+ *            O(iterations x nonzeros), collider O(contact candidates), skin, stability guard
+ *            O(nodes); in contact the probe's force, O(contacts) (sc_tissue_probe_force_n:
+ *            the step's matrix is still in the caches).
  *   imaging  sc_tissue_out -> sc_image_out (scan lines to the display, the compression
  *            measure). O(lines x samples) plus the tets each line crosses (sc_bscan.h); every
  *            line leaves through the display HAL as soon as it is computed, the frame's
  *            compression measure closes the display frame (hal/sc_hal_display.h). Then the
- *            exam's assessment takes the frame (sc_assess.h: O(1), and the probe's force,
- *            O(contacts), sc_tissue_probe_force_n).
+ *            exam's assessment takes the frame and the physics stage's force (sc_assess.h:
+ *            O(1)).
  *   status   sc_image_out -> CAN status frames every status_period_ms: the four status
  *            frames and the three assessment frames (0x210..0x212). O(1).
  *            Then, when hal->state is present, the console state stream (sc_state.h): at most
@@ -218,6 +220,8 @@ typedef struct sc_probe_in {
 typedef struct sc_tissue_out {
     uint8_t contact;         /* the collider touches the tissue */
     uint8_t reset;           /* the stability guard reset the tissue this frame */
+    float force_n;           /* the probe's force on the tissue (sc_tissue_probe_force_n), N;
+                                SC_FORCE_NOT_AVAILABLE without a case or contact */
     const sc_mesh *mesh;     /* NULL without a case */
     const sc_nodes *nodes;
 } sc_tissue_out;
