@@ -259,6 +259,40 @@ static void split(sc_lumen *l, const sc_mesh *m)
     l->span_tets = ranges > 1u ? 5u * span : m->tet_count;
 }
 
+#if SC_LUMEN_RANGES > 1
+#define LIST_TET(e) ((e)&0xFFFFFu)
+#define LIST_SLICE(e) (((e) >> 20) & 0x1Fu)
+#define LIST_FACES(e) (((e) >> 25) & 0xFu)
+_Static_assert(SC_MAX_TETS <= 0x100000u && SC_LUMEN_SLICES <= 32u,
+               "a lumen tet's index and section fit their bits of sc_lumen.list");
+
+static void range_tets(const sc_lumen *l, const sc_mesh *m, uint32_t r, uint32_t *t0, uint32_t *t1);
+
+/* sc_lumen.list (sc_lumen.h): per range, its lumen tets in tet order */
+static void build_list(sc_lumen *l, const sc_mesh *m)
+{
+    uint32_t n = 0;
+    for (uint32_t r = 0; r < l->ranges; r++) {
+        l->list_start[r] = n;
+        uint32_t t0, t1;
+        range_tets(l, m, r, &t0, &t1);
+        for (uint32_t t = t0; t < t1; t++) {
+            const uint8_t k = l->region[t];
+            if (k == 0u) {
+                continue;
+            }
+            uint32_t faces = 0;
+            for (uint32_t f = 0; f < 4u; f++) {
+                const int32_t nb = m->tet_nbr[t][f];
+                faces |= (nb >= 0 && l->region[nb] == 0u) ? 1u << f : 0u;
+            }
+            l->list[n++] = t | (slice_of(&l->v[k - 1u], m, t) << 20) | (faces << 25);
+        }
+    }
+    l->list_start[l->ranges] = n;
+}
+#endif
+
 int sc_lumen_init(sc_lumen *l, const sc_mesh *m, const sc_material_table *mat)
 {
     if (l == NULL || m == NULL || mat == NULL || m->tet_count > SC_MAX_TETS) {
@@ -356,6 +390,9 @@ int sc_lumen_init(sc_lumen *l, const sc_mesh *m, const sc_material_table *mat)
         sections(l, m, k);
     }
     split(l, m);
+#if SC_LUMEN_RANGES > 1
+    build_list(l, m);
+#endif
     sc_lumen_reset(l);
     return SC_OK;
 }
@@ -439,9 +476,11 @@ static float law(const sc_lumen_vessel *v, float s)
     return v->bulk_pa * s;
 }
 
+#if SC_LUMEN_RANGES == 1
 /* The first tet from t on with a region (nt if none): the frame's loops visit the lumens' tets
  * alone, in tet order (the sums' order unchanged), skipping the rest eight region bytes at a time
- * (the lumens are a few percent of the tets: the byte-per-tet scan was most of these passes). */
+ * (the lumens are a few percent of the tets: the byte-per-tet scan was most of these passes).
+ * Builds with more than one range read sc_lumen.list instead. */
 static uint32_t next_region_tet(const uint8_t *region, uint32_t t, uint32_t nt)
 {
     while (t + 8u <= nt) {
@@ -457,6 +496,7 @@ static uint32_t next_region_tet(const uint8_t *region, uint32_t t, uint32_t nt)
     }
     return t;
 }
+#endif
 
 /* one frame's passes on the pool: the lumen, the mesh, the state, the pressures, the phase */
 typedef struct lumen_job {
@@ -467,6 +507,7 @@ typedef struct lumen_job {
     sc_nodes *n;
     const float (*press)[SC_LUMEN_SLICES];
     uint32_t phase; /* 0: the even ranges, 1: the odd ones (forces, clear) */
+    float *list_vol; /* sc_lumen.list_vol (the lists' builds) */
 } lumen_job;
 
 static void range_tets(const sc_lumen *l, const sc_mesh *m, uint32_t r, uint32_t *t0, uint32_t *t1)
@@ -486,6 +527,14 @@ static void job_volume(void *arg, uint32_t r)
     const sc_nodes *n = j->n;
     float(*vol)[SC_LUMEN_SLICES] = j->part_vol[r];
     memset(vol, 0, sizeof j->part_vol[r]);
+#if SC_LUMEN_RANGES > 1
+    for (uint32_t i = l->list_start[r]; i < l->list_start[r + 1u]; i++) {
+        const uint32_t e = l->list[i], t = LIST_TET(e);
+        const float v = sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[t]);
+        j->list_vol[i] = v;
+        vol[l->region[t] - 1u][LIST_SLICE(e)] += v;
+    }
+#else
     uint32_t t0, t1;
     range_tets(l, m, r, &t0, &t1);
     for (uint32_t t = next_region_tet(l->region, t0, t1); t < t1;
@@ -493,6 +542,34 @@ static void job_volume(void *arg, uint32_t r)
         const uint8_t k = l->region[t];
         vol[k - 1u][slice_of(&l->v[k - 1u], m, t)] +=
             sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[t]);
+    }
+#endif
+}
+
+/* the pressure pk on face f of lumen tet tv (its wall tet across not crushed): a third of the
+ * face's outward area vector times pk onto each of its nodes */
+static inline void face_force(sc_nodes *n, const uint32_t *tv, uint32_t f, float pk)
+{
+    uint32_t q[3];
+    face_nodes(tv, f, q);
+    const float ax = n->x[q[1]] - n->x[q[0]], ay = n->y[q[1]] - n->y[q[0]],
+                az = n->z[q[1]] - n->z[q[0]];
+    const float bx = n->x[q[2]] - n->x[q[0]], by = n->y[q[2]] - n->y[q[0]],
+                bz = n->z[q[2]] - n->z[q[0]];
+    float cx = 0.5f * (ay * bz - az * by), cy = 0.5f * (az * bx - ax * bz),
+          cz = 0.5f * (ax * by - ay * bx);
+    /* outward: away from the tet's fourth vertex */
+    const uint32_t o = tv[f];
+    const float ox = n->x[q[0]] - n->x[o], oy = n->y[q[0]] - n->y[o], oz = n->z[q[0]] - n->z[o];
+    if (cx * ox + cy * oy + cz * oz < 0.0f) {
+        cx = -cx;
+        cy = -cy;
+        cz = -cz;
+    }
+    for (uint32_t a = 0; a < 3u; a++) {
+        n->fx[q[a]] += pk * cx;
+        n->fy[q[a]] += pk * cy;
+        n->fz[q[a]] += pk * cz;
     }
 }
 
@@ -504,9 +581,31 @@ static void job_forces(void *arg, uint32_t i)
     const sc_mesh *m = j->m;
     sc_nodes *n = j->n;
     const uint32_t r = 2u * i + j->phase;
+    uint32_t faces = 0;
+#if SC_LUMEN_RANGES > 1
+    for (uint32_t e = l->list_start[r]; e < l->list_start[r + 1u]; e++) {
+        const uint32_t w = l->list[e], t = LIST_TET(w);
+        const uint32_t *tv = m->tet[t];
+        if (!(j->list_vol[e] > 0.0f)) {
+            continue; /* an inverted (crushed) lumen tet: its faces have no outward side */
+        }
+        const float pk = j->press[l->region[t] - 1u][LIST_SLICE(w)];
+        for (uint32_t f = 0; f < 4u; f++) {
+            /* the faces with tissue across (LIST_FACES; not the hull, where the vessel goes on,
+             * nor a lumen, its own or another vessel's: a shared wall loaded by both lumens let
+             * an artery's pressure drive the filler of a crushed vein beside it far off in the
+             * robustness test), whose wall tet across is not crushed */
+            if ((LIST_FACES(w) & (1u << f)) == 0u ||
+                !(sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[m->tet_nbr[t][f]]) > 0.0f)) {
+                continue;
+            }
+            face_force(n, tv, f, pk);
+            faces++;
+        }
+    }
+#else
     uint32_t t0, t1;
     range_tets(l, m, r, &t0, &t1);
-    uint32_t faces = 0;
     for (uint32_t t = next_region_tet(l->region, t0, t1); t < t1;
          t = next_region_tet(l->region, t + 1u, t1)) {
         const uint8_t rg = l->region[t];
@@ -526,31 +625,11 @@ static void job_forces(void *arg, uint32_t i)
             if (!(sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[nb]) > 0.0f)) {
                 continue; /* the wall tet across is crushed: no face to push on */
             }
-            uint32_t q[3];
-            face_nodes(tv, f, q);
-            const float ax = n->x[q[1]] - n->x[q[0]], ay = n->y[q[1]] - n->y[q[0]],
-                        az = n->z[q[1]] - n->z[q[0]];
-            const float bx = n->x[q[2]] - n->x[q[0]], by = n->y[q[2]] - n->y[q[0]],
-                        bz = n->z[q[2]] - n->z[q[0]];
-            float cx = 0.5f * (ay * bz - az * by), cy = 0.5f * (az * bx - ax * bz),
-                  cz = 0.5f * (ax * by - ay * bx);
-            /* outward: away from the tet's fourth vertex */
-            const uint32_t o = tv[f];
-            const float ox = n->x[q[0]] - n->x[o], oy = n->y[q[0]] - n->y[o],
-                        oz = n->z[q[0]] - n->z[o];
-            if (cx * ox + cy * oy + cz * oz < 0.0f) {
-                cx = -cx;
-                cy = -cy;
-                cz = -cz;
-            }
-            for (uint32_t a = 0; a < 3u; a++) {
-                n->fx[q[a]] += pk * cx;
-                n->fy[q[a]] += pk * cy;
-                n->fz[q[a]] += pk * cz;
-            }
+            face_force(n, tv, f, pk);
             faces++;
         }
     }
+#endif
     j->part_faces[r] = faces;
 }
 
@@ -561,8 +640,26 @@ static void job_clear(void *arg, uint32_t i)
     const sc_lumen *l = j->l;
     const sc_mesh *m = j->m;
     sc_nodes *n = j->n;
+    const uint32_t r = 2u * i + j->phase;
+#if SC_LUMEN_RANGES > 1
+    for (uint32_t e = l->list_start[r]; e < l->list_start[r + 1u]; e++) {
+        const uint32_t w = l->list[e];
+        for (uint32_t f = 0; f < 4u; f++) {
+            if ((LIST_FACES(w) & (1u << f)) == 0u) {
+                continue;
+            }
+            uint32_t q[3];
+            face_nodes(m->tet[LIST_TET(w)], f, q);
+            for (uint32_t a = 0; a < 3u; a++) {
+                n->fx[q[a]] = 0.0f;
+                n->fy[q[a]] = 0.0f;
+                n->fz[q[a]] = 0.0f;
+            }
+        }
+    }
+#else
     uint32_t t0, t1;
-    range_tets(l, m, 2u * i + j->phase, &t0, &t1);
+    range_tets(l, m, r, &t0, &t1);
     for (uint32_t t = next_region_tet(l->region, t0, t1); t < t1;
          t = next_region_tet(l->region, t + 1u, t1)) {
         for (uint32_t f = 0; f < 4u; f++) {
@@ -579,6 +676,7 @@ static void job_clear(void *arg, uint32_t i)
             }
         }
     }
+#endif
 }
 
 /* the even ranges' job, then the odd ranges' (ranges two apart share no node) */
@@ -606,7 +704,11 @@ void sc_lumen_apply(sc_lumen *l, const sc_mesh *m, sc_nodes *n)
     float part1[1][SC_LUMEN_MAX][SC_LUMEN_SLICES]; /* one range: on the stack */
     float(*part)[SC_LUMEN_MAX][SC_LUMEN_SLICES] = part1;
 #endif
-    lumen_job j = {l, part, l->part_faces, m, n, NULL, 0u};
+#if SC_LUMEN_RANGES > 1
+    lumen_job j = {l, part, l->part_faces, m, n, NULL, 0u, l->list_vol};
+#else
+    lumen_job j = {l, part, l->part_faces, m, n, NULL, 0u, NULL};
+#endif
     sc_pool_run(l->pool, job_volume, &j, l->ranges);
     /* the ranges' partial volumes added to the first's in range order (one range: the serial
      * loop's sum) */
@@ -664,6 +766,6 @@ void sc_lumen_clear(const sc_lumen *l, const sc_mesh *m, sc_nodes *n)
     if (l->faces == 0u) {
         return;
     }
-    lumen_job j = {l, NULL, NULL, m, n, NULL, 0u};
+    lumen_job j = {l, NULL, NULL, m, n, NULL, 0u, NULL};
     run_phases(l, job_clear, &j);
 }

@@ -185,6 +185,18 @@ typedef struct sc_lumen {
 #endif
     uint32_t part_faces[SC_LUMEN_RANGES];
     uint8_t region[SC_MAX_TETS];    /* vessel of each tet, 1..count; 0: none */
+#if SC_LUMEN_RANGES > 1
+    /* The lumens' tets in tet order, each packed with what does not change after
+     * sc_lumen_init: the tet (bits 0..19), its section (20..24), the faces it loads (25..28:
+     * no lumen across them); range r's from list_start[r]. The frame's passes read these
+     * instead of scanning the region bytes and finding the sections and the faces again, and
+     * the forces take the volume pass's own volumes (list_vol): the same operations in the same
+     * order (a 64x32x32 press on two workers spent 1 ms a frame in these passes). The MCU, whose
+     * limits keep one range, scans as before (its SRAM has no room for 8 bytes a tet). */
+    uint32_t list_start[SC_LUMEN_RANGES + 1u];
+    uint32_t list[SC_MAX_TETS];
+    float list_vol[SC_MAX_TETS];   /* the last volume pass's tet volumes, mm^3, list order */
+#endif
 } sc_lumen;
 
 /* The laws of config/sc_materials.h, per label (SC_LUMEN_NONE elsewhere). O(labels). */
