@@ -883,7 +883,8 @@ static inline uint32_t sc_ctz64(uint64_t x)
 
 /* Tet t into the plane tets when the plane cuts it (not flat, in front of some line): 0 when
  * the plane tets are over their limit. */
-static int add_plane_tet(sc_bscan *b, const sc_mesh *m, uint32_t t, uint32_t *np_io)
+static int add_plane_tet(sc_bscan *b, const sc_mesh *m, uint32_t t, uint32_t *np_io,
+                         uint32_t limit)
 {
     const uint32_t np = *np_io;
     const uint32_t *tv = m->tet[t];
@@ -911,7 +912,7 @@ static int add_plane_tet(sc_bscan *b, const sc_mesh *m, uint32_t t, uint32_t *np
     if (!sc_scan_geom_line_range(&b->geom, xmin, xmax, zmin, zmax, &lo, &hi)) {
         return 1;
     }
-    if (np >= SC_BSCAN_MAX_PLANE_TETS) {
+    if (np >= limit) {
         return 0;
     }
     sc_bscan_ptet *p = &b->ptets[np];
@@ -927,52 +928,114 @@ static int add_plane_tet(sc_bscan *b, const sc_mesh *m, uint32_t t, uint32_t *np
     return 1;
 }
 
+/* The plane tets of a grid mesh's cells between node layers k_begin - 1 .. k_end - 1: the cells
+ * with corners on both sides of the plane, found from 64-bit masks of the node rows (bit i:
+ * y > 0), two layers of rows at a time: O(nodes) plus the cut cells' tets instead of a pass over
+ * every tet; the same tets in the same (ascending) order, as a tet cut by the plane has its
+ * corners among its cell's. Written from ptets[*np_io] on, below limit; 0 when over it. */
+static int cut_layers(sc_bscan *b, const sc_mesh *m, uint32_t k_begin, uint32_t k_end,
+                      uint32_t *np_io, uint32_t limit)
+{
+    const uint32_t nx = m->nx, ny = m->ny;
+    uint64_t rows[2][SC_MAX_MESH_NY];
+    const uint64_t cells_x = ((uint64_t)1 << (nx - 1u)) - 1u; /* nx <= 64 */
+    for (uint32_t k = k_begin - 1u; k < k_end; k++) {
+        uint64_t *cur = rows[k & 1u];
+        for (uint32_t j = 0; j < ny; j++) {
+            const float *qy = &b->qy[nx * (j + ny * k)];
+            uint64_t mk = 0;
+            for (uint32_t i = 0; i < nx; i++) {
+                mk |= (uint64_t)(qy[i] > 0.0f) << i;
+            }
+            cur[j] = mk;
+        }
+        if (k + 1u == k_begin) {
+            continue;
+        }
+        const uint64_t *prev = rows[(k - 1u) & 1u];
+        for (uint32_t j = 0; j + 1u < ny; j++) {
+            const uint64_t any = prev[j] | prev[j + 1u] | cur[j] | cur[j + 1u];
+            const uint64_t all = prev[j] & prev[j + 1u] & cur[j] & cur[j + 1u];
+            uint64_t cut = (any | (any >> 1)) & ~(all & (all >> 1)) & cells_x;
+            const uint32_t c0 = (nx - 1u) * (j + (ny - 1u) * (k - 1u));
+            while (cut != 0u) {
+                const uint32_t i = sc_ctz64(cut);
+                cut &= cut - 1u;
+                for (uint32_t t = 5u * (c0 + i); t < 5u * (c0 + i) + 5u; t++) {
+                    if (!add_plane_tet(b, m, t, np_io, limit)) {
+                        return 0;
+                    }
+                }
+            }
+        }
+    }
+    return 1;
+}
+
+#if SC_BSCAN_RANGES > 1
+/* The cut layers on the pool: part p takes a share of the node layers and writes its tets from
+ * ptets[p * cap] on (cap: its share of the capacity); the parts are then moved together in
+ * part order, which is tet order: the serial pass's tets, order and maps. */
+typedef struct cut_job {
+    sc_bscan *b;
+    const sc_mesh *m;
+    uint32_t parts, cap;
+    uint32_t n[SC_BSCAN_RANGES];
+    uint8_t ok[SC_BSCAN_RANGES];
+} cut_job;
+
+static void job_cut(void *arg, uint32_t p)
+{
+    cut_job *j = (cut_job *)arg;
+    const uint32_t layers = j->m->nz - 1u;
+    const uint32_t k0 = 1u + (uint32_t)(((uint64_t)p * layers) / j->parts);
+    const uint32_t k1 = 1u + (uint32_t)(((uint64_t)(p + 1u) * layers) / j->parts);
+    uint32_t np = p * j->cap;
+    j->ok[p] = (uint8_t)(k0 >= k1 || cut_layers(j->b, j->m, k0, k1, &np, (p + 1u) * j->cap));
+    j->n[p] = np - p * j->cap;
+}
+#endif
+
 /* Returns 0 when the path's limits are exceeded (the caller then walks this frame). */
 static int build_regions(sc_bscan *b, const sc_mesh *m)
 {
     const uint32_t lines = b->def.scan.lines_n, regions = b->def.regions_n;
     uint32_t np = 0;
     if (b->mesh_grid) {
-        /* the cells with corners on both sides of the plane, found from 64-bit masks of the
-         * node rows (bit i: y > 0), two layers of rows at a time: O(nodes) plus the cut cells'
-         * tets instead of a pass over every tet; the same tets in the same (ascending) order,
-         * as a tet cut by the plane has its corners among its cell's */
-        const uint32_t nx = m->nx, ny = m->ny, nz = m->nz;
-        uint64_t rows[2][SC_MAX_MESH_NY];
-        const uint64_t cells_x = ((uint64_t)1 << (nx - 1u)) - 1u; /* nx <= 64 */
-        for (uint32_t k = 0; k < nz; k++) {
-            uint64_t *cur = rows[k & 1u];
-            for (uint32_t j = 0; j < ny; j++) {
-                const float *qy = &b->qy[nx * (j + ny * k)];
-                uint64_t mk = 0;
-                for (uint32_t i = 0; i < nx; i++) {
-                    mk |= (uint64_t)(qy[i] > 0.0f) << i;
+        int done = 0;
+#if SC_BSCAN_RANGES > 1
+        if (sc_pool_workers(b->pool) > 1u && m->nz > 2u) {
+            /* 64x32x32 on two workers: 0.51-0.56 ms a frame on the caller alone */
+            cut_job j;
+            j.b = b;
+            j.m = m;
+            j.parts = m->nz - 1u < SC_BSCAN_RANGES ? m->nz - 1u : SC_BSCAN_RANGES;
+            j.cap = SC_BSCAN_MAX_PLANE_TETS / j.parts;
+            sc_pool_run(b->pool, job_cut, &j, j.parts);
+            done = 1;
+            for (uint32_t p = 0; p < j.parts; p++) {
+                done &= j.ok[p];
+            }
+            for (uint32_t p = 0; done && p < j.parts; p++) {
+                const uint32_t from = p * j.cap;
+                if (from != np && j.n[p] > 0u) {
+                    memmove(&b->ptets[np], &b->ptets[from], j.n[p] * sizeof b->ptets[0]);
+                    memmove(&b->ptet_lo[np], &b->ptet_lo[from], j.n[p] * sizeof b->ptet_lo[0]);
+                    memmove(&b->ptet_hi[np], &b->ptet_hi[from], j.n[p] * sizeof b->ptet_hi[0]);
                 }
-                cur[j] = mk;
+                np += j.n[p];
             }
-            if (k == 0u) {
-                continue;
+            if (!done) {
+                np = 0; /* a part over its share: the whole pass on the caller decides */
             }
-            const uint64_t *prev = rows[(k - 1u) & 1u];
-            for (uint32_t j = 0; j + 1u < ny; j++) {
-                const uint64_t any = prev[j] | prev[j + 1u] | cur[j] | cur[j + 1u];
-                const uint64_t all = prev[j] & prev[j + 1u] & cur[j] & cur[j + 1u];
-                uint64_t cut = (any | (any >> 1)) & ~(all & (all >> 1)) & cells_x;
-                const uint32_t c0 = (nx - 1u) * (j + (ny - 1u) * (k - 1u));
-                while (cut != 0u) {
-                    const uint32_t i = sc_ctz64(cut);
-                    cut &= cut - 1u;
-                    for (uint32_t t = 5u * (c0 + i); t < 5u * (c0 + i) + 5u; t++) {
-                        if (!add_plane_tet(b, m, t, &np)) {
-                            return 0;
-                        }
-                    }
-                }
-            }
+        }
+#endif
+        if (!done && !cut_layers(b, m, 1u, m->nz, &np, SC_BSCAN_MAX_PLANE_TETS)) {
+            return 0;
         }
     } else {
         for (uint32_t t = 0; t < m->tet_count; t++) {
-            if (!add_plane_tet(b, m, t, &np)) {
+            if (!add_plane_tet(b, m, t, &np, SC_BSCAN_MAX_PLANE_TETS)) {
                 return 0;
             }
         }
