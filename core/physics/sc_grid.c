@@ -843,6 +843,75 @@ int sc_grid_block(const sc_grid *g, uint32_t i, uint32_t j, float out[9])
     return 1;
 }
 
+void sc_grid_row_disp(const sc_grid *g, uint32_t i, const uint32_t ci[3], const float *const x[3],
+                      const float *const x0[3], float f[3])
+{
+    SC_ASSERT(g != NULL && ci != NULL && x != NULL && x0 != NULL && f != NULL);
+    const uint32_t h = SC_GRID_HEAD, nx = g->nx, ny = g->ny, nz = g->nz;
+    const ptrdiff_t o[3] = {1, (ptrdiff_t)nx, (ptrdiff_t)g->nxy};
+    static const uint8_t sym[9] = {0u, 1u, 2u, 1u, 3u, 4u, 2u, 4u, 5u};
+    const int odd = g->odd[h + i] != 0;
+    for (int dz = -1; dz <= 1; dz++) {
+        for (int dy = -1; dy <= 1; dy++) {
+            for (int dx = -1; dx <= 1; dx++) {
+                const int jx = (int)ci[0] + dx, jy = (int)ci[1] + dy, jz = (int)ci[2] + dz;
+                if (jx < 0 || jy < 0 || jz < 0 || jx >= (int)nx || jy >= (int)ny ||
+                    jz >= (int)nz) {
+                    continue;
+                }
+                const uint32_t j = (uint32_t)jx + nx * ((uint32_t)jy + ny * (uint32_t)jz);
+                const int d[3] = {dx, dy, dz};
+                const int moved = (dx != 0) + (dy != 0) + (dz != 0);
+                float k[9];
+                if (moved == 0) {
+                    for (uint32_t q = 0; q < 9u; q++) {
+                        k[q] = g->d[sym[q]][h + i];
+                    }
+                } else {
+                    /* the stored block of the pair and whether it is K(j, i) (transposed), as
+                     * sc_grid_block finds it: a grid edge (e at the lower node), a face
+                     * diagonal of odd nodes (f at the face's lowest node: the main diagonal's
+                     * lower end, or the anti diagonal's face one back along d1), else none */
+                    const float *blk = NULL;
+                    int tr = 0;
+                    if (moved == 1) {
+                        const uint32_t a = dx != 0 ? 0u : (dy != 0 ? 1u : 2u);
+                        tr = d[a] < 0;
+                        blk = &g->e[a][0][(ptrdiff_t)h + (ptrdiff_t)(tr ? j : i)];
+                    } else if (moved == 2 && odd) {
+                        const uint32_t w = dz == 0 ? 0u : (dy == 0 ? 1u : 2u);
+                        const uint32_t a1 = w == 2u ? 1u : 0u, a2 = w == 0u ? 1u : 2u;
+                        const int s1 = d[a1], s2 = d[a2];
+                        ptrdiff_t at = (ptrdiff_t)i; /* (+, +): the main diagonal from i */
+                        if (s1 < 0 && s2 < 0) {
+                            at = (ptrdiff_t)j; /* the main diagonal from j */
+                            tr = 1;
+                        } else if (s1 < 0) {
+                            at = (ptrdiff_t)i - o[a1]; /* the anti diagonal, i its upper end */
+                        } else if (s2 < 0) {
+                            at = (ptrdiff_t)i - o[a2]; /* the anti diagonal, j its upper end */
+                            tr = 1;
+                        }
+                        blk = &g->f[w][0][(ptrdiff_t)h + at];
+                    }
+                    if (blk == NULL) {
+                        continue;
+                    }
+                    for (uint32_t r = 0; r < 3u; r++) {
+                        for (uint32_t c = 0; c < 3u; c++) {
+                            k[3u * r + c] = blk[(size_t)(tr ? 3u * c + r : 3u * r + c) * SC_GRID_ROW];
+                        }
+                    }
+                }
+                const float u[3] = {x[0][j] - x0[0][j], x[1][j] - x0[1][j], x[2][j] - x0[2][j]};
+                for (uint32_t c = 0; c < 3u; c++) {
+                    f[c] += k[3u * c] * u[0] + k[3u * c + 1u] * u[1] + k[3u * c + 2u] * u[2];
+                }
+            }
+        }
+    }
+}
+
 void sc_grid_apply_ref(const sc_grid *g, float cm, float ck, const double *p, double *q)
 {
     SC_ASSERT(g != NULL && p != NULL && q != NULL);

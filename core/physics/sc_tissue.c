@@ -493,36 +493,18 @@ static void job_force(void *arg, uint32_t r)
     const sc_tissue *t = jb->t;
     const sc_mesh *m = &t->mesh;
     const sc_nodes *n = &t->nodes;
-    const uint32_t nx = m->nx, ny = m->ny, nz = m->nz;
+    const uint32_t nx = m->nx, ny = m->ny;
     const uint32_t q0 = r * SC_TISSUE_FORCE_RANGE;
     const uint32_t q1 = q0 + SC_TISSUE_FORCE_RANGE < t->contacts.count
                             ? q0 + SC_TISSUE_FORCE_RANGE
                             : t->contacts.count;
+    const float *const x[3] = {n->x, n->y, n->z};
+    const float *const x0[3] = {m->rest_x, m->rest_y, m->rest_z};
     float f[3] = {0.0f, 0.0f, 0.0f};
     for (uint32_t q = q0; q < q1; q++) {
         const uint32_t i = t->contacts.c[q].node;
-        const uint32_t ix = i % nx, iy = (i / nx) % ny, iz = i / (nx * ny);
-        for (int dz = -1; dz <= 1; dz++) {
-            for (int dy = -1; dy <= 1; dy++) {
-                for (int dx = -1; dx <= 1; dx++) {
-                    const int jx = (int)ix + dx, jy = (int)iy + dy, jz = (int)iz + dz;
-                    if (jx < 0 || jy < 0 || jz < 0 || jx >= (int)nx || jy >= (int)ny ||
-                        jz >= (int)nz) {
-                        continue;
-                    }
-                    const uint32_t j = (uint32_t)jx + nx * ((uint32_t)jy + ny * (uint32_t)jz);
-                    float k[9];
-                    if (!sc_grid_block(&t->fem.grid, i, j, k)) {
-                        continue;
-                    }
-                    const float u[3] = {n->x[j] - m->rest_x[j], n->y[j] - m->rest_y[j],
-                                        n->z[j] - m->rest_z[j]};
-                    for (uint32_t c = 0; c < 3u; c++) {
-                        f[c] += k[3u * c] * u[0] + k[3u * c + 1u] * u[1] + k[3u * c + 2u] * u[2];
-                    }
-                }
-            }
-        }
+        const uint32_t ci[3] = {i % nx, (i / nx) % ny, i / (nx * ny)};
+        sc_grid_row_disp(&t->fem.grid, i, ci, x, x0, f);
     }
     jb->f[r][0] = f[0];
     jb->f[r][1] = f[1];

@@ -166,6 +166,66 @@ static void grid_stores_one_block_per_mesh_edge_and_none_elsewhere(void **state)
                   g_mesh.ny, g_mesh.nz, (unsigned)SC_GRID_ROW, sizeof(sc_fem));
 }
 
+/* sc_grid_row_disp (the probe's force per contact node) against the sum its caller formed from
+ * sc_grid_block over the 3x3x3 neighbourhood in z, y, x order: the same bits at every node of
+ * grids whose smallest sides make the offsets coincide (nx = 2: the anti diagonal one node apart),
+ * with a displacement of both signs. */
+static void row_displacement_product_equals_the_block_lookups(void **state)
+{
+    (void)state;
+    static const uint32_t dims[4][3] = {{5u, 4u, 3u}, {2u, 2u, 2u}, {3u, 2u, 4u}, {6u, 5u, 7u}};
+    for (uint32_t dsz = 0; dsz < 4u; dsz++) {
+        make_mesh(dims[dsz][0], dims[dsz][1], dims[dsz][2]);
+        sc_fem_def def = sc_fem_default_def();
+        assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &def), SC_OK);
+        const uint32_t nn = g_mesh.node_count, nx = g_mesh.nx, ny = g_mesh.ny, nz = g_mesh.nz;
+        uint32_t seed = 12345u + dsz;
+        for (uint32_t i = 0; i < nn; i++) {
+            float *p[3] = {&g_nodes.x[i], &g_nodes.y[i], &g_nodes.z[i]};
+            for (uint32_t c = 0; c < 3u; c++) {
+                seed = seed * 1664525u + 1013904223u;
+                *p[c] += ((float)(seed >> 8) / 16777216.0f - 0.5f) * 0.8f;
+            }
+        }
+        const float *const x[3] = {g_nodes.x, g_nodes.y, g_nodes.z};
+        const float *const x0[3] = {g_mesh.rest_x, g_mesh.rest_y, g_mesh.rest_z};
+        uint32_t nonzero = 0;
+        for (uint32_t i = 0; i < nn; i++) {
+            const uint32_t ci[3] = {i % nx, (i / nx) % ny, i / (nx * ny)};
+            float want[3] = {0.0f, 0.0f, 0.0f}, got[3] = {0.0f, 0.0f, 0.0f};
+            for (int dz = -1; dz <= 1; dz++) {
+                for (int dy = -1; dy <= 1; dy++) {
+                    for (int dx = -1; dx <= 1; dx++) {
+                        const int jx = (int)ci[0] + dx, jy = (int)ci[1] + dy, jz = (int)ci[2] + dz;
+                        if (jx < 0 || jy < 0 || jz < 0 || jx >= (int)nx || jy >= (int)ny ||
+                            jz >= (int)nz) {
+                            continue;
+                        }
+                        const uint32_t j = (uint32_t)jx + nx * ((uint32_t)jy + ny * (uint32_t)jz);
+                        float k[9];
+                        if (!sc_grid_block(&g_fem.grid, i, j, k)) {
+                            continue;
+                        }
+                        const float u[3] = {x[0][j] - x0[0][j], x[1][j] - x0[1][j],
+                                            x[2][j] - x0[2][j]};
+                        for (uint32_t c = 0; c < 3u; c++) {
+                            want[c] += k[3u * c] * u[0] + k[3u * c + 1u] * u[1] +
+                                       k[3u * c + 2u] * u[2];
+                        }
+                    }
+                }
+            }
+            sc_grid_row_disp(&g_fem.grid, i, ci, x, x0, got);
+            for (uint32_t c = 0; c < 3u; c++) {
+                assert_true(same(want[c], got[c]));
+                nonzero += fabsf(want[c]) > 0.0f ? 1u : 0u;
+            }
+        }
+        assert_true(nonzero > nn); /* the displacement did load the rows */
+        sc_nodes_reset_to_rest(&g_nodes, &g_mesh);
+    }
+}
+
 /* ---- element stiffness ------------------------------------------------------------------- */
 
 static double max_abs(const double *v, uint32_t count)
@@ -1120,6 +1180,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(init_rejects_invalid_inputs),
         cmocka_unit_test(grid_stores_one_block_per_mesh_edge_and_none_elsewhere),
+        cmocka_unit_test(row_displacement_product_equals_the_block_lookups),
         cmocka_unit_test(stiffness_annihilates_rigid_motions_and_diagonal_blocks_are_symmetric),
         cmocka_unit_test(linear_field_gives_no_interior_force_and_exact_energy),
         cmocka_unit_test(solver_converges_to_the_static_patch_solution),
