@@ -773,43 +773,54 @@ int sc_grid_solve(sc_grid *g, sc_nodes *n, float dt_s, float beta_s, float alpha
     return SC_OK;
 }
 
-/* the face of plane w with lowest node m exists (its far corner is inside the grid) */
-static int face_exists(const sc_grid *g, uint32_t m, uint32_t w)
+/* K(i, j) (row-major) into out for j = i + d (d: x, y, z steps of -1, 0 or 1, j inside the
+ * grid): the diagonal block (d = 0), a grid edge's block (e at the lower node), a face diagonal's
+ * of odd nodes (f at the face's lowest node: the main diagonal's lower end, or the anti
+ * diagonal's face one back along d1), read transposed when it is stored as K(j, i). Returns 0
+ * (out untouched) where no block is stored: a body diagonal, or a face diagonal of even nodes. */
+static int block_at(const sc_grid *g, uint32_t i, uint32_t j, const int d[3], float out[9])
 {
-    const uint32_t i = m % g->nx, j = (m / g->nx) % g->ny, k = m / g->nxy;
-    const int in_x = i + 1u < g->nx, in_y = j + 1u < g->ny, in_z = k + 1u < g->nz;
-    return w == 0u ? (in_x && in_y) : w == 1u ? (in_x && in_z) : (in_y && in_z);
-}
-
-/* The stored block of the node pair (a, b), a < b, or NULL. */
-static const float *pair_block(const sc_grid *g, uint32_t a, uint32_t b)
-{
-    const uint32_t h = SC_GRID_HEAD;
-    const uint32_t ai = a % g->nx, aj = (a / g->nx) % g->ny, ak = a / g->nxy;
-    const uint32_t dist = b - a;
-    if (dist == 1u && ai + 1u < g->nx) {
-        return &g->e[0][0][h + a];
-    }
-    if (dist == g->nx && aj + 1u < g->ny) {
-        return &g->e[1][0][h + a];
-    }
-    if (dist == g->nxy && ak + 1u < g->nz) {
-        return &g->e[2][0][h + a];
-    }
-    if (g->odd[h + a] == 0) {
-        return NULL; /* face diagonals join odd nodes */
-    }
-    const uint32_t d1s[3] = {1u, 1u, g->nx}, d2s[3] = {g->nx, g->nxy, g->nxy};
-    for (uint32_t w = 0; w < 3u; w++) {
-        const uint32_t d1 = d1s[w], d2 = d2s[w];
-        if (dist == d1 + d2 && face_exists(g, a, w)) {
-            return &g->f[w][0][h + a]; /* main diagonal of the (odd) face at a */
+    static const uint8_t sym[9] = {0u, 1u, 2u, 1u, 3u, 4u, 2u, 4u, 5u};
+    const ptrdiff_t h = SC_GRID_HEAD;
+    const ptrdiff_t o[3] = {1, (ptrdiff_t)g->nx, (ptrdiff_t)g->nxy};
+    const int moved = (d[0] != 0) + (d[1] != 0) + (d[2] != 0);
+    if (moved == 0) {
+        for (uint32_t q = 0; q < 9u; q++) {
+            out[q] = g->d[sym[q]][h + (ptrdiff_t)i];
         }
-        if (dist == d2 - d1 && a >= d1 && face_exists(g, a - d1, w)) {
-            return &g->f[w][0][h + a - d1]; /* anti diagonal of the (even) face at a - d1 */
+        return 1;
+    }
+    const float *blk = NULL;
+    int tr = 0;
+    if (moved == 1) {
+        const uint32_t a = d[0] != 0 ? 0u : (d[1] != 0 ? 1u : 2u);
+        tr = d[a] < 0;
+        blk = &g->e[a][0][h + (ptrdiff_t)(tr ? j : i)];
+    } else if (moved == 2 && g->odd[h + (ptrdiff_t)i] != 0) {
+        /* plane w of the two axes a1 < a2 that move */
+        const uint32_t w = d[2] == 0 ? 0u : (d[1] == 0 ? 1u : 2u);
+        const uint32_t a1 = w == 2u ? 1u : 0u, a2 = w == 0u ? 1u : 2u;
+        ptrdiff_t at = (ptrdiff_t)i; /* (+, +): the main diagonal from i */
+        if (d[a1] < 0 && d[a2] < 0) {
+            at = (ptrdiff_t)j; /* the main diagonal from j */
+            tr = 1;
+        } else if (d[a1] < 0) {
+            at = (ptrdiff_t)i - o[a1]; /* the anti diagonal, i its upper end */
+        } else if (d[a2] < 0) {
+            at = (ptrdiff_t)i - o[a2]; /* the anti diagonal, j its upper end */
+            tr = 1;
+        }
+        blk = &g->f[w][0][h + at];
+    }
+    if (blk == NULL) {
+        return 0;
+    }
+    for (uint32_t r = 0; r < 3u; r++) {
+        for (uint32_t c = 0; c < 3u; c++) {
+            out[3u * r + c] = blk[(size_t)(tr ? 3u * c + r : 3u * r + c) * SC_GRID_ROW];
         }
     }
-    return NULL;
+    return 1;
 }
 
 int sc_grid_block(const sc_grid *g, uint32_t i, uint32_t j, float out[9])
@@ -821,36 +832,25 @@ int sc_grid_block(const sc_grid *g, uint32_t i, uint32_t j, float out[9])
     if (i >= g->node_count || j >= g->node_count) {
         return 0;
     }
-    const uint32_t h = SC_GRID_HEAD;
-    if (i == j) {
-        static const uint8_t sym[9] = {0u, 1u, 2u, 1u, 3u, 4u, 2u, 4u, 5u};
-        for (uint32_t k = 0; k < 9u; k++) {
-            out[k] = g->d[sym[k]][h + i];
+    const uint32_t nx = g->nx, ny = g->ny;
+    const int64_t ci[3] = {i % nx, (i / nx) % ny, i / (nx * ny)};
+    const int64_t cj[3] = {j % nx, (j / nx) % ny, j / (nx * ny)};
+    int d[3];
+    for (uint32_t a = 0; a < 3u; a++) {
+        const int64_t s = cj[a] - ci[a];
+        if (s < -1 || s > 1) {
+            return 0; /* farther than the neighbourhood: no block */
         }
-        return 1;
+        d[a] = (int)s;
     }
-    const int swap = i > j;
-    const float *blk = swap ? pair_block(g, j, i) : pair_block(g, i, j);
-    if (blk == NULL) {
-        return 0;
-    }
-    for (uint32_t r = 0; r < 3u; r++) {
-        for (uint32_t c = 0; c < 3u; c++) {
-            const float val = blk[(size_t)(3u * r + c) * SC_GRID_ROW];
-            out[swap ? 3u * c + r : 3u * r + c] = val;
-        }
-    }
-    return 1;
+    return block_at(g, i, j, d, out);
 }
 
 void sc_grid_row_disp(const sc_grid *g, uint32_t i, const uint32_t ci[3], const float *const x[3],
                       const float *const x0[3], float f[3])
 {
     SC_ASSERT(g != NULL && ci != NULL && x != NULL && x0 != NULL && f != NULL);
-    const uint32_t h = SC_GRID_HEAD, nx = g->nx, ny = g->ny, nz = g->nz;
-    const ptrdiff_t o[3] = {1, (ptrdiff_t)nx, (ptrdiff_t)g->nxy};
-    static const uint8_t sym[9] = {0u, 1u, 2u, 1u, 3u, 4u, 2u, 4u, 5u};
-    const int odd = g->odd[h + i] != 0;
+    const uint32_t nx = g->nx, ny = g->ny, nz = g->nz;
     for (int dz = -1; dz <= 1; dz++) {
         for (int dy = -1; dy <= 1; dy++) {
             for (int dx = -1; dx <= 1; dx++) {
@@ -861,47 +861,9 @@ void sc_grid_row_disp(const sc_grid *g, uint32_t i, const uint32_t ci[3], const 
                 }
                 const uint32_t j = (uint32_t)jx + nx * ((uint32_t)jy + ny * (uint32_t)jz);
                 const int d[3] = {dx, dy, dz};
-                const int moved = (dx != 0) + (dy != 0) + (dz != 0);
                 float k[9];
-                if (moved == 0) {
-                    for (uint32_t q = 0; q < 9u; q++) {
-                        k[q] = g->d[sym[q]][h + i];
-                    }
-                } else {
-                    /* the stored block of the pair and whether it is K(j, i) (transposed), as
-                     * sc_grid_block finds it: a grid edge (e at the lower node), a face
-                     * diagonal of odd nodes (f at the face's lowest node: the main diagonal's
-                     * lower end, or the anti diagonal's face one back along d1), else none */
-                    const float *blk = NULL;
-                    int tr = 0;
-                    if (moved == 1) {
-                        const uint32_t a = dx != 0 ? 0u : (dy != 0 ? 1u : 2u);
-                        tr = d[a] < 0;
-                        blk = &g->e[a][0][(ptrdiff_t)h + (ptrdiff_t)(tr ? j : i)];
-                    } else if (moved == 2 && odd) {
-                        const uint32_t w = dz == 0 ? 0u : (dy == 0 ? 1u : 2u);
-                        const uint32_t a1 = w == 2u ? 1u : 0u, a2 = w == 0u ? 1u : 2u;
-                        const int s1 = d[a1], s2 = d[a2];
-                        ptrdiff_t at = (ptrdiff_t)i; /* (+, +): the main diagonal from i */
-                        if (s1 < 0 && s2 < 0) {
-                            at = (ptrdiff_t)j; /* the main diagonal from j */
-                            tr = 1;
-                        } else if (s1 < 0) {
-                            at = (ptrdiff_t)i - o[a1]; /* the anti diagonal, i its upper end */
-                        } else if (s2 < 0) {
-                            at = (ptrdiff_t)i - o[a2]; /* the anti diagonal, j its upper end */
-                            tr = 1;
-                        }
-                        blk = &g->f[w][0][(ptrdiff_t)h + at];
-                    }
-                    if (blk == NULL) {
-                        continue;
-                    }
-                    for (uint32_t r = 0; r < 3u; r++) {
-                        for (uint32_t c = 0; c < 3u; c++) {
-                            k[3u * r + c] = blk[(size_t)(tr ? 3u * c + r : 3u * r + c) * SC_GRID_ROW];
-                        }
-                    }
+                if (!block_at(g, i, j, d, k)) {
+                    continue;
                 }
                 const float u[3] = {x[0][j] - x0[0][j], x[1][j] - x0[1][j], x[2][j] - x0[2][j]};
                 for (uint32_t c = 0; c < 3u; c++) {

@@ -351,9 +351,9 @@ int sc_grid_solve(sc_grid *g, sc_nodes *n, float dt_s, float beta_s, float alpha
 int sc_grid_block(const sc_grid *g, uint32_t i, uint32_t j, float out[9]);
 
 /* f += sum over the nodes j of node i's 3x3x3 neighbourhood, in z, y, x order, of K(i, j)
- * (x_j - x0_j) (the probe's force per contact node, sc_tissue.h): sc_grid_block's blocks and the
- * sum its caller formed, without looking each pair up (27 searches of 60 rows per contact).
- * ci: i's grid coordinates; x, x0: current and rest positions by axis. O(1). */
+ * (x_j - x0_j) (the probe's force per contact node, sc_tissue.h): sc_grid_block's blocks, each
+ * found from its offset without dividing a node index. ci: i's grid coordinates; x, x0: current
+ * and rest positions by axis. O(1). */
 void sc_grid_row_disp(const sc_grid *g, uint32_t i, const uint32_t ci[3], const float *const x[3],
                       const float *const x0[3], float f[3]);
 

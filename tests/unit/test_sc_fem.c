@@ -169,7 +169,8 @@ static void grid_stores_one_block_per_mesh_edge_and_none_elsewhere(void **state)
 /* sc_grid_row_disp (the probe's force per contact node) against the sum its caller formed from
  * sc_grid_block over the 3x3x3 neighbourhood in z, y, x order: the same bits at every node of
  * grids whose smallest sides make the offsets coincide (nx = 2: the anti diagonal one node apart),
- * with a displacement of both signs. */
+ * with a displacement of both signs. (Both find a block by its offset; the blocks themselves are
+ * checked against the mesh's edges and K_ji = K_ij^T above.) */
 static void row_displacement_product_equals_the_block_lookups(void **state)
 {
     (void)state;
