@@ -259,6 +259,20 @@ static void split(sc_lumen *l, const sc_mesh *m)
     l->span_tets = ranges > 1u ? 5u * span : m->tet_count;
 }
 
+/* the faces of lumen tet t that its pressure loads, bit f for face f: tissue across (not the
+ * hull, where the vessel goes on, nor a lumen, its own or another vessel's: a shared wall loaded
+ * by both lumens let an artery's pressure drive the filler of a crushed vein beside it far off in
+ * the robustness test) */
+static uint32_t loaded_faces(const sc_lumen *l, const sc_mesh *m, uint32_t t)
+{
+    uint32_t faces = 0;
+    for (uint32_t f = 0; f < 4u; f++) {
+        const int32_t nb = m->tet_nbr[t][f];
+        faces |= (nb >= 0 && l->region[nb] == 0u) ? 1u << f : 0u;
+    }
+    return faces;
+}
+
 #if SC_LUMEN_RANGES > 1
 #define LIST_TET(e) ((e)&0xFFFFFu)
 #define LIST_SLICE(e) (((e) >> 20) & 0x1Fu)
@@ -281,12 +295,8 @@ static void build_list(sc_lumen *l, const sc_mesh *m)
             if (k == 0u) {
                 continue;
             }
-            uint32_t faces = 0;
-            for (uint32_t f = 0; f < 4u; f++) {
-                const int32_t nb = m->tet_nbr[t][f];
-                faces |= (nb >= 0 && l->region[nb] == 0u) ? 1u << f : 0u;
-            }
-            l->list[n++] = t | (slice_of(&l->v[k - 1u], m, t) << 20) | (faces << 25);
+            l->list[n++] =
+                t | (slice_of(&l->v[k - 1u], m, t) << 20) | (loaded_faces(l, m, t) << 25);
         }
     }
     l->list_start[l->ranges] = n;
@@ -573,6 +583,18 @@ static inline void face_force(sc_nodes *n, const uint32_t *tv, uint32_t f, float
     }
 }
 
+/* face f of tet tv's nodes' external forces back to zero */
+static inline void face_clear(sc_nodes *n, const uint32_t *tv, uint32_t f)
+{
+    uint32_t q[3];
+    face_nodes(tv, f, q);
+    for (uint32_t a = 0; a < 3u; a++) {
+        n->fx[q[a]] = 0.0f;
+        n->fy[q[a]] = 0.0f;
+        n->fz[q[a]] = 0.0f;
+    }
+}
+
 /* range 2 i + phase's boundary forces (its faces counted in part_faces) */
 static void job_forces(void *arg, uint32_t i)
 {
@@ -591,10 +613,7 @@ static void job_forces(void *arg, uint32_t i)
         }
         const float pk = j->press[l->region[t] - 1u][LIST_SLICE(w)];
         for (uint32_t f = 0; f < 4u; f++) {
-            /* the faces with tissue across (LIST_FACES; not the hull, where the vessel goes on,
-             * nor a lumen, its own or another vessel's: a shared wall loaded by both lumens let
-             * an artery's pressure drive the filler of a crushed vein beside it far off in the
-             * robustness test), whose wall tet across is not crushed */
+            /* the loaded faces (loaded_faces), whose wall tet across is not crushed */
             if ((LIST_FACES(w) & (1u << f)) == 0u ||
                 !(sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[m->tet_nbr[t][f]]) > 0.0f)) {
                 continue;
@@ -614,16 +633,11 @@ static void job_forces(void *arg, uint32_t i)
         if (!(sc_mesh_tet_volume_mm3(n->x, n->y, n->z, tv) > 0.0f)) {
             continue; /* an inverted (crushed) lumen tet: its faces have no outward side */
         }
+        const uint32_t loaded = loaded_faces(l, m, t);
         for (uint32_t f = 0; f < 4u; f++) {
-            const int32_t nb = m->tet_nbr[t][f];
-            if (nb < 0 || l->region[nb] != 0u) {
-                /* hull (the vessel goes on), inside the lumen, or a wall shared with another
-                 * vessel (loaded by both lumens: an artery's pressure drove the filler of a
-                 * crushed vein beside it far off in the robustness test) */
-                continue;
-            }
-            if (!(sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[nb]) > 0.0f)) {
-                continue; /* the wall tet across is crushed: no face to push on */
+            if ((loaded & (1u << f)) == 0u ||
+                !(sc_mesh_tet_volume_mm3(n->x, n->y, n->z, m->tet[m->tet_nbr[t][f]]) > 0.0f)) {
+                continue; /* not loaded, or the wall tet across is crushed: no face to push on */
             }
             face_force(n, tv, f, pk);
             faces++;
@@ -645,15 +659,8 @@ static void job_clear(void *arg, uint32_t i)
     for (uint32_t e = l->list_start[r]; e < l->list_start[r + 1u]; e++) {
         const uint32_t w = l->list[e];
         for (uint32_t f = 0; f < 4u; f++) {
-            if ((LIST_FACES(w) & (1u << f)) == 0u) {
-                continue;
-            }
-            uint32_t q[3];
-            face_nodes(m->tet[LIST_TET(w)], f, q);
-            for (uint32_t a = 0; a < 3u; a++) {
-                n->fx[q[a]] = 0.0f;
-                n->fy[q[a]] = 0.0f;
-                n->fz[q[a]] = 0.0f;
+            if ((LIST_FACES(w) & (1u << f)) != 0u) {
+                face_clear(n, m->tet[LIST_TET(w)], f);
             }
         }
     }
@@ -662,17 +669,10 @@ static void job_clear(void *arg, uint32_t i)
     range_tets(l, m, r, &t0, &t1);
     for (uint32_t t = next_region_tet(l->region, t0, t1); t < t1;
          t = next_region_tet(l->region, t + 1u, t1)) {
+        const uint32_t loaded = loaded_faces(l, m, t);
         for (uint32_t f = 0; f < 4u; f++) {
-            const int32_t nb = m->tet_nbr[t][f];
-            if (nb < 0 || l->region[nb] != 0u) {
-                continue;
-            }
-            uint32_t q[3];
-            face_nodes(m->tet[t], f, q);
-            for (uint32_t a = 0; a < 3u; a++) {
-                n->fx[q[a]] = 0.0f;
-                n->fy[q[a]] = 0.0f;
-                n->fz[q[a]] = 0.0f;
+            if ((loaded & (1u << f)) != 0u) {
+                face_clear(n, m->tet[t], f);
             }
         }
     }
