@@ -262,6 +262,27 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
                   t->src[1] == k[4] && t->tr[0] == k[5] && t->tr[1] == k[6]);
         (void)t;
         (void)k;
+        /* write_cell: the target's two sources in exactly one group of entries */
+        uint32_t groups = 0;
+        for (uint32_t gi = 0; gi < SC_GRID_TMPL_GROUPS; gi++) {
+            const uint8_t *gr = sc_grid_tmpl_group[gi];
+            groups +=
+                (uint32_t)((gr[0] == 0u) == (k[0] == 0u) && (k[3] == gr[1] || k[3] == gr[2]) &&
+                           (k[4] == gr[1] || k[4] == gr[2]));
+        }
+        SC_ASSERT(groups == 1u);
+        (void)groups;
+    }
+    /* and every template entry in exactly one group: computed once */
+    for (uint32_t e = 0; e < 8u + 18u; e++) {
+        uint32_t in = 0;
+        for (uint32_t gi = 0; gi < SC_GRID_TMPL_GROUPS; gi++) {
+            const uint8_t *gr = sc_grid_tmpl_group[gi];
+            const uint32_t base = gr[0] == 0u ? 0u : 8u;
+            in += (uint32_t)(e == base + gr[1]) + (uint32_t)(gr[2] != gr[1] && e == base + gr[2]);
+        }
+        SC_ASSERT(in == 1u);
+        (void)in;
     }
     memset(&g->stats, 0, sizeof g->stats);
     memset(g->below_n, 0, sizeof g->below_n);

@@ -178,8 +178,8 @@ _Static_assert(SC_GRID_POOL_RANGE % SC_GRID_CHUNK == 0u && SC_GRID_SUM_BLOCK % 1
 #define SC_GRID_CELL_BLOCK 16u
 /* assembly targets of a cell: 8 corners, 12 grid edges, 6 face diagonals */
 #define SC_GRID_TARGETS 26u
-/* buffer rows of a cell: 8 template corners x (6 diagonal + 3 residual), then the 18 template
- * edge slots x 9 */
+/* buffer rows of a cell: its real targets in order, 9 each (the 8 corners' 6 diagonal + 3
+ * residual values, then the 18 edges' 3x3 blocks) */
 #define SC_GRID_BUF_ROWS (8u * 9u + 18u * 9u)
 _Static_assert(SC_GRID_ASM_SPAN % SC_GRID_CELL_BLOCK == 0u &&
                    SC_GRID_ASM_SPAN > SC_MAX_MESH_NX * SC_MAX_MESH_NY + SC_MAX_MESH_NX +

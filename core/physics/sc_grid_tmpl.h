@@ -43,4 +43,13 @@ static const uint8_t sc_grid_tmpl_target[26][7] = {
     {2u, 0u, 4u, 14u, 14u, 0u, 0u}, {2u, 1u, 0u, 4u, 4u, 0u, 0u},   {2u, 1u, 2u, 9u, 9u, 0u, 0u},
     {2u, 2u, 0u, 5u, 10u, 0u, 0u},  {2u, 2u, 1u, 10u, 5u, 0u, 0u}};
 
+/* the template entries computed together (kind 0 corner or 1 edge slot, entry, entry; one entry
+ * twice where it feeds its targets alone): every target's two sources, src0 and src1, lie in one
+ * group, so write_cell computes each entry once and writes its targets from registers */
+#define SC_GRID_TMPL_GROUPS 17u
+static const uint8_t sc_grid_tmpl_group[SC_GRID_TMPL_GROUPS][3] = {
+    {0u, 0u, 1u},   {0u, 2u, 3u},   {0u, 4u, 5u}, {0u, 6u, 7u},   {1u, 0u, 0u},  {1u, 6u, 6u},
+    {1u, 11u, 11u}, {1u, 15u, 15u}, {1u, 1u, 7u}, {1u, 16u, 12u}, {1u, 2u, 13u}, {1u, 17u, 8u},
+    {1u, 3u, 3u},   {1u, 14u, 14u}, {1u, 4u, 4u}, {1u, 9u, 9u},   {1u, 5u, 10u}};
+
 #endif /* SC_GRID_TMPL_H */
