@@ -284,6 +284,28 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
         SC_ASSERT(in == 1u);
         (void)in;
     }
+    /* write_cell's order (groups, then their targets, backwards): within a row family (kind and
+     * axis) the corner offsets descend, so a node's sums run in cell order (sc_grid.h) */
+    uint8_t order[SC_GRID_TARGETS];
+    uint32_t no = 0;
+    for (uint32_t gn = SC_GRID_TMPL_GROUPS; gn-- > 0u;) {
+        const uint8_t *gr = sc_grid_tmpl_group[gn];
+        for (uint32_t ti = SC_GRID_TARGETS; ti-- > 0u;) {
+            const uint8_t *k = sc_grid_tmpl_target[ti];
+            if ((k[0] == 0u) == (gr[0] == 0u) && (k[3] == gr[1] || k[3] == gr[2])) {
+                order[no++] = (uint8_t)ti;
+            }
+        }
+    }
+    SC_ASSERT(no == SC_GRID_TARGETS);
+    for (uint32_t a = 0; a < no; a++) {
+        for (uint32_t b = a + 1u; b < no; b++) {
+            const uint8_t *ka = sc_grid_tmpl_target[order[a]], *kb = sc_grid_tmpl_target[order[b]];
+            SC_ASSERT(ka[0] != kb[0] || ka[1] != kb[1] || g->off[ka[2]] > g->off[kb[2]]);
+            (void)ka;
+            (void)kb;
+        }
+    }
     memset(&g->stats, 0, sizeof g->stats);
     memset(g->below_n, 0, sizeof g->below_n);
     memset(g->floor_dirty, 0, sizeof g->floor_dirty);

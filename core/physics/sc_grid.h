@@ -31,15 +31,14 @@
  *
  * Assembly by cell: a cell's five tets (SC_MSDS_CELL_TETS, an odd cell mirrored in x) give
  * the blocks of its 8 corners, 12 grid edges and 6 face diagonals; the cell kernels compute a
- * block of SC_GRID_CELL_BLOCK cells in the template's (mirrored) frame, 9 rows per template
- * corner (6 diagonal entries, 3 residual) and per template edge slot, pick per cell the
- * template row of its parity (transposed where the mirror reverses the edge) into sc_grid.buf,
- * 9 rows per real target, and then add each of the 26 targets to the matrix and the residual
- * with one straight pass per target. (Picking the parity in those passes instead, from a
- * template-frame buffer, measured the same: 0.73 ms for the 32x16x16 MSDS cells either way.)
- * Those passes fix the order in which a node's sums are formed, so the result does not depend
- * on the vector width (every instruction-set variant of sc_grid_kern.inc gives the same bits)
- * nor on anything but SC_GRID_CELL_BLOCK.
+ * vector of cells in the template's (mirrored) frame, 9 values per template corner (6 diagonal
+ * entries, 3 residual) and per template edge slot, pick per cell the value of its parity
+ * (transposed where the mirror reverses the edge) and add it straight to its real target's row
+ * (26 targets x 9 rows). A node's sums are formed in the order of the cells that add into it,
+ * lowest first, within a vector as across vectors (write_cell's target order), so the result
+ * does not depend on the vector width: every instruction-set variant of sc_grid_kern.inc gives
+ * the same bits. (A block buffer, added target by target after each 16 cells, cost a store and
+ * a load per value: 0.73 against 0.53 ms for the 32x16x16 MSDS cells.)
  *
  * The step (sc_grid_begin, the caller's assembly, sc_grid_solve):
  * - Dirichlet DOFs: fixed nodes (mesh node_fixed 1, nodes of no tet), the held axes of roller
@@ -154,12 +153,12 @@ _Static_assert(SC_GRID_POOL_RANGE % SC_GRID_CHUNK == 0u && SC_GRID_SUM_BLOCK % 1
 #define SC_GRID_MAT_ROWS 60u /* d 6, e 27, f 27: row k of the matrix at &d[0][0] + k ROW */
 
 /* The cell passes (FEM assembly, the MSDS's volume terms) on the worker pool: the cell origins
- * are cut into ranges of SC_GRID_ASM_SPAN origins (whole cell blocks), each with its own block
- * buffer; the even ranges run first (at the same time: two ranges apart, their corner sets do not
- * meet, since SC_GRID_ASM_SPAN > nx ny + nx + SC_GRID_CELL_BLOCK), then the odd ones. A node on
- * the seam after an odd range takes the next (even) range's sums before the odd one's, so that
- * order is part of what makes a state hash, the number of workers is not; a mesh of one range
- * (cell origins up to SC_GRID_ASM_SPAN: up to 32x16x16) sums exactly as the serial loop did. */
+ * are cut into ranges of SC_GRID_ASM_SPAN origins (whole cell blocks); the even ranges run first
+ * (at the same time: two ranges apart, their corner sets do not meet, since SC_GRID_ASM_SPAN > nx
+ * ny + nx + SC_GRID_CELL_BLOCK), then the odd ones. A node on the seam after an odd range takes the
+ * next (even) range's sums before the odd one's, so that order is part of what makes a state hash,
+ * the number of workers is not; a mesh of one range (cell origins up to SC_GRID_ASM_SPAN: up to
+ * 32x16x16) sums exactly as the serial loop did. */
 #define SC_GRID_ASM_SPAN 8192u
 /* A mesh of more than two such ranges (more than 16,384 cell origins: 48x24x24, 64x32x32) is cut
  * into ranges of sc_grid.asm_span origins instead, chosen by the mesh alone: the smallest whole
@@ -172,15 +171,11 @@ _Static_assert(SC_GRID_POOL_RANGE % SC_GRID_CHUNK == 0u && SC_GRID_SUM_BLOCK % 1
 #define SC_GRID_ASM_SPAN_MIN 1024u
 #define SC_GRID_ASM_RANGES ((SC_MAX_NODES + SC_GRID_ASM_SPAN_MIN - 1u) / SC_GRID_ASM_SPAN_MIN)
 
-/* cells per assembly block (a multiple of every variant's vector width); part of what makes
- * a state hash, so it is the same on every target (the MCU's SRAM sets it: the buffer is
- * 234 x 16 floats, 15 KB; 32 measured no faster on x86-64) */
+/* cells per assembly block (a multiple of every variant's vector width): the unit of the
+ * ranges, the write prefetch and the floor-only pass's skip; the sums do not depend on it */
 #define SC_GRID_CELL_BLOCK 16u
 /* assembly targets of a cell: 8 corners, 12 grid edges, 6 face diagonals */
 #define SC_GRID_TARGETS 26u
-/* buffer rows of a cell: its real targets in order, 9 each (the 8 corners' 6 diagonal + 3
- * residual values, then the 18 edges' 3x3 blocks) */
-#define SC_GRID_BUF_ROWS (8u * 9u + 18u * 9u)
 _Static_assert(SC_GRID_ASM_SPAN % SC_GRID_CELL_BLOCK == 0u &&
                    SC_GRID_ASM_SPAN > SC_MAX_MESH_NX * SC_MAX_MESH_NY + SC_MAX_MESH_NX +
                                           SC_GRID_CELL_BLOCK,
@@ -266,9 +261,6 @@ typedef struct sc_grid {
     SC_ALIGN_HOT int32_t cell_ok[SC_GRID_ROW];  /* -1: a cell has this origin */
     uint8_t con[SC_GRID_ROW]; /* this step: 1 fixed, 2 kinematic, 0 free, 0x80 | roller bits */
     uint8_t used[SC_MAX_NODES]; /* node belongs to at least one tet */
-    /* ---- scratch of the cell kernels: one block of cells per assembly range, rows of
-     * SC_GRID_CELL_BLOCK (one range, 15 KB, on the MCU's limits) ---- */
-    SC_ALIGN_HOT float buf[SC_GRID_ASM_RANGES][SC_GRID_BUF_ROWS][SC_GRID_CELL_BLOCK];
 #if SC_GRID_REST_COPY
     /* ---- the linear FEM's rest K, rows as d, e, f (above) ---- */
     SC_ALIGN_HOT float rest[SC_GRID_MAT_ROWS][SC_GRID_ROW];

@@ -1013,16 +1013,19 @@ static void steps_are_bitwise_deterministic(void **state)
     /* Stored values: the same in Debug (-O1, sanitizers) and Release (-O3) on x86-64, with
      * every instruction-set variant (test_sc_simd) and with one-lane vectors (-DSC_VEC_SCALAR,
      * the MCU's build of sc_grid_kern.c), since the core is built with -ffp-contract=off,
-     * every reduction has a fixed order and the cell kernels' sums go through fixed passes
-     * (sc_grid.h). A change here is a change of the numerics (FEM, mesh, materials or fixed
+     * every reduction has a fixed order and the cell kernels add into a node in the order of
+     * the cells (sc_grid.h). A change here is a change of the numerics (FEM, mesh, materials or fixed
      * nodes): update the values deliberately, in the same commit, saying why. Last changed when
      * the FEM moved to the grid matrix (template gradients, element-wise r0 for both models,
      * the grid's PCG and the unloaded warm start toward rest; were 0xebcf32bae8caa610 and
      * 0x1189f04920bf6f8a); then when the artery's material became the wall's share of a lumen
      * held open by the lumen law (config/sc_materials.h: 300 -> 30 kPa; were
-     * 0x278682b11d0e4003 and 0xc59ad4b441628d65). */
-    assert_true(h[0][0] == UINT64_C(0x58b41fbf1a603f79));
-    assert_true(h[1][0] == UINT64_C(0x3b36656df22db08c));
+     * 0x278682b11d0e4003 and 0xc59ad4b441628d65); then when the cell kernels stopped going
+     * through a block buffer and add each cell vector straight into the matrix, so a node's
+     * sums run in cell order instead of target by target per 16 cells (the same terms, summed
+     * in another order; were 0x58b41fbf1a603f79 and 0x3b36656df22db08c). */
+    assert_true(h[0][0] == UINT64_C(0xba78d9d32a13524b));
+    assert_true(h[1][0] == UINT64_C(0x0550a3c053a9e757));
 }
 
 /* ---- run-time switches -------------------------------------------------------------------- */
