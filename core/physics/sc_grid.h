@@ -56,8 +56,8 @@
  *
  * Memory (R = SC_GRID_ROW floats, ~SC_MAX_NODES + 2 (nx ny + nx) + 48): matrix 60 rows, mass,
  * positions and rest 6, solver vectors v r z p q and the preconditioner 18, masks 2 (int32),
- * flags: 87 rows of 4 B and 1 B: 3.4 MB at 32x16x16 (sizeof(sc_fem) printed by bench-fem), and
- * the cell buffer (234 x 16 floats, 15 KB). Never allocates, never calls the OS. Deterministic.
+ * flags: 87 rows of 4 B and 1 B: 3.4 MB at 32x16x16 (sizeof(sc_fem) printed by bench-fem).
+ * Never allocates, never calls the OS. Deterministic.
  * Threads: one writer.
  */
 #ifndef SC_GRID_H
