@@ -262,18 +262,8 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
                   t->src[1] == k[4] && t->tr[0] == k[5] && t->tr[1] == k[6]);
         (void)t;
         (void)k;
-        /* write_cell: the target's two sources in exactly one group of entries */
-        uint32_t groups = 0;
-        for (uint32_t gi = 0; gi < SC_GRID_TMPL_GROUPS; gi++) {
-            const uint8_t *gr = sc_grid_tmpl_group[gi];
-            groups +=
-                (uint32_t)((gr[0] == 0u) == (k[0] == 0u) && (k[3] == gr[1] || k[3] == gr[2]) &&
-                           (k[4] == gr[1] || k[4] == gr[2]));
-        }
-        SC_ASSERT(groups == 1u);
-        (void)groups;
     }
-    /* and every template entry in exactly one group: computed once */
+    /* write_cell's groups: every template entry in exactly one group (computed once) */
     for (uint32_t e = 0; e < 8u + 18u; e++) {
         uint32_t in = 0;
         for (uint32_t gi = 0; gi < SC_GRID_TMPL_GROUPS; gi++) {
@@ -284,15 +274,20 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
         SC_ASSERT(in == 1u);
         (void)in;
     }
-    /* write_cell's order (groups, then their targets, backwards): within a row family (kind and
-     * axis) the corner offsets descend, so a node's sums run in cell order (sc_grid.h) */
-    uint8_t order[SC_GRID_TARGETS];
+    /* write_cell's walk (groups, then their targets, backwards; a target is written by the group
+     * that holds its even source): each target once, its odd source in the same group, and
+     * within a row family (kind and axis) the corner offsets descending, so a node's sums run
+     * in cell order (sc_grid.h) */
+    uint8_t order[SC_GRID_TARGETS], seen[SC_GRID_TARGETS] = {0};
     uint32_t no = 0;
     for (uint32_t gn = SC_GRID_TMPL_GROUPS; gn-- > 0u;) {
         const uint8_t *gr = sc_grid_tmpl_group[gn];
         for (uint32_t ti = SC_GRID_TARGETS; ti-- > 0u;) {
             const uint8_t *k = sc_grid_tmpl_target[ti];
             if ((k[0] == 0u) == (gr[0] == 0u) && (k[3] == gr[1] || k[3] == gr[2])) {
+                SC_ASSERT(no < SC_GRID_TARGETS && seen[ti] == 0u &&
+                          (k[4] == gr[1] || k[4] == gr[2]));
+                seen[ti] = 1u;
                 order[no++] = (uint8_t)ti;
             }
         }
