@@ -597,18 +597,18 @@ static const sc_bscan_tcache *tet_cached(line_w *w, const sc_mesh *m, uint32_t t
         return tc;
     }
     for (uint32_t i = 0; i < 4u; i++) {
-        tc->lam[i][0] = al[i];
-        tc->lam[i][1] = g[i][0];
-        tc->lam[i][2] = g[i][2];
+        tc->lam[0][i] = al[i];
+        tc->lam[1][i] = g[i][0];
+        tc->lam[2][i] = g[i][2];
     }
     for (uint32_t j = 0; j < 3u; j++) {
         tc->rest[0][j] = 0.0f;
         tc->rest[1][j] = 0.0f;
         tc->rest[2][j] = 0.0f;
         for (uint32_t i = 0; i < 4u; i++) {
-            tc->rest[0][j] += tc->lam[i][j] * m->rest_x[tv[i]];
-            tc->rest[1][j] += tc->lam[i][j] * m->rest_y[tv[i]];
-            tc->rest[2][j] += tc->lam[i][j] * m->rest_z[tv[i]];
+            tc->rest[0][j] += tc->lam[j][i] * m->rest_x[tv[i]];
+            tc->rest[1][j] += tc->lam[j][i] * m->rest_y[tv[i]];
+            tc->rest[2][j] += tc->lam[j][i] * m->rest_z[tv[i]];
         }
     }
     return tc;
@@ -681,7 +681,10 @@ static float walk(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t t, u
                   float s_in, uint32_t *k, uint32_t *steps, int *trouble)
 {
     const uint32_t n = c->n;
+    /* the line in locals: the cache's stores cannot alias them */
+    const float ox = c->ox, oz = c->oz, dx = c->dx, dz = c->dz;
     uint32_t reloc_k = UINT32_MAX; /* the sample of the last relocation */
+    uint32_t k_in = first_k(s_in, n); /* first_k(s_in), carried from the last step's exit */
     for (;;) {
         if (*steps >= SC_BSCAN_MAX_WALK_STEPS) {
             w->cnt->walk_aborts++;
@@ -694,7 +697,7 @@ static float walk(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t t, u
             /* flat or inverted: a fold; locate the samples from here on and walk on */
             uint32_t tn = 0;
             float sn = 0.0f;
-            const uint32_t ks = first_k(s_in, n);
+            const uint32_t ks = k_in;
             const int rr = relocate(w, m, c, ks, k, ks == reloc_k && *k <= ks, &tn, &sn);
             if (rr < 0) {
                 *trouble = 1;
@@ -708,40 +711,42 @@ static float walk(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t t, u
             t = tn;
             f_in = 4u;
             s_in = sn;
+            k_in = first_k(s_in, n);
             continue;
         }
         float a[4], be[4];
         for (uint32_t i = 0; i < 4u; i++) {
-            a[i] = tc->lam[i][0] + tc->lam[i][1] * c->ox + tc->lam[i][2] * c->oz;
-            be[i] = tc->lam[i][1] * c->dx + tc->lam[i][2] * c->dz;
+            a[i] = tc->lam[0][i] + tc->lam[1][i] * ox + tc->lam[2][i] * oz;
+            be[i] = tc->lam[1][i] * dx + tc->lam[2][i] * dz;
         }
         /* exit: the face whose coordinate reaches 0 first, s_i = -a_i / be_i over be_i < 0;
-         * compared by cross-multiplication (be_i be_j > 0), one division at the end */
+         * compared by cross-multiplication (be_i be_j > 0), one division at the end. Selects,
+         * not branches: which face it is does not follow a pattern the predictor learns. */
         uint32_t f_out = 4u;
+        float af = 0.0f, bf = 0.0f; /* a and be of f_out */
         for (uint32_t i = 0; i < 4u; i++) {
-            if (i != f_in && be[i] < 0.0f && (f_out == 4u || a[i] * be[f_out] > a[f_out] * be[i])) {
-                f_out = i;
-            }
+            const int take =
+                (i != f_in) & (be[i] < 0.0f) & ((f_out == 4u) | (a[i] * bf > af * be[i]));
+            f_out = take ? i : f_out;
+            af = take ? a[i] : af;
+            bf = take ? be[i] : bf;
         }
         if (f_out == 4u) {
             *trouble = 1; /* no way out along the ray: degenerate */
             return (float)n;
         }
-        float s_out = -a[f_out] / be[f_out];
+        float s_out = -af / bf;
         if (s_out < s_in) {
             s_out = s_in;
         }
-        uint32_t k0 = first_k(s_in, n);
-        if (k0 < *k) {
-            k0 = *k;
-        }
+        const uint32_t k0 = k_in < *k ? *k : k_in;
         const uint32_t k1 = first_k(s_out, n);
         if (k1 > k0) {
             /* rest position along the ray inside this tet: A + s B (mm), then voxel units */
             float ra[3], vb[3], va[3];
             for (uint32_t d = 0; d < 3u; d++) {
-                ra[d] = tc->rest[d][0] + tc->rest[d][1] * c->ox + tc->rest[d][2] * c->oz;
-                vb[d] = (tc->rest[d][1] * c->dx + tc->rest[d][2] * c->dz) * c->inv_sp[d];
+                ra[d] = tc->rest[d][0] + tc->rest[d][1] * ox + tc->rest[d][2] * oz;
+                vb[d] = (tc->rest[d][1] * dx + tc->rest[d][2] * dz) * c->inv_sp[d];
             }
             to_vox(c, ra, va);
             emit_run(w, k0, k1, va, vb);
@@ -757,13 +762,12 @@ static float walk(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t t, u
         const uint32_t u = (uint32_t)nb;
         uint32_t back = 4u;
         for (uint32_t v = 0; v < 4u; v++) {
-            if (m->tet_nbr[u][v] == (int32_t)t) {
-                back = v;
-            }
+            back = m->tet_nbr[u][v] == (int32_t)t ? v : back;
         }
         t = u;
         f_in = back;
         s_in = s_out;
+        k_in = k1;
     }
 }
 

@@ -163,8 +163,8 @@ typedef struct sc_bscan_run {
  * the image-frame (x, z), valid for the frame `epoch`. */
 typedef struct sc_bscan_tcache {
     uint32_t epoch, tet, ok;
-    float lam[4][3];
-    float rest[3][3];
+    float lam[3][4];  /* lambda_i = lam[0][i] + lam[1][i] x + lam[2][i] z (face i's coordinate) */
+    float rest[3][3]; /* rest position d = rest[d][0] + rest[d][1] x + rest[d][2] z */
 } sc_bscan_tcache;
 
 /* Entries of the walker's tet cache (power of two). */
