@@ -602,13 +602,14 @@ static const sc_bscan_tcache *tet_cached(line_w *w, const sc_mesh *m, uint32_t t
         tc->lam[2][i] = g[i][2];
     }
     for (uint32_t j = 0; j < 3u; j++) {
-        tc->rest[0][j] = 0.0f;
-        tc->rest[1][j] = 0.0f;
-        tc->rest[2][j] = 0.0f;
+        tc->rest[j][0] = 0.0f;
+        tc->rest[j][1] = 0.0f;
+        tc->rest[j][2] = 0.0f;
+        tc->rest[j][3] = 0.0f;
         for (uint32_t i = 0; i < 4u; i++) {
-            tc->rest[0][j] += tc->lam[j][i] * m->rest_x[tv[i]];
-            tc->rest[1][j] += tc->lam[j][i] * m->rest_y[tv[i]];
-            tc->rest[2][j] += tc->lam[j][i] * m->rest_z[tv[i]];
+            tc->rest[j][0] += tc->lam[j][i] * m->rest_x[tv[i]];
+            tc->rest[j][1] += tc->lam[j][i] * m->rest_y[tv[i]];
+            tc->rest[j][2] += tc->lam[j][i] * m->rest_z[tv[i]];
         }
     }
     return tc;
@@ -674,37 +675,137 @@ static int relocate(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t ks
     return 0;
 }
 
+/* Four floats of the walker's step (a tet's four faces, or a point's three coordinates and a
+ * pad), lane by lane the same IEEE operations as the scalar expressions they replace: GCC's
+ * vectors where there are any (SSE, NEON; lowered to scalar code elsewhere), arrays otherwise
+ * (and in the one-lane build, -DSC_VEC_SCALAR, which tests that path). */
+#if defined(__GNUC__) && !defined(SC_VEC_SCALAR)
+#define SC_W4_VECTOR 1
+#else
+#define SC_W4_VECTOR 0
+#endif
+#if SC_W4_VECTOR
+typedef float w4 __attribute__((vector_size(16)));
+static inline w4 w4_ld(const float *p)
+{
+    w4 v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
+static inline w4 w4_splat(float x)
+{
+    const w4 v = {x, x, x, x};
+    return v;
+}
+#define W4_LANE(v, i) ((v)[i])
+#else
+typedef struct w4 {
+    float l[4];
+} w4;
+static inline w4 w4_ld(const float *p)
+{
+    w4 v;
+    memcpy(v.l, p, sizeof v.l);
+    return v;
+}
+static inline w4 w4_splat(float x)
+{
+    const w4 v = {{x, x, x, x}};
+    return v;
+}
+#define W4_LANE(v, i) ((v).l[i])
+#endif
+/* a + b x + c y, and b x + c y, lane by lane */
+static inline w4 w4_affine(w4 a, w4 b, w4 c, float x, float y)
+{
+#if SC_W4_VECTOR
+    return (a + b * w4_splat(x)) + c * w4_splat(y);
+#else
+    w4 r;
+    for (uint32_t i = 0; i < 4u; i++) {
+        r.l[i] = (a.l[i] + b.l[i] * x) + c.l[i] * y;
+    }
+    return r;
+#endif
+}
+static inline w4 w4_lin(w4 b, w4 c, float x, float y)
+{
+#if SC_W4_VECTOR
+    return b * w4_splat(x) + c * w4_splat(y);
+#else
+    w4 r;
+    for (uint32_t i = 0; i < 4u; i++) {
+        r.l[i] = b.l[i] * x + c.l[i] * y;
+    }
+    return r;
+#endif
+}
+/* (a - o) s and a s, lane by lane */
+static inline w4 w4_subs(w4 a, w4 o, w4 sc)
+{
+#if SC_W4_VECTOR
+    return (a - o) * sc;
+#else
+    w4 r;
+    for (uint32_t i = 0; i < 4u; i++) {
+        r.l[i] = (a.l[i] - o.l[i]) * sc.l[i];
+    }
+    return r;
+#endif
+}
+static inline w4 w4_mul(w4 a, w4 sc)
+{
+#if SC_W4_VECTOR
+    return a * sc;
+#else
+    w4 r;
+    for (uint32_t i = 0; i < 4u; i++) {
+        r.l[i] = a.l[i] * sc.l[i];
+    }
+    return r;
+#endif
+}
+
 /* Walk the current line from tet t, entered through local face f_in (4: none) at line
  * parameter s_in, writing the rest positions of the samples from *k on. Returns the parameter
  * where the walk left the mesh (or >= n when it reached the end of the line). */
 static float walk(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t t, uint32_t f_in,
-                  float s_in, uint32_t *k, uint32_t *steps, int *trouble)
+                  float s_in, uint32_t *k_io, uint32_t *steps_io, int *trouble)
 {
     const uint32_t n = c->n;
+    /* the sample and step counts in registers (the runs' stores may alias what they point
+     * at), written back on every way out */
+    uint32_t k = *k_io, steps = *steps_io;
     /* the line in locals: the cache's stores cannot alias them */
     const float ox = c->ox, oz = c->oz, dx = c->dx, dz = c->dz;
+    const float vo4[4] = {c->vo[0], c->vo[1], c->vo[2], 0.0f};
+    const float sp4[4] = {c->inv_sp[0], c->inv_sp[1], c->inv_sp[2], 0.0f};
+    const w4 vo = w4_ld(vo4), isp = w4_ld(sp4);
     uint32_t reloc_k = UINT32_MAX; /* the sample of the last relocation */
     uint32_t k_in = first_k(s_in, n); /* first_k(s_in), carried from the last step's exit */
     for (;;) {
-        if (*steps >= SC_BSCAN_MAX_WALK_STEPS) {
+        if (steps >= SC_BSCAN_MAX_WALK_STEPS) {
             w->cnt->walk_aborts++;
             *trouble = 1;
+            *k_io = k;
+            *steps_io = steps;
             return (float)n;
         }
-        (*steps)++;
+        steps++;
         const sc_bscan_tcache *tc = tet_cached(w, m, t);
         if (!tc->ok) {
             /* flat or inverted: a fold; locate the samples from here on and walk on */
             uint32_t tn = 0;
             float sn = 0.0f;
             const uint32_t ks = k_in;
-            const int rr = relocate(w, m, c, ks, k, ks == reloc_k && *k <= ks, &tn, &sn);
-            if (rr < 0) {
-                *trouble = 1;
-                return (float)n;
-            }
-            if (rr == 0) {
-                return sn;
+            uint32_t kr = k;
+            const int rr = relocate(w, m, c, ks, &kr, ks == reloc_k && k <= ks, &tn, &sn);
+            k = kr;
+            if (rr <= 0) {
+                *trouble = rr < 0 ? 1 : *trouble;
+                *k_io = k;
+                *steps_io = steps;
+                return rr < 0 ? (float)n : sn;
             }
             w->cnt->walk_relocations++;
             reloc_k = (uint32_t)sn;
@@ -714,11 +815,10 @@ static float walk(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t t, u
             k_in = first_k(s_in, n);
             continue;
         }
-        float a[4], be[4];
-        for (uint32_t i = 0; i < 4u; i++) {
-            a[i] = tc->lam[0][i] + tc->lam[1][i] * ox + tc->lam[2][i] * oz;
-            be[i] = tc->lam[1][i] * dx + tc->lam[2][i] * dz;
-        }
+        const w4 l1 = w4_ld(tc->lam[1]), l2 = w4_ld(tc->lam[2]);
+        const w4 av = w4_affine(w4_ld(tc->lam[0]), l1, l2, ox, oz), bv = w4_lin(l1, l2, dx, dz);
+        const float a[4] = {W4_LANE(av, 0), W4_LANE(av, 1), W4_LANE(av, 2), W4_LANE(av, 3)};
+        const float be[4] = {W4_LANE(bv, 0), W4_LANE(bv, 1), W4_LANE(bv, 2), W4_LANE(bv, 3)};
         /* exit: the face whose coordinate reaches 0 first, s_i = -a_i / be_i over be_i < 0;
          * compared by cross-multiplication (be_i be_j > 0), one division at the end. Selects,
          * not branches: which face it is does not follow a pattern the predictor learns. */
@@ -733,30 +833,30 @@ static float walk(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t t, u
         }
         if (f_out == 4u) {
             *trouble = 1; /* no way out along the ray: degenerate */
+            *k_io = k;
+            *steps_io = steps;
             return (float)n;
         }
         float s_out = -af / bf;
         if (s_out < s_in) {
             s_out = s_in;
         }
-        const uint32_t k0 = k_in < *k ? *k : k_in;
+        const uint32_t k0 = k_in < k ? k : k_in;
         const uint32_t k1 = first_k(s_out, n);
         if (k1 > k0) {
             /* rest position along the ray inside this tet: A + s B (mm), then voxel units */
-            float ra[3], vb[3], va[3];
-            for (uint32_t d = 0; d < 3u; d++) {
-                ra[d] = tc->rest[d][0] + tc->rest[d][1] * ox + tc->rest[d][2] * oz;
-                vb[d] = (tc->rest[d][1] * dx + tc->rest[d][2] * dz) * c->inv_sp[d];
-            }
-            to_vox(c, ra, va);
-            emit_run(w, k0, k1, va, vb);
-            *k = k1;
-        }
-        if (s_out >= (float)n) {
-            return s_out;
+            const w4 r1 = w4_ld(tc->rest[1]), r2 = w4_ld(tc->rest[2]);
+            const w4 ra = w4_affine(w4_ld(tc->rest[0]), r1, r2, ox, oz);
+            const w4 vbv = w4_mul(w4_lin(r1, r2, dx, dz), isp), vav = w4_subs(ra, vo, isp);
+            const float va[3] = {W4_LANE(vav, 0), W4_LANE(vav, 1), W4_LANE(vav, 2)};
+            const float vb[3] = {W4_LANE(vbv, 0), W4_LANE(vbv, 1), W4_LANE(vbv, 2)};
+            emit_run(w, k0, k1, va, vb); /* to_vox's (p - vo) inv_sp, lane by lane */
+            k = k1;
         }
         const int32_t nb = m->tet_nbr[t][f_out];
-        if (nb < 0) {
+        if (s_out >= (float)n || nb < 0) {
+            *k_io = k;
+            *steps_io = steps;
             return s_out;
         }
         const uint32_t u = (uint32_t)nb;

@@ -164,7 +164,7 @@ typedef struct sc_bscan_run {
 typedef struct sc_bscan_tcache {
     uint32_t epoch, tet, ok;
     float lam[3][4];  /* lambda_i = lam[0][i] + lam[1][i] x + lam[2][i] z (face i's coordinate) */
-    float rest[3][3]; /* rest position d = rest[d][0] + rest[d][1] x + rest[d][2] z */
+    float rest[3][4]; /* rest position d = rest[0][d] + rest[1][d] x + rest[2][d] z; [3] 0 */
 } sc_bscan_tcache;
 
 /* Entries of the walker's tet cache (power of two). */
