@@ -774,8 +774,9 @@ static float walk(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t t, u
 {
     const uint32_t n = c->n;
     /* the sample and step counts in registers (the runs' stores may alias what they point
-     * at), written back on every way out */
+     * at), written back at the one way out */
     uint32_t k = *k_io, steps = *steps_io;
+    float out = (float)n; /* where the walk left the mesh: n at the line's end or in trouble */
     /* the line in locals: the cache's stores cannot alias them */
     const float ox = c->ox, oz = c->oz, dx = c->dx, dz = c->dz;
     const float vo4[4] = {c->vo[0], c->vo[1], c->vo[2], 0.0f};
@@ -787,9 +788,7 @@ static float walk(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t t, u
         if (steps >= SC_BSCAN_MAX_WALK_STEPS) {
             w->cnt->walk_aborts++;
             *trouble = 1;
-            *k_io = k;
-            *steps_io = steps;
-            return (float)n;
+            break;
         }
         steps++;
         const sc_bscan_tcache *tc = tet_cached(w, m, t);
@@ -801,11 +800,13 @@ static float walk(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t t, u
             uint32_t kr = k;
             const int rr = relocate(w, m, c, ks, &kr, ks == reloc_k && k <= ks, &tn, &sn);
             k = kr;
-            if (rr <= 0) {
-                *trouble = rr < 0 ? 1 : *trouble;
-                *k_io = k;
-                *steps_io = steps;
-                return rr < 0 ? (float)n : sn;
+            if (rr < 0) {
+                *trouble = 1;
+                break;
+            }
+            if (rr == 0) {
+                out = sn;
+                break;
             }
             w->cnt->walk_relocations++;
             reloc_k = (uint32_t)sn;
@@ -833,9 +834,7 @@ static float walk(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t t, u
         }
         if (f_out == 4u) {
             *trouble = 1; /* no way out along the ray: degenerate */
-            *k_io = k;
-            *steps_io = steps;
-            return (float)n;
+            break;
         }
         float s_out = -af / bf;
         if (s_out < s_in) {
@@ -855,9 +854,8 @@ static float walk(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t t, u
         }
         const int32_t nb = m->tet_nbr[t][f_out];
         if (s_out >= (float)n || nb < 0) {
-            *k_io = k;
-            *steps_io = steps;
-            return s_out;
+            out = s_out;
+            break;
         }
         const uint32_t u = (uint32_t)nb;
         uint32_t back = 4u;
@@ -869,6 +867,9 @@ static float walk(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t t, u
         s_in = s_out;
         k_in = k1;
     }
+    *k_io = k;
+    *steps_io = steps;
+    return out;
 }
 
 static void map_line_walk(line_w *w, const sc_mesh *m, uint32_t l, const frame_ctx *c)
