@@ -240,6 +240,7 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
     g->rest_patched = 0u;
     g->prefetch = (uint8_t)(nn > SC_GRID_PREFETCH_NODES);
     g->springs_fused = (uint8_t)(nn > SC_GRID_SPRINGS_FUSED_NODES);
+    g->face_pairs = (uint8_t)(SC_GRID_PAIRS && nn <= SC_GRID_PAIRS_NODES);
     g->step_max_mm = 2.0f * sqrtf(m->cell_mm[0] * m->cell_mm[0] + m->cell_mm[1] * m->cell_mm[1] +
                                   m->cell_mm[2] * m->cell_mm[2]);
     init_slots(g);
@@ -322,6 +323,21 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
     zero_rows(&g->p[0][0], 3u, used);
     zero_rows(&g->q[0][0], 3u, used);
     zero_rows(&g->pc[0][0], 3u, used);
+#if SC_GRID_PAIRS
+    if (nn <= SC_GRID_PAIRS_NODES) {
+        /* zero outside the packed pairs: the face sums by pair read there (sc_grid.h) */
+        const size_t pused = SC_GRID_PROW;
+        SC_ASSERT(SC_GRID_PHEAD + g->node_end / 2u + (nxy + nx + 1u) / 2u + 1u <= SC_GRID_PROW &&
+                  (nxy + nx + 1u) / 2u + 1u <= SC_GRID_PHEAD);
+        float *fp = &g->fpair[0][0][0][0];
+        for (uint32_t k = 0; k < 54u; k++) {
+            memset(fp + (size_t)k * SC_GRID_PROW, 0, pused * sizeof(float));
+        }
+        for (uint32_t c = 0; c < 3u; c++) {
+            memset(g->ppair[c], 0, pused * sizeof(float));
+        }
+    }
+#endif
     memset(g->odd, 0, (size_t)used * sizeof(int32_t));
     memset(g->cell_odd, 0, (size_t)used * sizeof(int32_t));
     memset(g->cell_ok, 0, (size_t)used * sizeof(int32_t));

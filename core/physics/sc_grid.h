@@ -151,6 +151,25 @@ _Static_assert(SC_GRID_POOL_RANGE % SC_GRID_CHUNK == 0u && SC_GRID_SUM_BLOCK % 1
 #define SC_GRID_SPRINGS_FUSED_NODES 8192u
 #endif
 #define SC_GRID_MAT_ROWS 60u /* d 6, e 27, f 27: row k of the matrix at &d[0][0] + k ROW */
+/* The mat-vec's face sums by node pairs (sc_grid_kern.inc, face_pairs): a face diagonal joins two
+ * odd nodes (i + j + k odd), so the face passes over whole vectors of nodes did half their work
+ * for even lanes they then dropped. Nodes 2m and 2m + 1 (a pair: on one grid row when nx is even,
+ * one odd node and one even one) give the pair copies below: the face rows of each pair's odd
+ * node (its main diagonals) and of its even node (its anti diagonals), and p at its odd node.
+ * A vector of pairs is then a vector of odd nodes, every lane used, each with the same products
+ * in the same order as before: the same bits. The face rows are copied once per CG (and per lone
+ * mat-vec), p as the CG forms it. Meshes of up to SC_GRID_PAIRS_NODES nodes, whose matrix the
+ * caches hold, with whole vectors of pairs in a row (nx a multiple of twice the kernel's vector
+ * width): `bench-physics 300 cg 32x16x16`, CG of 10 iterations 0.88-0.92 -> 0.82-0.84 ms. On
+ * the larger meshes the product waits on memory, where the copy's bytes cost more than the
+ * lanes save (64x32x32, one thread: 9.9 -> 10.4-11.1 ms). Builds with the rest copy only (the
+ * MCU's SRAM holds no 27 more rows). */
+#define SC_GRID_PAIRS       SC_GRID_REST_COPY
+#define SC_GRID_PAIRS_NODES 8192u
+/* pair m at SC_GRID_PHEAD + m: the farthest neighbour pair of a mesh of at most
+ * SC_GRID_PAIRS_NODES nodes (nz >= 2) is within (nx ny + nx + 1) / 2 + 1 <= 4096 pairs */
+#define SC_GRID_PHEAD (SC_GRID_PAIRS_NODES / 2u)
+#define SC_GRID_PROW  ((((3u * SC_GRID_PHEAD + 15u) / 16u) | 1u) * 16u)
 
 /* The cell passes (FEM assembly, the MSDS's volume terms) on the worker pool: the cell origins
  * are cut into ranges of SC_GRID_ASM_SPAN origins (whole cell blocks); the even ranges run first
@@ -218,6 +237,9 @@ typedef struct sc_grid {
     uint8_t prefetch;   /* 1: the kernels prefetch (node_count > SC_GRID_PREFETCH_NODES) */
     uint8_t springs_fused; /* 1: the MSDS's springs in one pass (node_count >
                               SC_GRID_SPRINGS_FUSED_NODES; either value gives the same bits) */
+    uint8_t face_pairs;   /* 1: the mat-vec takes the face sums by pair where it can (SC_GRID_PAIRS:
+                             node_count <= SC_GRID_PAIRS_NODES); 0 (a test's): the whole-vector
+                             passes. Either gives the same bits; set it to 0 only. */
     uint8_t rest_patched; /* 1: the matrix is the rest K but for a floor_only pass's additions in
                              the cell ranges marked in floor_dirty (0 after sc_grid_clear) */
     uint8_t floor_dirty[SC_GRID_ASM_RANGES];
@@ -261,6 +283,11 @@ typedef struct sc_grid {
     SC_ALIGN_HOT int32_t cell_ok[SC_GRID_ROW];  /* -1: a cell has this origin */
     uint8_t con[SC_GRID_ROW]; /* this step: 1 fixed, 2 kinematic, 0 free, 0x80 | roller bits */
     uint8_t used[SC_MAX_NODES]; /* node belongs to at least one tet */
+#if SC_GRID_PAIRS
+    /* ---- the face rows and p by node pair (pair m at SC_GRID_PHEAD + m; SC_GRID_PAIRS) ---- */
+    SC_ALIGN_HOT float fpair[3][9][2][SC_GRID_PROW]; /* [..][0]: the odd node's, [1]: the even's */
+    SC_ALIGN_HOT float ppair[3][SC_GRID_PROW];       /* p at the pair's odd node */
+#endif
 #if SC_GRID_REST_COPY
     /* ---- the linear FEM's rest K, rows as d, e, f (above) ---- */
     SC_ALIGN_HOT float rest[SC_GRID_MAT_ROWS][SC_GRID_ROW];
