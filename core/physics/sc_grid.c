@@ -326,16 +326,10 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
 #if SC_GRID_PAIRS
     if (nn <= SC_GRID_PAIRS_NODES) {
         /* zero outside the packed pairs: the face sums by pair read there (sc_grid.h) */
-        const size_t pused = SC_GRID_PROW;
         SC_ASSERT(SC_GRID_PHEAD + g->node_end / 2u + (nxy + nx + 1u) / 2u + 1u <= SC_GRID_PROW &&
                   (nxy + nx + 1u) / 2u + 1u <= SC_GRID_PHEAD);
-        float *fp = &g->fpair[0][0][0][0];
-        for (uint32_t k = 0; k < 54u; k++) {
-            memset(fp + (size_t)k * SC_GRID_PROW, 0, pused * sizeof(float));
-        }
-        for (uint32_t c = 0; c < 3u; c++) {
-            memset(g->ppair[c], 0, pused * sizeof(float));
-        }
+        memset(g->fpair, 0, sizeof g->fpair);
+        memset(g->ppair, 0, sizeof g->ppair);
     }
 #endif
     memset(g->odd, 0, (size_t)used * sizeof(int32_t));
