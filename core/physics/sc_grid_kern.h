@@ -32,6 +32,9 @@ typedef struct sc_grid_kern {
     void (*msds_springs)(sc_grid *g, const sc_msds *s, float dt, float ck);
     /* The MSDS volume and floor terms, added. */
     void (*msds_cells)(sc_grid *g, const sc_msds *s, float dt, float ck);
+    /* The stable MSDS's step matrix: msds_springs, then msds_cells if cells != 0, with the same
+     * bits; on the large meshes (sc_grid.springs_fused) in one pass, range by range. */
+    void (*msds_assemble)(sc_grid *g, const sc_msds *s, float dt, float ck, int cells);
     /* The polar rotation of one element by the kernels' lane code (tests): 1, or 0 with
      * R = I when det F <= 1e-3. */
     int (*polar)(const float F[9], float R[9]);

@@ -1,6 +1,6 @@
 /* sc_msds_implicit.c: backward Euler for the MSDS on the grid matrix; see
- * sc_msds_implicit.h. The springs' and the volume term's assembly are sc_grid_kern.inc's
- * msds_springs and msds_cells. */
+ * sc_msds_implicit.h. The springs' and the volume term's assembly is sc_grid_kern.inc's
+ * msds_assemble (msds_springs and msds_cells). */
 #include "sc_msds_implicit.h"
 
 #include <math.h>
@@ -24,11 +24,9 @@ void sc_msds_implicit_step(const sc_msds *s, sc_fem *f, const sc_mesh *m, sc_nod
     sc_grid_begin(&f->grid, m, n, dt_s, beta, alpha, kinematic);
     sc_grid_clear(&f->grid, SC_GRID_CLEAR_DIAG);
     f->rest_k = 0u;
-    k->msds_springs(&f->grid, s, dt_s, ck);
-    if (s->def.volume_stiffness_ratio > 0.0f ||
-        (s->def.floor_volume_ratio > 0.0f && s->def.floor_pa > 0.0f)) {
-        k->msds_cells(&f->grid, s, dt_s, ck);
-    }
+    k->msds_assemble(&f->grid, s, dt_s, ck,
+                     s->def.volume_stiffness_ratio > 0.0f ||
+                         (s->def.floor_volume_ratio > 0.0f && s->def.floor_pa > 0.0f));
     f->stats.degenerate_tets = 0u;
     const int rc = sc_grid_solve(&f->grid, n, dt_s, beta, alpha, cg_iterations);
     f->stats.cg_iterations_run = f->grid.stats.cg_iterations_run;
