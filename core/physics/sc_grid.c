@@ -305,31 +305,29 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
             (void)kb;
         }
     }
-    /* write_cell's pairs: an upper target's lower one is of its row family, one node before it,
-     * and the next target of that family in the walk; every lower target has its upper one */
-    uint32_t lows = 0;
+    /* write_cell's pairs: two targets naming each other, of one row family, the upper one (odd
+     * corner) one node after the lower one and written first, with no other target of that
+     * family between them in the walk */
     for (uint32_t a = 0; a < no; a++) {
-        const uint32_t hi = order[a], lo = sc_grid_tmpl_pair_lo[hi];
-        lows += sc_grid_tmpl_pair_is_lo[hi];
+        const uint32_t hi = order[a], lo = sc_grid_tmpl_pair[hi];
         if (lo == 0xffu) {
             continue;
         }
+        SC_ASSERT(lo < SC_GRID_TARGETS && sc_grid_tmpl_pair[lo] == hi);
         const uint8_t *kh = sc_grid_tmpl_target[hi], *kl = sc_grid_tmpl_target[lo];
-        SC_ASSERT(lo < SC_GRID_TARGETS && sc_grid_tmpl_pair_is_lo[lo] == 1u &&
-                  sc_grid_tmpl_pair_is_lo[hi] == 0u && kh[0] == kl[0] && kh[1] == kl[1] &&
-                  g->off[kh[2]] == g->off[kl[2]] + 1u);
+        SC_ASSERT(((kh[2] ^ kl[2]) & 1u) == 1u); /* one upper, one lower */
+        if ((kh[2] & 1u) == 0u) {
+            continue; /* the lower one: checked from its upper one */
+        }
+        SC_ASSERT(kh[0] == kl[0] && kh[1] == kl[1] && g->off[kh[2]] == g->off[kl[2]] + 1u);
         uint32_t b = a + 1u;
         while (b < no && (sc_grid_tmpl_target[order[b]][0] != kh[0] ||
                           sc_grid_tmpl_target[order[b]][1] != kh[1])) {
             b++;
         }
         SC_ASSERT(b < no && order[b] == lo);
-        (void)kh;
         (void)kl;
-        lows--;
     }
-    SC_ASSERT(lows == 0u);
-    (void)lows;
     memset(&g->stats, 0, sizeof g->stats);
     memset(g->below_n, 0, sizeof g->below_n);
     memset(g->floor_dirty, 0, sizeof g->floor_dirty);

@@ -44,15 +44,12 @@ static const uint8_t sc_grid_tmpl_target[26][7] = {
     {2u, 2u, 0u, 5u, 10u, 0u, 0u},  {2u, 2u, 1u, 10u, 5u, 0u, 0u}};
 
 /* write_cell's pairs of targets one node apart in one row family (kind and axis; corners c + 1
- * and c, same group): per upper target its lower one, else 0xff; per lower target 1. The walk
- * writes the upper one first, so a row's two vectors at node offsets 1 and 0 overlap in all but
- * one lane: written as one (write_cell), not a load waiting on the store just before it. */
-static const uint8_t sc_grid_tmpl_pair_lo[26] = {
-    0xffu, 0u,    0xffu, 2u,    0xffu, 4u,    0xffu, 6u,    0xffu, 0xffu, 0xffu, 0xffu, 0xffu,
-    12u,   0xffu, 14u,   0xffu, 16u,   0xffu, 18u,   0xffu, 0xffu, 0xffu, 0xffu, 0xffu, 24u};
-static const uint8_t sc_grid_tmpl_pair_is_lo[26] = {1u, 0u, 1u, 0u, 1u, 0u, 1u, 0u, 0u,
-                                                    0u, 0u, 0u, 1u, 0u, 1u, 0u, 1u, 0u,
-                                                    1u, 0u, 0u, 0u, 0u, 0u, 1u, 0u};
+ * and c, same group): per target of a pair the other one, else 0xff. The walk writes the upper
+ * one (odd corner) first, so a row's two vectors at node offsets 1 and 0 overlap in all but one
+ * lane: written as one (write_cell), not a load waiting on the store just before it. */
+static const uint8_t sc_grid_tmpl_pair[26] = {
+    1u,  0u,  3u,  2u,  5u,  4u,  7u,  6u,    0xffu, 0xffu, 0xffu, 0xffu, 13u,
+    12u, 15u, 14u, 17u, 16u, 19u, 18u, 0xffu, 0xffu, 0xffu, 0xffu, 25u,   24u};
 
 /* the template entries computed together (kind 0 corner or 1 edge slot, entry, entry; one entry
  * twice where it feeds its targets alone): every target's two sources, src0 and src1, lie in one
