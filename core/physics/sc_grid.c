@@ -240,9 +240,6 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
     g->rest_patched = 0u;
     g->prefetch = (uint8_t)(nn > SC_GRID_PREFETCH_NODES);
     g->springs_fused = (uint8_t)(nn > SC_GRID_SPRINGS_FUSED_NODES);
-    g->asm_reach =
-        (nxy + nx + 1u + SC_GRID_CELL_BLOCK - 1u) / SC_GRID_CELL_BLOCK * SC_GRID_CELL_BLOCK;
-    SC_ASSERT(g->asm_reach <= g->asm_span);
     g->face_pairs = (uint8_t)(SC_GRID_PAIRS && nn <= SC_GRID_PAIRS_NODES);
     g->step_max_mm = 2.0f * sqrtf(m->cell_mm[0] * m->cell_mm[0] + m->cell_mm[1] * m->cell_mm[1] +
                                   m->cell_mm[2] * m->cell_mm[2]);

@@ -148,7 +148,7 @@ _Static_assert(SC_GRID_POOL_RANGE % SC_GRID_CHUNK == 0u && SC_GRID_SUM_BLOCK % 1
  * 2.3x the spring arithmetic: `bench-physics 20 stages 64x32x32`, one worker, springs 4.47 ->
  * 3.98 ms; `bench-physics 100 stages 32x16x16` 0.33-0.34 -> 0.43 ms (the rows stay in cache
  * there, the arithmetic shows). On these meshes the springs also run range by range with the
- * cells' volume terms (msds_assemble, sc_grid.asm_reach): the cells add into rows still in the
+ * cells' volume terms (msds_assemble): the cells add into rows still in the
  * core's cache instead of reading the whole matrix back (same bits). */
 #ifndef SC_GRID_SPRINGS_FUSED_NODES
 #define SC_GRID_SPRINGS_FUSED_NODES 8192u
@@ -234,7 +234,6 @@ typedef struct sc_grid {
     uint32_t node_end;  /* node_count rounded up to SC_GRID_CHUNK */
     uint32_t cell_end;  /* cell origins 0 .. cell_end - 1 are visited (rounded up to a block) */
     uint32_t asm_span;  /* cell origins per range of the cell passes (SC_GRID_ASM_SPAN above) */
-    uint32_t asm_reach; /* nx ny + nx + 1 (a cell's farthest corner) in whole cell blocks */
     uint32_t sum_block; /* nodes per block of the CG's dot products (SC_GRID_SUM_BLOCK above) */
     uint32_t range;     /* nodes per range of the node loops and the CG (SC_GRID_POOL_RANGE) */
     uint8_t rest_saved; /* 1: rest[] holds a rest K (sc_grid_save_rest; 0 after sc_grid_init) */
