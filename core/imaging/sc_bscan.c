@@ -398,11 +398,20 @@ static inline float max_f(float a, float b)
     return (b > a || isnan(a)) ? b : a;
 }
 
+#define SC_BSCAN_HULL_AHEAD 16u
+
 static void build_segments(sc_bscan *b, const sc_mesh *m)
 {
     const uint32_t lines = b->def.scan.lines_n;
     uint32_t ns = 0;
     for (uint32_t h = 0; h < b->hull_count; h++) {
+#if defined(__GNUC__)
+        /* the hull's tets are all over the tet array (4.8 MB at 64x32x32): the corners of the
+         * face SC_BSCAN_HULL_AHEAD on asked for now, so that their load does not wait */
+        if (h + SC_BSCAN_HULL_AHEAD < b->hull_count) {
+            __builtin_prefetch(m->tet[b->hull[h + SC_BSCAN_HULL_AHEAD].tet], 0, 1);
+        }
+#endif
         const uint32_t t = b->hull[h].tet, v = b->hull[h].face;
         uint32_t f[3], fi = 0;
         for (uint32_t w = 0; w < 4u; w++) {
@@ -592,8 +601,8 @@ static const sc_bscan_tcache *tet_cached(line_w *w, const sc_mesh *m, uint32_t t
     tc->tet = t;
     const uint32_t *tv = m->tet[t];
     float al[4], g[4][3];
-    tc->ok = (uint32_t)(tet_affine(b, tv, al, g) == 1); /* the walker needs orientation */
-    if (!tc->ok) {
+    tc->orient = tet_affine(b, tv, al, g);
+    if (tc->orient == 0) {
         return tc;
     }
     for (uint32_t i = 0; i < 4u; i++) {
@@ -617,8 +626,9 @@ static const sc_bscan_tcache *tet_cached(line_w *w, const sc_mesh *m, uint32_t t
 
 static int build_regions(sc_bscan *b, const sc_mesh *m);
 static void map_line_regions(line_w *w, const sc_mesh *m, uint32_t l, const frame_ctx *c);
-static int32_t locate_deepest(sc_bscan *b, const sc_mesh *m, uint32_t r, float x, float z);
-static void fill_run(line_w *w, const frame_ctx *c, uint32_t ta, uint32_t a, uint32_t z);
+static int32_t locate_deepest(line_w *w, const sc_mesh *m, uint32_t r, float x, float z);
+static void fill_run(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t ta, uint32_t a,
+                     uint32_t z);
 static uint32_t region_of_line(uint32_t l, uint32_t lines, uint32_t regions);
 
 /* Where the walk cannot go on through face neighbours (a fold: an inverted or flat tet next),
@@ -656,7 +666,7 @@ static int relocate(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t ks
     const uint32_t r = region_of_line(c->line, b->def.scan.lines_n, b->def.regions_n);
     for (uint32_t kk = ks < *k ? *k : ks; kk < c->n; kk++) {
         const int32_t pi =
-            locate_deepest(b, m, r, c->ox + (float)kk * c->dx, c->oz + (float)kk * c->dz);
+            locate_deepest(w, m, r, c->ox + (float)kk * c->dx, c->oz + (float)kk * c->dz);
         if (pi < 0) {
             *s_out = (float)kk;
             return 0;
@@ -667,7 +677,7 @@ static int relocate(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t ks
             *s_out = (float)kk;
             return 1;
         }
-        fill_run(w, c, (uint32_t)pi, kk, kk);
+        fill_run(w, m, c, (uint32_t)pi, kk, kk);
         *k = kk + 1u;
         fill_first = 0;
     }
@@ -792,7 +802,7 @@ static float walk(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t t, u
         }
         steps++;
         const sc_bscan_tcache *tc = tet_cached(w, m, t);
-        if (!tc->ok) {
+        if (tc->orient != 1) {
             /* flat or inverted: a fold; locate the samples from here on and walk on */
             uint32_t tn = 0;
             float sn = 0.0f;
@@ -936,41 +946,6 @@ static uint32_t region_of_line(uint32_t l, uint32_t lines, uint32_t regions)
     return (l * regions) / lines;
 }
 
-/* sc_bscan_ptet.tet: the maps (lam, rest) not computed yet */
-#define SC_PTET_PENDING 0x80000000u
-_Static_assert(SC_MAX_TETS < SC_PTET_PENDING, "tet indices leave the pending bit free");
-
-/* The maps of a plane tet, computed on its first point test: most plane tets are never tested
- * (the walker relocates on a few lines); the same function of the same inputs as when they
- * were computed for every plane tet, so the same values. */
-static void ptet_ready(sc_bscan *b, const sc_mesh *m, sc_bscan_ptet *p)
-{
-    if ((p->tet & SC_PTET_PENDING) == 0u) {
-        return;
-    }
-    const uint32_t t = p->tet & ~SC_PTET_PENDING;
-    const uint32_t *tv = m->tet[t];
-    float al[4], g[4][3];
-    (void)tet_affine(b, tv, al, g); /* not flat: add_plane_tet checked */
-    for (uint32_t i = 0; i < 4u; i++) {
-        p->lam[i][0] = al[i];
-        p->lam[i][1] = g[i][0];
-        p->lam[i][2] = g[i][2];
-    }
-    for (uint32_t j = 0; j < 3u; j++) {
-        p->rest[0][j] = 0.0f;
-        p->rest[1][j] = 0.0f;
-        p->rest[2][j] = 0.0f;
-        for (uint32_t i = 0; i < 4u; i++) {
-            p->rest[0][j] += p->lam[i][j] * m->rest_x[tv[i]];
-            p->rest[1][j] += p->lam[i][j] * m->rest_y[tv[i]];
-            p->rest[2][j] += p->lam[i][j] * m->rest_z[tv[i]];
-        }
-    }
-    p->tet = t;
-}
-
-
 /* Index of the lowest set bit of x != 0. */
 static inline uint32_t sc_ctz64(uint64_t x)
 {
@@ -985,6 +960,8 @@ static inline uint32_t sc_ctz64(uint64_t x)
     return n;
 #endif
 }
+
+_Static_assert(SC_BSCAN_MAX_REGIONS <= 256u, "a plane tet's regions are bytes");
 
 /* Tet t into the plane tets when the plane cuts it (not flat, in front of some line): 0 when
  * the plane tets are over their limit. */
@@ -1021,14 +998,17 @@ static int add_plane_tet(sc_bscan *b, const sc_mesh *m, uint32_t t, uint32_t *np
         return 0;
     }
     sc_bscan_ptet *p = &b->ptets[np];
-    p->tet = t | SC_PTET_PENDING; /* the maps when a point is first tested (ptet_ready) */
+    p->tet = t;
     p->orient = orient;
     p->xmin = xmin;
     p->xmax = xmax;
     p->zmin = zmin;
     p->zmax = zmax;
-    b->ptet_lo[np] = lo;
-    b->ptet_hi[np] = hi;
+    /* the regions of its first and last line (here, on the pool's parts, not in the caller's
+     * binning: two divisions a tet) */
+    const uint32_t lines = b->def.scan.lines_n, regions = b->def.regions_n;
+    b->ptet_region[np][0] = (uint8_t)region_of_line((uint32_t)lo, lines, regions);
+    b->ptet_region[np][1] = (uint8_t)region_of_line((uint32_t)hi, lines, regions);
     *np_io = np + 1u;
     return 1;
 }
@@ -1104,7 +1084,7 @@ static void job_cut(void *arg, uint32_t p)
 /* Returns 0 when the path's limits are exceeded (the caller then walks this frame). */
 static int build_regions(sc_bscan *b, const sc_mesh *m)
 {
-    const uint32_t lines = b->def.scan.lines_n, regions = b->def.regions_n;
+    const uint32_t regions = b->def.regions_n;
     uint32_t np = 0;
     if (b->mesh_grid) {
         int done = 0;
@@ -1125,8 +1105,8 @@ static int build_regions(sc_bscan *b, const sc_mesh *m)
                 const uint32_t from = p * j.cap;
                 if (from != np && j.n[p] > 0u) {
                     memmove(&b->ptets[np], &b->ptets[from], j.n[p] * sizeof b->ptets[0]);
-                    memmove(&b->ptet_lo[np], &b->ptet_lo[from], j.n[p] * sizeof b->ptet_lo[0]);
-                    memmove(&b->ptet_hi[np], &b->ptet_hi[from], j.n[p] * sizeof b->ptet_hi[0]);
+                    memmove(&b->ptet_region[np], &b->ptet_region[from],
+                            j.n[p] * sizeof b->ptet_region[0]);
                 }
                 np += j.n[p];
             }
@@ -1157,8 +1137,7 @@ static int build_regions(sc_bscan *b, const sc_mesh *m)
     }
     uint32_t total = 0;
     for (uint32_t i = 0; i < np; i++) {
-        const uint32_t r0 = region_of_line((uint32_t)b->ptet_lo[i], lines, regions);
-        const uint32_t r1 = region_of_line((uint32_t)b->ptet_hi[i], lines, regions);
+        const uint32_t r0 = b->ptet_region[i][0], r1 = b->ptet_region[i][1];
         for (uint32_t r = r0; r <= r1; r++) {
             b->region_start[r + 1u]++;
         }
@@ -1171,8 +1150,7 @@ static int build_regions(sc_bscan *b, const sc_mesh *m)
         b->region_start[r + 1u] += b->region_start[r];
     }
     for (uint32_t i = 0; i < np; i++) {
-        const uint32_t r0 = region_of_line((uint32_t)b->ptet_lo[i], lines, regions);
-        const uint32_t r1 = region_of_line((uint32_t)b->ptet_hi[i], lines, regions);
+        const uint32_t r0 = b->ptet_region[i][0], r1 = b->ptet_region[i][1];
         for (uint32_t r = r0; r <= r1; r++) {
             b->region_refs[b->region_start[r]++] = i;
             float *bx = b->region_box[r];
@@ -1191,8 +1169,9 @@ static int build_regions(sc_bscan *b, const sc_mesh *m)
 
 /* The first tet of region r holding (x, z), a positively oriented one before an inverted one
  * (a fold's turned layer counts only where nothing else covers the point). */
-static int32_t locate_region(sc_bscan *b, const sc_mesh *m, uint32_t r, float x, float z)
+static int32_t locate_region(line_w *w, const sc_mesh *m, uint32_t r, float x, float z)
 {
+    const sc_bscan *b = w->b;
     const float *bx = b->region_box[r];
     if (x < bx[0] || x > bx[1] || z < bx[2] || z > bx[3]) {
         return -1;
@@ -1200,14 +1179,14 @@ static int32_t locate_region(sc_bscan *b, const sc_mesh *m, uint32_t r, float x,
     int32_t inverted = -1;
     for (uint32_t i = b->region_start[r]; i < b->region_start[r + 1u]; i++) {
         const uint32_t pi = b->region_refs[i];
-        sc_bscan_ptet *p = &b->ptets[pi];
+        const sc_bscan_ptet *p = &b->ptets[pi];
         if (x < p->xmin || x > p->xmax || z < p->zmin || z > p->zmax) {
             continue;
         }
-        ptet_ready(b, m, p);
+        const sc_bscan_tcache *tc = tet_cached(w, m, p->tet); /* not flat: add_plane_tet */
         int in = 1;
         for (uint32_t v = 0; v < 4u && in; v++) {
-            in = p->lam[v][0] + p->lam[v][1] * x + p->lam[v][2] * z >= -SC_BSCAN_LAMBDA_EPS;
+            in = tc->lam[0][v] + tc->lam[1][v] * x + tc->lam[2][v] * z >= -SC_BSCAN_LAMBDA_EPS;
         }
         if (in) {
             if (p->orient > 0) {
@@ -1224,8 +1203,9 @@ static int32_t locate_region(sc_bscan *b, const sc_mesh *m, uint32_t r, float x,
 /* The tet of region r that holds (x, z) deepest (largest smallest barycentric coordinate), a
  * positively oriented one before an inverted one: the oracle's rule, for the walker's
  * relocation inside folds. */
-static int32_t locate_deepest(sc_bscan *b, const sc_mesh *m, uint32_t r, float x, float z)
+static int32_t locate_deepest(line_w *w, const sc_mesh *m, uint32_t r, float x, float z)
 {
+    const sc_bscan *b = w->b;
     const float *bx = b->region_box[r];
     if (x < bx[0] || x > bx[1] || z < bx[2] || z > bx[3]) {
         return -1;
@@ -1235,14 +1215,14 @@ static int32_t locate_deepest(sc_bscan *b, const sc_mesh *m, uint32_t r, float x
     float best_min = -SC_BSCAN_LAMBDA_EPS;
     for (uint32_t i = b->region_start[r]; i < b->region_start[r + 1u]; i++) {
         const uint32_t pi = b->region_refs[i];
-        sc_bscan_ptet *p = &b->ptets[pi];
+        const sc_bscan_ptet *p = &b->ptets[pi];
         if (x < p->xmin || x > p->xmax || z < p->zmin || z > p->zmax) {
             continue;
         }
-        ptet_ready(b, m, p);
-        float lmin = p->lam[0][0] + p->lam[0][1] * x + p->lam[0][2] * z;
+        const sc_bscan_tcache *tc = tet_cached(w, m, p->tet); /* not flat: add_plane_tet */
+        float lmin = tc->lam[0][0] + tc->lam[1][0] * x + tc->lam[2][0] * z;
         for (uint32_t v = 1; v < 4u; v++) {
-            const float l = p->lam[v][0] + p->lam[v][1] * x + p->lam[v][2] * z;
+            const float l = tc->lam[0][v] + tc->lam[1][v] * x + tc->lam[2][v] * z;
             lmin = l < lmin ? l : lmin;
         }
         if (!(lmin >= -SC_BSCAN_LAMBDA_EPS)) {
@@ -1258,16 +1238,16 @@ static int32_t locate_deepest(sc_bscan *b, const sc_mesh *m, uint32_t r, float x
 }
 
 /* Rest positions of samples a..z (all in ptet ta), interpolated linearly between the ends. */
-static void fill_run(line_w *w, const frame_ctx *c, uint32_t ta, uint32_t a, uint32_t z)
+static void fill_run(line_w *w, const sc_mesh *m, const frame_ctx *c, uint32_t ta, uint32_t a,
+                     uint32_t z)
 {
-    sc_bscan *const b = w->b;
-    const sc_bscan_ptet *p = &b->ptets[ta];
+    const sc_bscan_tcache *tc = tet_cached(w, m, w->b->ptets[ta].tet);
     float ra[3], rz[3], va[3], vz[3];
     const float xa = c->ox + (float)a * c->dx, za = c->oz + (float)a * c->dz;
     const float xz = c->ox + (float)z * c->dx, zz = c->oz + (float)z * c->dz;
     for (uint32_t d = 0; d < 3u; d++) {
-        ra[d] = p->rest[d][0] + p->rest[d][1] * xa + p->rest[d][2] * za;
-        rz[d] = p->rest[d][0] + p->rest[d][1] * xz + p->rest[d][2] * zz;
+        ra[d] = tc->rest[0][d] + tc->rest[1][d] * xa + tc->rest[2][d] * za;
+        rz[d] = tc->rest[0][d] + tc->rest[1][d] * xz + tc->rest[2][d] * zz;
     }
     to_vox(c, ra, va);
     to_vox(c, rz, vz);
@@ -1294,23 +1274,23 @@ static void map_line_regions(line_w *w, const sc_mesh *m, uint32_t l, const fram
     const uint32_t last = c->n - 1u;
     st[sp].a = 0u;
     st[sp].z = last;
-    st[sp].ta = locate_region(b, m, r, c->ox, c->oz);
-    st[sp].tz = locate_region(b, m, r, c->ox + (float)last * c->dx, c->oz + (float)last * c->dz);
+    st[sp].ta = locate_region(w, m, r, c->ox, c->oz);
+    st[sp].tz = locate_region(w, m, r, c->ox + (float)last * c->dx, c->oz + (float)last * c->dz);
     sp++;
     while (sp > 0u) {
         sp--;
         const uint32_t a = st[sp].a, z = st[sp].z;
         const int32_t ta = st[sp].ta, tz = st[sp].tz;
         if (ta >= 0 && ta == tz) {
-            fill_run(w, c, (uint32_t)ta, a, z);
+            fill_run(w, m, c, (uint32_t)ta, a, z);
             continue;
         }
         if (z <= a + 1u) {
             if (ta >= 0) {
-                fill_run(w, c, (uint32_t)ta, a, a);
+                fill_run(w, m, c, (uint32_t)ta, a, a);
             }
             if (tz >= 0 && z != a) {
-                fill_run(w, c, (uint32_t)tz, z, z);
+                fill_run(w, m, c, (uint32_t)tz, z, z);
             }
             continue;
         }
@@ -1325,10 +1305,10 @@ static void map_line_regions(line_w *w, const sc_mesh *m, uint32_t l, const fram
             }
         }
         const uint32_t mid = a + (z - a + 1u) / 2u;
-        const int32_t tm1 = locate_region(b, m, r, c->ox + (float)(mid - 1u) * c->dx,
+        const int32_t tm1 = locate_region(w, m, r, c->ox + (float)(mid - 1u) * c->dx,
                                           c->oz + (float)(mid - 1u) * c->dz);
         const int32_t tm =
-            locate_region(b, m, r, c->ox + (float)mid * c->dx, c->oz + (float)mid * c->dz);
+            locate_region(w, m, r, c->ox + (float)mid * c->dx, c->oz + (float)mid * c->dz);
         SC_ASSERT(sp + 2u <= SC_COUNT_OF(st));
         st[sp].a = mid;
         st[sp].z = z;
@@ -2187,27 +2167,6 @@ static void range_job(void *arg, uint32_t r)
     }
 }
 
-typedef struct ready_args {
-    sc_bscan *b;
-    const sc_mesh *mesh;
-} ready_args;
-
-#define SC_BSCAN_READY_SPAN 256u
-
-/* The maps of plane tets [256 r, 256 r + 256): computed up front for the ranges, which only
- * read them (the same function of the same inputs as on first test). */
-static void ready_job(void *arg, uint32_t r)
-{
-    const ready_args *ra = arg;
-    sc_bscan *b = ra->b;
-    const uint32_t i1 = (r + 1u) * SC_BSCAN_READY_SPAN < b->ptet_count
-                            ? (r + 1u) * SC_BSCAN_READY_SPAN
-                            : b->ptet_count;
-    for (uint32_t i = r * SC_BSCAN_READY_SPAN; i < i1; i++) {
-        ptet_ready(b, ra->mesh, &b->ptets[i]);
-    }
-}
-
 /* A stored line leaves: the hook (in line order, as on the serial path) and the display. */
 static int emit_stored(const frame_args *fa, const sc_bscan_range *rg, uint32_t l, int rc)
 {
@@ -2272,11 +2231,6 @@ static int lines_pool(const frame_args *fa, sc_bscan_area_acc *acc, sc_bscan_cou
         /* the last frame's walker located across folds: this one likely does too, and a range
          * cannot build the bins (the same bins whenever they are built) */
         b->regions_state = build_regions(b, fa->mesh) ? 1u : 2u;
-    }
-    if (fa->mesh != NULL && b->regions_state == 1u) {
-        ready_args ra = {b, fa->mesh};
-        sc_pool_run(b->pool, ready_job, &ra,
-                    (b->ptet_count + SC_BSCAN_READY_SPAN - 1u) / SC_BSCAN_READY_SPAN);
     }
     sc_pool_run(b->pool, range_job, (void *)(uintptr_t)fa, nr);
     for (uint32_t r = 0; r < nr; r++) {
@@ -2451,6 +2405,12 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
         const xform_args xa = {b, nodes, mesh->node_count, &vol2img};
         sc_pool_run(b->pool, xform_job, (void *)(uintptr_t)&xa,
                     (mesh->node_count + SC_BSCAN_XFORM_SPAN - 1u) / SC_BSCAN_XFORM_SPAN);
+        if (++b->epoch == 0u) { /* wrapped: forget every entry */
+            for (uint32_t i = 0; i < SC_BSCAN_TET_CACHE; i++) {
+                b->tcache[i].epoch = 0u;
+            }
+            b->epoch = 1u;
+        }
         if (mapper == SC_BSCAN_MAP_REGIONS) {
             if (build_regions(b, mesh)) {
                 b->regions_state = 1u;
@@ -2461,12 +2421,6 @@ int sc_bscan_frame(sc_bscan *b, const sc_mesh *mesh, const sc_nodes *nodes, cons
             }
         }
         if (mapper == SC_BSCAN_MAP_WALK) {
-            if (++b->epoch == 0u) { /* wrapped: forget every entry */
-                for (uint32_t i = 0; i < SC_BSCAN_TET_CACHE; i++) {
-                    b->tcache[i].epoch = 0u;
-                }
-                b->epoch = 1u;
-            }
             build_segments(b, mesh);
             st->plane_hull_segments = b->seg_count;
         }

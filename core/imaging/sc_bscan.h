@@ -143,11 +143,9 @@ typedef struct sc_bscan_seg {
     int32_t line_lo, line_hi;
 } sc_bscan_seg;
 
-/* Region path: a tet cut by the plane, with its barycentric coordinates and rest position as
- * affine functions of the image-frame (x, z). */
+/* Region path: a tet cut by the plane and its box in the image frame (x, z); its maps come from
+ * the tet cache of the line that tests it (sc_bscan_tcache). */
 typedef struct sc_bscan_ptet {
-    float lam[4][3];  /* lambda_i = lam[i][0] + lam[i][1] x + lam[i][2] z */
-    float rest[3][3]; /* rest coordinate d = rest[d][0] + rest[d][1] x + rest[d][2] z */
     float xmin, xmax, zmin, zmax;
     uint32_t tet;   /* mesh tet */
     int32_t orient; /* 1 positively oriented, -1 inverted (a fold of the deformed mesh) */
@@ -160,9 +158,12 @@ typedef struct sc_bscan_run {
 } sc_bscan_run;
 
 /* Walker cache: a tet's barycentric coordinates and rest position as affine functions of
- * the image-frame (x, z), valid for the frame `epoch`. */
+ * the image-frame (x, z), valid for the frame `epoch`; the maps are set unless the tet is flat
+ * (orient 0). The walker steps through positively oriented tets; the fold search (the region
+ * bins) tests inverted ones too. */
 typedef struct sc_bscan_tcache {
-    uint32_t epoch, tet, ok;
+    uint32_t epoch, tet;
+    int32_t orient;   /* 1 positively oriented, -1 inverted, 0 flat (no maps) */
     float lam[3][4];  /* lambda_i = lam[0][i] + lam[1][i] x + lam[2][i] z (face i's coordinate) */
     float rest[3][4]; /* rest position d = rest[0][d] + rest[1][d] x + rest[2][d] z; [3] 0 */
 } sc_bscan_tcache;
@@ -287,8 +288,7 @@ typedef struct sc_bscan {
     uint32_t ptet_count;
     uint32_t regions_state; /* this frame: 0 not built, 1 built, 2 over the limits */
     sc_bscan_ptet ptets[SC_BSCAN_MAX_PLANE_TETS];
-    int32_t ptet_lo[SC_BSCAN_MAX_PLANE_TETS];
-    int32_t ptet_hi[SC_BSCAN_MAX_PLANE_TETS];
+    uint8_t ptet_region[SC_BSCAN_MAX_PLANE_TETS][2]; /* its first and last line's regions */
     uint32_t region_start[SC_BSCAN_MAX_REGIONS + 1u];
     uint32_t region_refs[SC_BSCAN_MAX_REGION_REFS];
     float region_box[SC_BSCAN_MAX_REGIONS][4]; /* xmin, xmax, zmin, zmax of its tets */
