@@ -587,16 +587,13 @@ static int active_at(line_w *w, uint32_t l)
     return 1;
 }
 
-/* The plane-affine maps of tet t for this frame, from a direct-mapped cache (adjacent scan
- * lines cross the same tets). Hit or miss, the values are the same: computed by one function
- * from the same inputs. */
-static const sc_bscan_tcache *tet_cached(line_w *w, const sc_mesh *m, uint32_t t)
+/* tet_cached's miss: tet t's maps into entry tc */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static const sc_bscan_tcache *
+tet_fill(const sc_bscan *b, const sc_mesh *m, uint32_t t, sc_bscan_tcache *tc)
 {
-    const sc_bscan *b = w->b;
-    sc_bscan_tcache *tc = &w->tcache[t & w->tmask];
-    if (tc->epoch == b->epoch && tc->tet == t) {
-        return tc;
-    }
     tc->epoch = b->epoch;
     tc->tet = t;
     const uint32_t *tv = m->tet[t];
@@ -622,6 +619,23 @@ static const sc_bscan_tcache *tet_cached(line_w *w, const sc_mesh *m, uint32_t t
         }
     }
     return tc;
+}
+
+/* The plane-affine maps of tet t for this frame, from a direct-mapped cache (adjacent scan
+ * lines cross the same tets). Hit or miss, the values are the same: computed by one function
+ * from the same inputs. The hit inline, in the walker's step and the fold search's tests. */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline const sc_bscan_tcache *
+tet_cached(line_w *w, const sc_mesh *m, uint32_t t)
+{
+    const sc_bscan *b = w->b;
+    sc_bscan_tcache *tc = &w->tcache[t & w->tmask];
+    if (tc->epoch == b->epoch && tc->tet == t) {
+        return tc;
+    }
+    return tet_fill(b, m, t, tc);
 }
 
 static int build_regions(sc_bscan *b, const sc_mesh *m);
@@ -2309,14 +2323,20 @@ static void xform_job(void *arg, uint32_t s)
 {
     const xform_args *a = (const xform_args *)arg;
     sc_bscan *b = a->b;
+    /* the transform and the arrays in locals, the arrays restrict: the stores cannot change
+     * what the loop reads, so it runs in vectors (the same operations, lane by lane) */
     const float *r = a->vol2img->r, *t = a->vol2img->t_mm;
+    const float r0 = r[0], r1 = r[1], r2 = r[2], r3 = r[3], r4 = r[4], r5 = r[5], r6 = r[6],
+                r7 = r[7], r8 = r[8], t0 = t[0], t1 = t[1], t2 = t[2];
+    const float *restrict nx = a->n->x, *restrict ny = a->n->y, *restrict nz = a->n->z;
+    float *restrict qx = b->qx, *restrict qy = b->qy, *restrict qz = b->qz;
     const uint32_t i0 = s * SC_BSCAN_XFORM_SPAN;
     const uint32_t i1 = i0 + SC_BSCAN_XFORM_SPAN < a->count ? i0 + SC_BSCAN_XFORM_SPAN : a->count;
     for (uint32_t i = i0; i < i1; i++) {
-        const float x = a->n->x[i], y = a->n->y[i], z = a->n->z[i];
-        b->qx[i] = r[0] * x + r[1] * y + r[2] * z + t[0];
-        b->qy[i] = r[3] * x + r[4] * y + r[5] * z + t[1];
-        b->qz[i] = r[6] * x + r[7] * y + r[8] * z + t[2];
+        const float x = nx[i], y = ny[i], z = nz[i];
+        qx[i] = r0 * x + r1 * y + r2 * z + t0;
+        qy[i] = r3 * x + r4 * y + r5 * z + t1;
+        qz[i] = r6 * x + r7 * y + r8 * z + t2;
     }
 }
 
