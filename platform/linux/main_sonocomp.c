@@ -440,6 +440,11 @@ static int write_hist(const char *path, const sc_engine *e)
     return fclose(f);
 }
 
+/* With workers: per frame, the loop thread's time outside the pool's jobs (the frame's serial
+ * work: what a second core does not shorten), from the pool's own count of the time the caller
+ * spent in its jobs. */
+static sc_stats g_alone;
+
 static void final_report(const sc_engine *e, double wall_s, const char *stop_reason,
                          const sc_display_dev *disp, const sc_rt_report *rt,
                          const sc_udp_display *udp)
@@ -468,6 +473,9 @@ static void final_report(const sc_engine *e, double wall_s, const char *stop_rea
         char name[40];
         snprintf(name, sizeof name, "stage %s", s->stages[i].name ? s->stages[i].name : "?");
         print_stats_row(name, &s->stages[i].stats);
+    }
+    if (g_alone.count != 0u) {
+        print_stats_row("outside the pool", &g_alone);
     }
     sc_display_link_state ls;
     if (sc_display_get_link_state(disp, &ls) == 0) {
@@ -944,6 +952,7 @@ int main(int argc, char **argv)
     const char *stop_reason = "error";
     double wall_s = 0.0;
     if (engine_ok) {
+        sc_stats_reset(&g_alone);
         const uint64_t t0 = sc_rt_now_ns();
         uint64_t next_status = t0 + 1000000000u;
         uint64_t frames_at_status = 0;
@@ -955,8 +964,13 @@ int main(int argc, char **argv)
                 stop_reason = sc_rt_stop_signal() == 15 ? "SIGTERM" : "SIGINT";
                 break;
             }
+            const uint64_t in_jobs0 = pool.job_ns;
             sc_engine_step(e, &fr);
             const uint64_t now = sc_rt_now_ns();
+            if (pool_started && fr.end_ns > fr.start_ns) {
+                const uint64_t busy = fr.end_ns - fr.start_ns, in_jobs = pool.job_ns - in_jobs0;
+                sc_stats_add(&g_alone, busy > in_jobs ? busy - in_jobs : 0u);
+            }
             if (now >= next_status) {
                 const uint64_t frames_now = sc_engine_get_sched(e)->frames;
                 fps = (double)(frames_now - frames_at_status) * 1e9 / (double)(now - t_status);
