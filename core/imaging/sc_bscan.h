@@ -313,6 +313,9 @@ typedef struct sc_bscan {
     sc_bscan_range range[SC_BSCAN_RANGES];
     uint16_t line_run0[SC_MAX_SCAN_LINES]; /* a stored line's first run in its range's runs */
     uint16_t line_runs[SC_MAX_SCAN_LINES];
+    /* the region bins on the pool: each part's count (then cursor) and box of each bin */
+    uint32_t part_cnt[SC_BSCAN_RANGES][SC_BSCAN_MAX_REGIONS];
+    float part_box[SC_BSCAN_RANGES][SC_BSCAN_MAX_REGIONS][4];
     uint8_t frame_out[SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES];
     uint8_t frame_label[SC_MAX_SCAN_LINES * SC_MAX_SCAN_SAMPLES];
 #endif
