@@ -36,26 +36,35 @@ static void futex_wake_all(_Atomic uint32_t *addr)
     (void)syscall(SYS_futex, (uint32_t *)addr, FUTEX_WAKE_PRIVATE, INT_MAX, NULL, NULL, 0);
 }
 
+/* The claim word: the job's sequence number, then the unclaimed ranges [front, back). */
+#define CLAIM_FRONT(c) ((uint32_t)((c) >> 16) & 0xffffu)
+#define CLAIM_BACK(c)  ((uint32_t)(c)&0xffffu)
+
 /* Claim and run ranges of job `seq` until none is left (or the job is no longer current). The
- * job's fields are read before a successful claim: a claim succeeds only while the claim word
- * still carries seq, and the caller resets that word (then a fence) before it writes the next
- * job's fields, so what was read is this job's. */
+ * caller (w = 0) claims from the front, the workers from the back: with two, each takes one end
+ * of the job's nodes in every job, so what a pass writes is mostly read by the next pass on the
+ * same core (and a contested claim is rare). The job's fields are read before a successful
+ * claim: a claim succeeds only while the claim word still carries seq, and the caller resets
+ * that word (then a fence) before it writes the next job's fields, so what was read is this
+ * job's. */
 static void run_ranges(sc_pool_linux *p, uint32_t seq, uint32_t w)
 {
     uint64_t finished = atomic_load_explicit(&p->done[w].n, memory_order_relaxed);
     for (;;) {
         const sc_pool_job_fn fn = atomic_load_explicit(&p->fn, memory_order_relaxed);
         void *const arg = atomic_load_explicit(&p->arg, memory_order_relaxed);
-        const uint32_t ranges = atomic_load_explicit(&p->ranges, memory_order_relaxed);
         uint64_t c = atomic_load_explicit(&p->claim, memory_order_seq_cst);
-        if ((uint32_t)(c >> 32) != seq || (uint32_t)c >= ranges) {
+        const uint32_t front = CLAIM_FRONT(c), back = CLAIM_BACK(c);
+        if ((uint32_t)(c >> 32) != seq || front >= back) {
             return;
         }
-        if (!atomic_compare_exchange_weak_explicit(&p->claim, &c, c + 1u, memory_order_seq_cst,
+        const uint32_t r = w == 0u ? front : back - 1u;
+        const uint64_t next = w == 0u ? c + ((uint64_t)1 << 16) : c - 1u;
+        if (!atomic_compare_exchange_weak_explicit(&p->claim, &c, next, memory_order_seq_cst,
                                                    memory_order_seq_cst)) {
             continue;
         }
-        fn(arg, (uint32_t)c);
+        fn(arg, r);
         atomic_store_explicit(&p->done[w].n, ++finished, memory_order_release);
     }
 }
@@ -98,12 +107,19 @@ static void pool_run(void *ctx, sc_pool_job_fn fn, void *arg, uint32_t ranges)
     sc_pool_linux *p = (sc_pool_linux *)ctx;
     const uint64_t t0 = now_ns();
     const uint32_t seq = atomic_load_explicit(&p->seq, memory_order_relaxed) + 1u;
+    if (ranges > 0xffffu) {
+        /* more than the claim word holds (no job of the core's has as many): on the caller */
+        for (uint32_t r = 0; r < ranges; r++) {
+            fn(arg, r);
+        }
+        p->job_ns += now_ns() - t0;
+        return;
+    }
     /* the claim word first: from here no late worker of the previous job can claim */
-    atomic_store_explicit(&p->claim, (uint64_t)seq << 32, memory_order_seq_cst);
+    atomic_store_explicit(&p->claim, (uint64_t)seq << 32 | ranges, memory_order_seq_cst);
     atomic_thread_fence(memory_order_seq_cst);
     atomic_store_explicit(&p->fn, fn, memory_order_relaxed);
     atomic_store_explicit(&p->arg, arg, memory_order_relaxed);
-    atomic_store_explicit(&p->ranges, ranges, memory_order_relaxed);
     /* every range of the previous job has finished: the counts are still */
     uint64_t target = (uint64_t)ranges;
     for (uint32_t w = 0; w < p->workers; w++) {
