@@ -285,7 +285,7 @@ typedef struct sc_bscan {
     uint32_t epoch;
     sc_bscan_tcache tcache[SC_BSCAN_TET_CACHE];
     /* region path */
-    uint32_t ptet_count;
+    uint32_t ptet_count;    /* plane tets found (the pool's parts leave gaps between their runs) */
     uint32_t regions_state; /* this frame: 0 not built, 1 built, 2 over the limits */
     sc_bscan_ptet ptets[SC_BSCAN_MAX_PLANE_TETS];
     uint8_t ptet_region[SC_BSCAN_MAX_PLANE_TETS][2]; /* its first and last line's regions */
