@@ -1124,8 +1124,17 @@ static int cut_layers(sc_bscan *b, const sc_mesh *m, uint32_t k_begin, uint32_t 
     return 1;
 }
 
+/* box bx (xmin, xmax, zmin, zmax) grown by the box x0 .. x1, z0 .. z1 */
+static void box_grow(float bx[4], float x0, float x1, float z0, float z1)
+{
+    bx[0] = min_f(bx[0], x0);
+    bx[1] = max_f(bx[1], x1);
+    bx[2] = min_f(bx[2], z0);
+    bx[3] = max_f(bx[3], z1);
+}
+
 /* The region bins' census of plane tets i0 .. i1 - 1: cnt[r] += the tets of region r, box[r]
- * (xmin, xmax, zmin, zmax) grown by their boxes. */
+ * grown by their boxes. */
 static void bin_count(const sc_bscan *b, uint32_t i0, uint32_t i1, uint32_t *cnt, float (*box)[4])
 {
     for (uint32_t i = i0; i < i1; i++) {
@@ -1133,11 +1142,7 @@ static void bin_count(const sc_bscan *b, uint32_t i0, uint32_t i1, uint32_t *cnt
         const sc_bscan_ptet *p = &b->ptets[i];
         for (uint32_t r = r0; r <= r1; r++) {
             cnt[r]++;
-            float *bx = box[r];
-            bx[0] = min_f(bx[0], p->xmin);
-            bx[1] = max_f(bx[1], p->xmax);
-            bx[2] = min_f(bx[2], p->zmin);
-            bx[3] = max_f(bx[3], p->zmax);
+            box_grow(box[r], p->xmin, p->xmax, p->zmin, p->zmax);
         }
     }
 }
@@ -1161,6 +1166,29 @@ static void boxes_empty(float (*box)[4], uint32_t regions)
         box[r][2] = INFINITY;
         box[r][3] = -INFINITY;
     }
+}
+
+/* The bins from the census of `parts` runs of plane tets (run p: cnt[p], box[p]): region_start,
+ * region_box, and cnt[p][r] turned into run p's cursor in bin r (run after run: the tets'
+ * order). Returns the references in all. */
+static uint32_t bins_place(sc_bscan *b, uint32_t parts, uint32_t (*cnt)[SC_BSCAN_MAX_REGIONS],
+                           float (*box)[SC_BSCAN_MAX_REGIONS][4])
+{
+    const uint32_t regions = b->def.regions_n;
+    uint32_t total = 0;
+    boxes_empty(b->region_box, regions);
+    for (uint32_t r = 0; r < regions; r++) {
+        b->region_start[r] = total;
+        for (uint32_t p = 0; p < parts; p++) {
+            const uint32_t c = cnt[p][r];
+            cnt[p][r] = total; /* run p's part of bin r starts here */
+            total += c;
+            const float *pb = box[p][r];
+            box_grow(b->region_box[r], pb[0], pb[1], pb[2], pb[3]);
+        }
+    }
+    b->region_start[regions] = total;
+    return total;
 }
 
 #if SC_BSCAN_RANGES > 1
@@ -1210,37 +1238,20 @@ static int regions_pool(sc_bscan *b, const sc_mesh *m)
     /* 64x32x32 on two workers: the cut 0.51-0.56 ms a frame on the caller alone, the bins
      * 0.13 ms */
     cut_job j;
-    const uint32_t regions = b->def.regions_n;
     j.b = b;
     j.m = m;
     j.parts = m->nz - 1u < SC_BSCAN_RANGES ? m->nz - 1u : SC_BSCAN_RANGES;
     j.cap = SC_BSCAN_MAX_PLANE_TETS / j.parts;
     sc_pool_run(b->pool, job_cut, &j, j.parts);
-    uint32_t np = 0, total = 0;
+    uint32_t np = 0;
     for (uint32_t p = 0; p < j.parts; p++) {
         if (!j.ok[p]) {
             return -1;
         }
         np += j.n[p];
     }
-    boxes_empty(b->region_box, regions);
-    for (uint32_t r = 0; r < regions; r++) {
-        b->region_start[r] = total;
-        for (uint32_t p = 0; p < j.parts; p++) {
-            const uint32_t c = b->part_cnt[p][r];
-            b->part_cnt[p][r] = total; /* part p's run of bin r starts here */
-            total += c;
-            float *bx = b->region_box[r];
-            const float *pb = b->part_box[p][r];
-            bx[0] = min_f(bx[0], pb[0]);
-            bx[1] = max_f(bx[1], pb[1]);
-            bx[2] = min_f(bx[2], pb[2]);
-            bx[3] = max_f(bx[3], pb[3]);
-        }
-    }
-    b->region_start[regions] = total;
     b->ptet_count = np;
-    if (total > SC_BSCAN_MAX_REGION_REFS) {
+    if (bins_place(b, j.parts, b->part_cnt, b->part_box) > SC_BSCAN_MAX_REGION_REFS) {
         return 0;
     }
     sc_pool_run(b->pool, job_fill, &j, j.parts);
@@ -1274,20 +1285,14 @@ static int build_regions(sc_bscan *b, const sc_mesh *m)
         }
     }
     b->ptet_count = np;
-    uint32_t cnt[SC_BSCAN_MAX_REGIONS] = {0};
-    boxes_empty(b->region_box, regions);
-    bin_count(b, 0u, np, cnt, b->region_box);
-    uint32_t total = 0;
-    for (uint32_t r = 0; r < regions; r++) {
-        b->region_start[r] = total;
-        total += cnt[r];
-        cnt[r] = b->region_start[r]; /* bin r's cursor */
-    }
-    b->region_start[regions] = total;
-    if (total > SC_BSCAN_MAX_REGION_REFS) {
+    uint32_t cnt[1][SC_BSCAN_MAX_REGIONS] = {{0}};
+    float box[1][SC_BSCAN_MAX_REGIONS][4];
+    boxes_empty(box[0], regions);
+    bin_count(b, 0u, np, cnt[0], box[0]);
+    if (bins_place(b, 1u, cnt, box) > SC_BSCAN_MAX_REGION_REFS) {
         return 0;
     }
-    bin_fill(b, 0u, np, cnt);
+    bin_fill(b, 0u, np, cnt[0]);
     return 1;
 }
 
