@@ -444,6 +444,15 @@ static int write_hist(const char *path, const sc_engine *e)
  * work: what a second core does not shorten), from the pool's own count of the time the caller
  * spent in its jobs. */
 static sc_stats g_alone;
+/* With workers: the workers' share of each frame's ranges (sc_pool_linux_ranges; their even
+ * share is (W - 1) / W), and the frames by it: the workers ran at least half their even share
+ * (a quarter of the ranges with two), or less (held: the host had their CPUs). "Two cores" is
+ * the first kind's frame time; the second kind's count and misses say how often the host took a
+ * core away. On the shared VM of docs/performance.md no frame was held: in its slow phases both
+ * cores run slow, the workers' share stays near a half. */
+static sc_stats g_present;
+static uint64_t g_held_frames, g_held_misses, g_present_misses;
+static double g_share_sum, g_share_min = 1.0;
 
 static void final_report(const sc_engine *e, double wall_s, const char *stop_reason,
                          const sc_display_dev *disp, const sc_rt_report *rt,
@@ -476,6 +485,16 @@ static void final_report(const sc_engine *e, double wall_s, const char *stop_rea
     }
     if (g_alone.count != 0u) {
         print_stats_row("outside the pool", &g_alone);
+        const uint64_t n = g_present.count + g_held_frames;
+        printf("  workers' share of the ranges: mean %.3f, lowest %.3f; frames with the workers "
+               "held by the host (under half their share) %llu, misses %llu\n",
+               n ? g_share_sum / (double)n : 0.0, n ? g_share_min : 0.0,
+               (unsigned long long)g_held_frames, (unsigned long long)g_held_misses);
+        if (g_held_frames != 0u) {
+            print_stats_row("frame, not held", &g_present);
+            printf("  frames not held %llu, misses %llu\n", (unsigned long long)g_present.count,
+                   (unsigned long long)g_present_misses);
+        }
     }
     sc_display_link_state ls;
     if (sc_display_get_link_state(disp, &ls) == 0) {
@@ -953,6 +972,7 @@ int main(int argc, char **argv)
     double wall_s = 0.0;
     if (engine_ok) {
         sc_stats_reset(&g_alone);
+        sc_stats_reset(&g_present);
         const uint64_t t0 = sc_rt_now_ns();
         uint64_t next_status = t0 + 1000000000u;
         uint64_t frames_at_status = 0;
@@ -965,11 +985,29 @@ int main(int argc, char **argv)
                 break;
             }
             const uint64_t in_jobs0 = pool.job_ns;
+            uint64_t by_workers0 = 0, by_workers1 = 0;
+            const uint64_t by_caller0 = pool_started ? sc_pool_linux_ranges(&pool, &by_workers0) : 0u;
+            const uint64_t misses0 = sc_engine_get_sched(e)->misses;
             sc_engine_step(e, &fr);
             const uint64_t now = sc_rt_now_ns();
             if (pool_started && fr.end_ns > fr.start_ns) {
                 const uint64_t busy = fr.end_ns - fr.start_ns, in_jobs = pool.job_ns - in_jobs0;
                 sc_stats_add(&g_alone, busy > in_jobs ? busy - in_jobs : 0u);
+                const uint64_t by_caller = sc_pool_linux_ranges(&pool, &by_workers1) - by_caller0;
+                const uint64_t by_workers = by_workers1 - by_workers0;
+                const uint64_t missed = sc_engine_get_sched(e)->misses - misses0;
+                const uint64_t ranges = by_caller + by_workers;
+                const double share = ranges ? (double)by_workers / (double)ranges : 0.0;
+                g_share_sum += share;
+                g_share_min = share < g_share_min ? share : g_share_min;
+                /* the workers' even share is (W - 1) / W of the ranges: held under half of it */
+                if (by_workers * 2u * pool.workers < ranges * (pool.workers - 1u)) {
+                    g_held_frames++;
+                    g_held_misses += missed;
+                } else {
+                    sc_stats_add(&g_present, busy);
+                    g_present_misses += missed;
+                }
             }
             if (now >= next_status) {
                 const uint64_t frames_now = sc_engine_get_sched(e)->frames;

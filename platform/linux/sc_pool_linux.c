@@ -206,6 +206,16 @@ int sc_pool_linux_start(sc_pool_linux *p, uint32_t workers, int first_cpu, uint3
     return 0;
 }
 
+uint64_t sc_pool_linux_ranges(const sc_pool_linux *p, uint64_t *by_workers)
+{
+    uint64_t w = 0;
+    for (uint32_t i = 1; i < p->workers; i++) {
+        w += atomic_load_explicit(&p->done[i].n, memory_order_acquire);
+    }
+    *by_workers = w;
+    return atomic_load_explicit(&p->done[0].n, memory_order_relaxed);
+}
+
 void sc_pool_linux_stop(sc_pool_linux *p)
 {
     atomic_store_explicit(&p->stop, 1u, memory_order_seq_cst);

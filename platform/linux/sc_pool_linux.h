@@ -72,6 +72,13 @@ typedef struct sc_pool_linux {
 int sc_pool_linux_start(sc_pool_linux *p, uint32_t workers, int first_cpu, uint32_t spin_us,
                         sc_pool_dev *dev);
 
+/* The ranges run so far by the caller (returned) and by the workers (*by_workers): read them
+ * between jobs, on the caller's thread. Per frame, the workers' share tells whether the other
+ * cores took part: with two, about half when both run, and none while the host holds the
+ * second CPU (a shared VM's hypervisor can, for seconds at a time, and the guest sees no steal
+ * time), when the caller runs every range itself. */
+uint64_t sc_pool_linux_ranges(const sc_pool_linux *p, uint64_t *by_workers);
+
 /* Stop and join the threads. The pool must not be running a job. */
 void sc_pool_linux_stop(sc_pool_linux *p);
 
