@@ -74,9 +74,8 @@ int sc_pool_linux_start(sc_pool_linux *p, uint32_t workers, int first_cpu, uint3
 
 /* The ranges run so far by the caller (returned) and by the workers (*by_workers): read them
  * between jobs, on the caller's thread. Per frame, the workers' share tells whether the other
- * cores took part: with two, about half when both run, and none while the host holds the
- * second CPU (a shared VM's hypervisor can, for seconds at a time, and the guest sees no steal
- * time), when the caller runs every range itself. */
+ * cores took part: with two, about half when both run, and next to none if the host stops the
+ * second CPU (sonocomp's final statistics count such frames). */
 uint64_t sc_pool_linux_ranges(const sc_pool_linux *p, uint64_t *by_workers);
 
 /* Stop and join the threads. The pool must not be running a job. */
