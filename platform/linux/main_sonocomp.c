@@ -451,7 +451,7 @@ static sc_stats g_alone;
  * core away. On the shared VM of docs/performance.md no frame was held: in its slow phases both
  * cores run slow, the workers' share stays near a half. */
 static sc_stats g_present;
-static uint64_t g_held_frames, g_held_misses, g_present_misses;
+static uint64_t g_held_frames, g_held_misses, g_present_misses, g_present_ranged;
 static double g_share_sum, g_share_min = 1.0;
 
 static void final_report(const sc_engine *e, double wall_s, const char *stop_reason,
@@ -485,7 +485,7 @@ static void final_report(const sc_engine *e, double wall_s, const char *stop_rea
     }
     if (g_alone.count != 0u) {
         print_stats_row("outside the pool", &g_alone);
-        const uint64_t n = g_present.count + g_held_frames;
+        const uint64_t n = g_present_ranged + g_held_frames; /* the frames with a job */
         printf("  workers' share of the ranges: mean %.3f, lowest %.3f; frames with the workers "
                "held by the host (under half their share) %llu, misses %llu\n",
                n ? g_share_sum / (double)n : 0.0, n ? g_share_min : 0.0,
@@ -986,7 +986,8 @@ int main(int argc, char **argv)
             }
             const uint64_t in_jobs0 = pool.job_ns;
             uint64_t by_workers0 = 0, by_workers1 = 0;
-            const uint64_t by_caller0 = pool_started ? sc_pool_linux_ranges(&pool, &by_workers0) : 0u;
+            const uint64_t by_caller0 =
+                pool_started ? sc_pool_linux_ranges(&pool, &by_workers0) : 0u;
             const uint64_t misses0 = sc_engine_get_sched(e)->misses;
             sc_engine_step(e, &fr);
             const uint64_t now = sc_rt_now_ns();
@@ -997,16 +998,19 @@ int main(int argc, char **argv)
                 const uint64_t by_workers = by_workers1 - by_workers0;
                 const uint64_t missed = sc_engine_get_sched(e)->misses - misses0;
                 const uint64_t ranges = by_caller + by_workers;
-                const double share = ranges ? (double)by_workers / (double)ranges : 0.0;
-                g_share_sum += share;
-                g_share_min = share < g_share_min ? share : g_share_min;
+                if (ranges != 0u) { /* (a frame with no job says nothing of the workers) */
+                    const double share = (double)by_workers / (double)ranges;
+                    g_share_sum += share;
+                    g_share_min = share < g_share_min ? share : g_share_min;
+                }
                 /* the workers' even share is (W - 1) / W of the ranges: held under half of it */
-                if (by_workers * 2u * pool.workers < ranges * (pool.workers - 1u)) {
+                if (ranges != 0u && by_workers * 2u * pool.workers < ranges * (pool.workers - 1u)) {
                     g_held_frames++;
                     g_held_misses += missed;
                 } else {
                     sc_stats_add(&g_present, busy);
                     g_present_misses += missed;
+                    g_present_ranged += ranges != 0u ? 1u : 0u;
                 }
             }
             if (now >= next_status) {
