@@ -451,7 +451,8 @@ static sc_stats g_alone;
  * core away. On the shared VM of docs/performance.md no frame was held: in its slow phases both
  * cores run slow, the workers' share stays near a half. */
 static sc_stats g_present;
-static uint64_t g_held_frames, g_held_misses, g_present_misses, g_present_ranged;
+static uint64_t g_held_frames, g_held_misses, g_present_misses;
+static uint64_t g_share_frames; /* the frames that ran a pool job: the share's count */
 static double g_share_sum, g_share_min = 1.0;
 
 static void final_report(const sc_engine *e, double wall_s, const char *stop_reason,
@@ -485,15 +486,14 @@ static void final_report(const sc_engine *e, double wall_s, const char *stop_rea
     }
     if (g_alone.count != 0u) {
         print_stats_row("outside the pool", &g_alone);
-        const uint64_t n = g_present_ranged + g_held_frames; /* the frames with a job */
+        const uint64_t n = g_share_frames;
         printf("  workers' share of the ranges: mean %.3f, lowest %.3f; frames with the workers "
                "held by the host (under half their share) %llu, misses %llu\n",
                n ? g_share_sum / (double)n : 0.0, n ? g_share_min : 0.0,
                (unsigned long long)g_held_frames, (unsigned long long)g_held_misses);
         if (g_held_frames != 0u) {
             print_stats_row("frame, not held", &g_present);
-            printf("  frames not held %llu, misses %llu\n", (unsigned long long)g_present.count,
-                   (unsigned long long)g_present_misses);
+            printf("  misses in the frames not held %llu\n", (unsigned long long)g_present_misses);
         }
     }
     sc_display_link_state ls;
@@ -998,19 +998,21 @@ int main(int argc, char **argv)
                 const uint64_t by_workers = by_workers1 - by_workers0;
                 const uint64_t missed = sc_engine_get_sched(e)->misses - misses0;
                 const uint64_t ranges = by_caller + by_workers;
-                if (ranges != 0u) { /* (a frame with no job says nothing of the workers) */
+                int held = 0; /* (a frame with no job says nothing of the workers) */
+                if (ranges != 0u) {
                     const double share = (double)by_workers / (double)ranges;
+                    g_share_frames++;
                     g_share_sum += share;
                     g_share_min = share < g_share_min ? share : g_share_min;
+                    /* the workers' even share is (W - 1) / W of the ranges: held under half */
+                    held = by_workers * 2u * pool.workers < ranges * (pool.workers - 1u);
                 }
-                /* the workers' even share is (W - 1) / W of the ranges: held under half of it */
-                if (ranges != 0u && by_workers * 2u * pool.workers < ranges * (pool.workers - 1u)) {
+                if (held) {
                     g_held_frames++;
                     g_held_misses += missed;
                 } else {
                     sc_stats_add(&g_present, busy);
                     g_present_misses += missed;
-                    g_present_ranged += ranges != 0u ? 1u : 0u;
                 }
             }
             if (now >= next_status) {
