@@ -1878,6 +1878,16 @@ static int sample_span(line_w *w, const vol_ctx *vc, uint32_t k0, uint32_t k1, c
             beyond_sample(vc, vr, b->lut_b_fx, k, p, w->out, w->label);
         }
     }
+    if (mode == SPAN_WORDS) {
+        /* the words kernel of sample_span_inside may have written up to 7 words past kb, over
+         * this span's samples beyond the volume zeroed above: they read voxel 0 again (else the
+         * line sampler gathers from a position off the volume: a fault at a 64x32x32 rock) */
+        for (uint32_t k = kb; k < k1 && k < kb + 7u; k++) {
+            w->pos_h[0][k] = 0u;
+            w->pos_h[1][k] = 0u;
+            w->pos_h[2][k] = 0u;
+        }
+    }
     return 0;
 }
 
