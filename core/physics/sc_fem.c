@@ -58,16 +58,15 @@ int sc_fem_def_validate(const sc_fem_def *def)
 
 /* The template's rest shape gradients per cell parity (an odd cell's template corner c sits at
  * the real corner c ^ 1: mirrored in x), volumes and the sign of the template order's 6V. */
-static void init_template(sc_fem *f, const sc_mesh *m)
+static void template_cells(sc_grid_fem_in *el, const float cell_mm[3])
 {
-    sc_grid_fem_in *el = &f->element;
     for (uint32_t p = 0; p < 2u; p++) {
         for (uint32_t q = 0; q < 5u; q++) {
             float pos[4][3];
             for (uint32_t a = 0; a < 4u; a++) {
                 const uint32_t c = (uint32_t)s_tets[q][a] ^ p;
                 for (uint32_t k = 0; k < 3u; k++) {
-                    pos[a][k] = ((c >> k) & 1u) != 0u ? m->cell_mm[k] : 0.0f;
+                    pos[a][k] = ((c >> k) & 1u) != 0u ? cell_mm[k] : 0.0f;
                 }
             }
             float ed[3][3];
@@ -98,6 +97,12 @@ static void init_template(sc_fem *f, const sc_mesh *m)
             el->vol_mm3[q] = fabsf(det) / 6.0f;
         }
     }
+}
+
+static void init_template(sc_fem *f, const sc_mesh *m)
+{
+    sc_grid_fem_in *el = &f->element;
+    template_cells(el, m->cell_mm);
     el->floor_ratio = f->def.floor_volume_ratio;
     el->floor_nmm2 = f->def.floor_pa * SC_FEM_PA_TO_NMM2;
     el->floor_step_mm = fminf(m->cell_mm[0], fminf(m->cell_mm[1], m->cell_mm[2]));
@@ -116,6 +121,64 @@ static sc_grid_fem_in element_in(const sc_fem *f, int corotated)
     in.floor_only = 0;
     return in;
 }
+
+#if SC_GRID_COARSE
+/* The two-grid correction's coarse grid (sc_grid.h, sc_grid_coarse): layout and masses from the
+ * fine grid, and the linear rest K of cells twice the size whose lambda and mu are the means
+ * over the 8 fine cells each covers (the fine lamv, muv summed, over 8 cell volumes). The
+ * same coarse K serves the MSDS, whose springs model the same E and nu. O(N). */
+static int build_coarse(sc_fem *f, const sc_mesh *m)
+{
+    sc_grid_coarse *c = &f->coarse;
+    const sc_grid *g = &f->grid;
+    int rc = sc_grid_coarse_init(c, g, m->cell_mm);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    sc_grid *gc = &c->grid;
+    const float cell2[3] = {2.0f * m->cell_mm[0], 2.0f * m->cell_mm[1], 2.0f * m->cell_mm[2]};
+    sc_grid_fem_in in;
+    memset(&in, 0, sizeof in);
+    template_cells(&in, cell2);
+    float cell_vol = 0.0f;
+    for (uint32_t q = 0; q < 5u; q++) {
+        cell_vol += f->element.vol_mm3[q];
+    }
+    const uint32_t h = SC_GRID_HEAD, used = SC_GRID_HEAD + gc->node_end + SC_GRID_PAD;
+    for (uint32_t q = 0; q < 5u; q++) {
+        memset(c->lamv[q], 0, (size_t)used * sizeof(float));
+        memset(c->muv[q], 0, (size_t)used * sizeof(float));
+    }
+    const uint32_t nx = g->nx, nxy = g->nxy;
+    for (uint32_t t = 0; t < gc->node_count; t++) {
+        if (gc->cell_ok[h + t] == 0) {
+            continue;
+        }
+        const uint32_t a = t % gc->nx, b = (t / gc->nx) % gc->ny, k = t / gc->nxy;
+        float sl = 0.0f, sm = 0.0f;
+        for (uint32_t d = 0; d < 8u; d++) {
+            const uint32_t tf = (2u * a + (d & 1u)) + nx * (2u * b + ((d >> 1) & 1u)) +
+                                nxy * (2u * k + ((d >> 2) & 1u));
+            for (uint32_t q = 0; q < 5u; q++) {
+                sl += f->lamv[q][h + tf];
+                sm += f->muv[q][h + tf];
+            }
+        }
+        for (uint32_t q = 0; q < 5u; q++) {
+            c->lamv[q][h + t] = sl / (8.0f * cell_vol) * in.vol_mm3[q];
+            c->muv[q][h + t] = sm / (8.0f * cell_vol) * in.vol_mm3[q];
+        }
+    }
+    for (uint32_t ax = 0; ax < 3u; ax++) {
+        memcpy(gc->x[ax], gc->x0[ax], (size_t)used * sizeof(float));
+    }
+    in.lamv = &c->lamv[0][0];
+    in.muv = &c->muv[0][0];
+    in.floor_step_mm = fminf(cell2[0], fminf(cell2[1], cell2[2]));
+    sc_grid_kern_selected()->fem_cells(gc, &in, 0.0f, 0.0f);
+    return SC_OK;
+}
+#endif
 
 int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat, const sc_fem_def *def)
 {
@@ -200,6 +263,11 @@ int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat, const
     sc_grid_kern_selected()->fem_cells(g, &in, 0.0f, 0.0f);
     f->rest_k = 1u;
     (void)sc_grid_save_rest(g); /* a big mesh keeps it aside (sc_grid.h) */
+#if SC_GRID_COARSE
+    if (nn > SC_GRID_COARSE_NODES && build_coarse(f, m) == SC_OK) {
+        g->coarse = &f->coarse;
+    }
+#endif
     return SC_OK;
 }
 

@@ -109,6 +109,10 @@ typedef struct sc_fem {
     SC_ALIGN_HOT float lamv[5][SC_GRID_ROW];
     SC_ALIGN_HOT float muv[5][SC_GRID_ROW];
     sc_grid grid; /* matrix, lumped masses, solver vectors */
+#if SC_GRID_COARSE
+    sc_grid_coarse coarse; /* the two-grid correction (grid.coarse: meshes of more than
+                              SC_GRID_COARSE_NODES nodes) */
+#endif
 } sc_fem;
 
 /* Floor term (an extension: walls that meet do not pass through each other): a tet whose

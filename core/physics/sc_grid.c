@@ -201,15 +201,11 @@ uint32_t sc_grid_asm_span(uint32_t nx, uint32_t ny, uint32_t nz)
     return asm_span;
 }
 
-int sc_grid_init(sc_grid *g, const sc_mesh *m)
+/* Everything of sc_grid_init but the rest positions and the cells' nodes: sizes, ranges,
+ * templates, zeroed rows and masks (cell_ok, used and the rest positions are the caller's). */
+static void init_layout(sc_grid *g, uint32_t nx, uint32_t ny, uint32_t nz, const float cell_mm[3])
 {
-    if (g == NULL || m == NULL || m->nx < 2u || m->ny < 2u || m->nz < 2u ||
-        m->nx > SC_MAX_MESH_NX || m->ny > SC_MAX_MESH_NY || m->nz > SC_MAX_MESH_NZ ||
-        m->node_count != m->nx * m->ny * m->nz ||
-        m->tet_count != 5u * (m->nx - 1u) * (m->ny - 1u) * (m->nz - 1u)) {
-        return SC_ERR_INVALID_ARG;
-    }
-    const uint32_t nx = m->nx, ny = m->ny, nz = m->nz, nxy = nx * ny, nn = m->node_count;
+    const uint32_t nxy = nx * ny, nn = nx * ny * nz;
     g->nx = nx;
     g->ny = ny;
     g->nz = nz;
@@ -241,8 +237,8 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
     g->prefetch = (uint8_t)(nn > SC_GRID_PREFETCH_NODES);
     g->springs_fused = (uint8_t)(nn > SC_GRID_SPRINGS_FUSED_NODES);
     g->face_pairs = (uint8_t)(SC_GRID_PAIRS && nn <= SC_GRID_PAIRS_NODES);
-    g->step_max_mm = 2.0f * sqrtf(m->cell_mm[0] * m->cell_mm[0] + m->cell_mm[1] * m->cell_mm[1] +
-                                  m->cell_mm[2] * m->cell_mm[2]);
+    g->step_max_mm =
+        2.0f * sqrtf(cell_mm[0] * cell_mm[0] + cell_mm[1] * cell_mm[1] + cell_mm[2] * cell_mm[2]);
     init_slots(g);
     init_targets(g);
     /* the kernels' constant tables are this derivation */
@@ -360,7 +356,21 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
     memset(g->cell_ok, 0, (size_t)used * sizeof(int32_t));
     memset(g->con, 1, (size_t)used); /* padding: held */
     memset(g->used, 0, nn);
+#if SC_GRID_COARSE
+    g->coarse = NULL;
+#endif
+}
 
+int sc_grid_init(sc_grid *g, const sc_mesh *m)
+{
+    if (g == NULL || m == NULL || m->nx < 2u || m->ny < 2u || m->nz < 2u ||
+        m->nx > SC_MAX_MESH_NX || m->ny > SC_MAX_MESH_NY || m->nz > SC_MAX_MESH_NZ ||
+        m->node_count != m->nx * m->ny * m->nz ||
+        m->tet_count != 5u * (m->nx - 1u) * (m->ny - 1u) * (m->nz - 1u)) {
+        return SC_ERR_INVALID_ARG;
+    }
+    const uint32_t nx = m->nx, ny = m->ny, nz = m->nz, nxy = nx * ny, nn = m->node_count;
+    init_layout(g, nx, ny, nz, m->cell_mm);
     const uint32_t h = SC_GRID_HEAD;
     for (uint32_t t = 0; t < nn; t++) {
         const uint32_t i = t % nx, j = (t / nx) % ny, k = t / nxy;
@@ -800,6 +810,328 @@ static void job_finish(void *arg, uint32_t r)
     j->clamped[r] = clamped;
 }
 
+#if SC_GRID_COARSE
+int sc_grid_init_box(sc_grid *g, uint32_t nx, uint32_t ny, uint32_t nz, const float origin_mm[3],
+                     const float cell_mm[3])
+{
+    if (g == NULL || origin_mm == NULL || cell_mm == NULL || nx < 2u || ny < 2u || nz < 2u ||
+        nx > SC_MAX_MESH_NX || ny > SC_MAX_MESH_NY || nz > SC_MAX_MESH_NZ) {
+        return SC_ERR_INVALID_ARG;
+    }
+    const uint32_t nxy = nx * ny, nn = nxy * nz;
+    init_layout(g, nx, ny, nz, cell_mm);
+    const uint32_t h = SC_GRID_HEAD;
+    for (uint32_t t = 0; t < nn; t++) {
+        const uint32_t i = t % nx, j = (t / nx) % ny, k = t / nxy;
+        g->x0[0][h + t] = origin_mm[0] + (float)i * cell_mm[0];
+        g->x0[1][h + t] = origin_mm[1] + (float)j * cell_mm[1];
+        g->x0[2][h + t] = origin_mm[2] + (float)k * cell_mm[2];
+        g->odd[h + t] = ((i + j + k) & 1u) != 0u ? -1 : 0;
+        if (i + 1u < nx && j + 1u < ny && k + 1u < nz) {
+            g->cell_ok[h + t] = -1;
+            g->cell_odd[h + t] = ((i + j + k) & 1u) != 0u ? -1 : 0;
+        }
+        g->used[t] = 1u; /* every node is a corner of a cell (each count at least 2) */
+    }
+    return SC_OK;
+}
+
+/* P along one axis: the coarse nodes (1 or 2) and weights fine node i takes (cn coarse nodes) */
+static uint32_t coarse_of_fine(uint32_t i, uint32_t cn, uint32_t idx[2], float w[2])
+{
+    const uint32_t a = i / 2u;
+    idx[0] = a;
+    w[0] = 1.0f;
+    if ((i & 1u) == 0u || a + 1u >= cn) {
+        return 1u; /* on a coarse node, or past the last one */
+    }
+    w[0] = 0.5f;
+    idx[1] = a + 1u;
+    w[1] = 0.5f;
+    return 2u;
+}
+
+/* P^T along one axis: the fine nodes (1 to 3) and weights coarse node a gathers (n fine nodes,
+ * cn coarse): P's column a */
+static uint32_t fine_of_coarse(uint32_t a, uint32_t n, uint32_t cn, uint32_t idx[3], float w[3])
+{
+    uint32_t k = 0;
+    if (a > 0u) {
+        idx[k] = 2u * a - 1u;
+        w[k++] = 0.5f;
+    }
+    idx[k] = 2u * a;
+    w[k++] = 1.0f;
+    if (2u * a + 1u < n) {
+        idx[k] = 2u * a + 1u;
+        w[k++] = a + 1u < cn ? 0.5f : 1.0f;
+    }
+    return k;
+}
+
+/* (P^T row)[I] over the fine nodes, z, y, x order; a fine node whose mask is 0 adds nothing
+ * (mask NULL: every node) */
+static float restrict_at(const sc_grid *g, const sc_grid *gc, uint32_t t, const float *row,
+                         const float *mask)
+{
+    const uint32_t a[3] = {t % gc->nx, (t / gc->nx) % gc->ny, t / gc->nxy};
+    const uint32_t n[3] = {g->nx, g->ny, g->nz}, cn[3] = {gc->nx, gc->ny, gc->nz};
+    uint32_t idx[3][3];
+    float w[3][3];
+    uint32_t k[3];
+    for (uint32_t ax = 0; ax < 3u; ax++) {
+        k[ax] = fine_of_coarse(a[ax], n[ax], cn[ax], idx[ax], w[ax]);
+    }
+    const uint32_t h = SC_GRID_HEAD;
+    float sum = 0.0f;
+    for (uint32_t z = 0; z < k[2]; z++) {
+        for (uint32_t y = 0; y < k[1]; y++) {
+            const uint32_t base = g->nxy * idx[2][z] + g->nx * idx[1][y];
+            const float wzy = w[2][z] * w[1][y];
+            for (uint32_t x = 0; x < k[0]; x++) {
+                const uint32_t i = h + base + idx[0][x];
+                if (mask == NULL || nonzero(mask[i])) {
+                    sum += wzy * w[0][x] * row[i];
+                }
+            }
+        }
+    }
+    return sum;
+}
+
+int sc_grid_coarse_init(sc_grid_coarse *c, const sc_grid *g, const float cell_mm[3])
+{
+    if (c == NULL || g == NULL || cell_mm == NULL || g->nx < 3u || g->ny < 3u || g->nz < 3u) {
+        return SC_ERR_INVALID_ARG;
+    }
+    const uint32_t h = SC_GRID_HEAD;
+    const float origin[3] = {g->x0[0][h], g->x0[1][h], g->x0[2][h]};
+    const float cell[3] = {2.0f * cell_mm[0], 2.0f * cell_mm[1], 2.0f * cell_mm[2]};
+    sc_grid *gc = &c->grid;
+    const int rc =
+        sc_grid_init_box(gc, (g->nx + 1u) / 2u, (g->ny + 1u) / 2u, (g->nz + 1u) / 2u, origin, cell);
+    if (rc != SC_OK) {
+        return rc;
+    }
+    c->fine[0] = g->nx;
+    c->fine[1] = g->ny;
+    c->fine[2] = g->nz;
+    c->iterations = SC_GRID_COARSE_ITERATIONS;
+    for (uint32_t t = 0; t < gc->node_count; t++) {
+        gc->mass[h + t] = restrict_at(g, gc, t, g->mass, NULL); /* P^T M P, lumped */
+    }
+    return SC_OK;
+}
+
+/* the two-grid correction's loops (sc_grid_coarse): ranges of the coarse grid's range
+ * (restriction) or the fine grid's (prolongation, update); every node its own */
+typedef struct coarse_job {
+    sc_grid *g;
+    sc_grid *gc;
+    float alpha;
+    float pr[SC_GRID_SUM_BLOCKS], pq[SC_GRID_SUM_BLOCKS];
+} coarse_job;
+
+static void range_of(const sc_grid *g, uint32_t r, uint32_t *i0, uint32_t *i1)
+{
+    *i0 = r * g->range;
+    *i1 = *i0 + g->range < g->node_count ? *i0 + g->range : g->node_count;
+}
+
+/* Row (b, k) of r_c = P^T r over the free fine DOFs (pc nonzero): the fine rows (y, z) of its
+ * column, weighted, then x; out[c][a] for the row's cnx nodes. */
+static void restrict_row(const sc_grid *g, const sc_grid *gc, uint32_t b, uint32_t k,
+                         float out[3][SC_MAX_MESH_NX])
+{
+    uint32_t iy[3], iz[3];
+    float wy[3], wz[3];
+    const uint32_t ky = fine_of_coarse(b, g->ny, gc->ny, iy, wy);
+    const uint32_t kz = fine_of_coarse(k, g->nz, gc->nz, iz, wz);
+    const uint32_t cnx = gc->nx, nx = g->nx;
+    for (uint32_t c = 0; c < 3u; c++) {
+        for (uint32_t a = 0; a < cnx; a++) {
+            out[c][a] = 0.0f;
+        }
+    }
+    for (uint32_t z = 0; z < kz; z++) {
+        for (uint32_t y = 0; y < ky; y++) {
+            const float w = wz[z] * wy[y];
+            const uint32_t base = SC_GRID_HEAD + g->nxy * iz[z] + nx * iy[y];
+            for (uint32_t c = 0; c < 3u; c++) {
+                const float *rr = &g->r[c][base], *m = &g->pc[c][base];
+                for (uint32_t a = 0; a < cnx; a++) {
+                    const uint32_t x = 2u * a;
+                    float sum = nonzero(m[x]) ? rr[x] : 0.0f;
+                    if (a > 0u && nonzero(m[x - 1u])) {
+                        sum += 0.5f * rr[x - 1u];
+                    }
+                    if (x + 1u < nx && nonzero(m[x + 1u])) {
+                        sum += (a + 1u < cnx ? 0.5f : 1.0f) * rr[x + 1u];
+                    }
+                    out[c][a] += w * sum;
+                }
+            }
+        }
+    }
+}
+
+/* coarse flags from the fine nodes under them, r_c = P^T r on the free fine DOFs, e_c = 0 */
+static void job_coarse_restrict(void *arg, uint32_t r)
+{
+    const coarse_job *j = (const coarse_job *)arg;
+    const sc_grid *g = j->g;
+    sc_grid *gc = j->gc;
+    uint32_t i0, i1;
+    range_of(gc, r, &i0, &i1);
+    const uint32_t h = SC_GRID_HEAD;
+    const uint32_t n[3] = {g->nx, g->ny, g->nz}, cn[3] = {gc->nx, gc->ny, gc->nz};
+    float row[3][SC_MAX_MESH_NX];
+    for (uint32_t t = i0; t < i1; t++) {
+        const uint32_t ca[3] = {t % gc->nx, (t / gc->nx) % gc->ny, t / gc->nxy};
+        if (t == i0 || ca[0] == 0u) {
+            restrict_row(g, gc, ca[1], ca[2], row);
+        }
+        /* held where a fine node it carries whole is held: its own, and on an axis of an even
+         * fine count the last fine node past it (else the coarse grid would miss that face's
+         * support: the far sides and the bottom) */
+        uint32_t f0[3], f1[3];
+        for (uint32_t ax = 0; ax < 3u; ax++) {
+            f0[ax] = 2u * ca[ax];
+            f1[ax] = ca[ax] + 1u == cn[ax] && f0[ax] + 1u < n[ax] ? f0[ax] + 1u : f0[ax];
+        }
+        uint32_t held = 0u;
+        for (uint32_t d = 0; d < 8u; d++) {
+            const uint32_t i = ((d & 1u) ? f1[0] : f0[0]) + g->nx * ((d & 2u) ? f1[1] : f0[1]) +
+                               g->nxy * ((d & 4u) ? f1[2] : f0[2]);
+            const uint8_t con = g->con[h + i];
+            held |= con == 1u || con == 2u ? 7u : (con >= 0x80u ? (con >> 1) & 7u : 0u);
+        }
+        gc->con[h + t] = held == 7u ? 1u : (held != 0u ? (uint8_t)(0x80u | (held << 1)) : 0u);
+        for (uint32_t c = 0; c < 3u; c++) {
+            gc->r[c][h + t] = row[c][ca[0]];
+            gc->v[c][h + t] = 0.0f;
+        }
+    }
+}
+
+/* p = P e_c on the free fine DOFs (0 on the held ones): per fine row (y, z) the coarse rows
+ * under it weighted, then x */
+static void job_coarse_prolong(void *arg, uint32_t r)
+{
+    const coarse_job *j = (const coarse_job *)arg;
+    sc_grid *g = j->g;
+    const sc_grid *gc = j->gc;
+    uint32_t i0, i1;
+    range_of(g, r, &i0, &i1);
+    const uint32_t h = SC_GRID_HEAD, cnx = gc->nx;
+    float row[3][SC_MAX_MESH_NX];
+    for (uint32_t i = i0; i < i1; i++) {
+        const uint32_t x = i % g->nx;
+        if (i == i0 || x == 0u) {
+            const uint32_t y = (i / g->nx) % g->ny, z = i / g->nxy;
+            uint32_t iy[2], iz[2];
+            float wy[2], wz[2];
+            const uint32_t ky = coarse_of_fine(y, gc->ny, iy, wy);
+            const uint32_t kz = coarse_of_fine(z, gc->nz, iz, wz);
+            for (uint32_t c = 0; c < 3u; c++) {
+                for (uint32_t a = 0; a < cnx; a++) {
+                    row[c][a] = 0.0f;
+                }
+                for (uint32_t zz = 0; zz < kz; zz++) {
+                    for (uint32_t yy = 0; yy < ky; yy++) {
+                        const float w = wz[zz] * wy[yy];
+                        const float *vc = &gc->v[c][h + gc->nxy * iz[zz] + cnx * iy[yy]];
+                        for (uint32_t a = 0; a < cnx; a++) {
+                            row[c][a] += w * vc[a];
+                        }
+                    }
+                }
+            }
+        }
+        const uint32_t a = x / 2u;
+        for (uint32_t c = 0; c < 3u; c++) {
+            const float val =
+                ((x & 1u) == 0u || a + 1u >= cnx) ? row[c][a] : 0.5f * (row[c][a] + row[c][a + 1u]);
+            g->p[c][h + i] = nonzero(g->pc[c][h + i]) ? val : 0.0f;
+        }
+    }
+}
+
+/* p.r and p.q over a sum block, components then nodes */
+static void job_coarse_dots(void *arg, uint32_t b)
+{
+    coarse_job *j = (coarse_job *)arg;
+    const sc_grid *g = j->g;
+    const uint32_t i0 = SC_GRID_HEAD + b * g->sum_block;
+    const uint32_t i1 = SC_GRID_HEAD + (b * g->sum_block + g->sum_block < g->node_count
+                                            ? b * g->sum_block + g->sum_block
+                                            : g->node_count);
+    float pr = 0.0f, pq = 0.0f;
+    for (uint32_t c = 0; c < 3u; c++) {
+        for (uint32_t i = i0; i < i1; i++) {
+            pr += g->p[c][i] * g->r[c][i];
+            pq += g->p[c][i] * g->q[c][i];
+        }
+    }
+    j->pr[b] = pr;
+    j->pq[b] = pq;
+}
+
+/* v += alpha p, r -= alpha q (q = A p) */
+static void job_coarse_update(void *arg, uint32_t r)
+{
+    const coarse_job *j = (const coarse_job *)arg;
+    sc_grid *g = j->g;
+    uint32_t i0, i1;
+    range_of(g, r, &i0, &i1);
+    const uint32_t h = SC_GRID_HEAD;
+    const float alpha = j->alpha;
+    for (uint32_t c = 0; c < 3u; c++) {
+        for (uint32_t i = h + i0; i < h + i1; i++) {
+            g->v[c][i] += alpha * g->p[c][i];
+            g->r[c][i] -= alpha * g->q[c][i];
+        }
+    }
+}
+
+/* The two-grid correction of the warm start (sc_grid_coarse), after the fine preconditioner. */
+static void coarse_correct(sc_grid *g, float cm, float ck)
+{
+    sc_grid_coarse *c = g->coarse;
+    sc_grid *gc = &c->grid;
+    gc->pool = g->pool;
+    coarse_job cj;
+    memset(&cj, 0, sizeof cj);
+    cj.g = g;
+    cj.gc = gc;
+    sc_pool_run(g->pool, job_coarse_restrict, &cj, job_ranges(gc, gc->range));
+    step_job j;
+    memset(&j, 0, sizeof j);
+    j.g = gc;
+    j.cm = cm;
+    j.ck = ck;
+    sc_pool_run(g->pool, job_precond, &j, job_ranges(gc, gc->range));
+    sc_grid_cg_out out;
+    const sc_grid_kern *k = sc_grid_kern_selected();
+    k->cg(gc, cm, ck, c->iterations, &out);
+    sc_pool_run(g->pool, job_coarse_prolong, &cj, job_ranges(g, g->range));
+    k->matvec(g, cm, ck);
+    /* the step along P e_c that minimises the fine error's energy, (p.r) / (p.A p): the coarse
+     * K is not P^T K P (its own cells, the fine model's nonlinear and floor terms left out), and
+     * a correction scaled by it never raises the error's A-norm */
+    const uint32_t blocks = job_ranges(g, g->sum_block);
+    sc_pool_run(g->pool, job_coarse_dots, &cj, blocks);
+    float pr = 0.0f, pq = 0.0f;
+    for (uint32_t b = 0; b < blocks && b < SC_GRID_SUM_BLOCKS; b++) {
+        pr += cj.pr[b];
+        pq += cj.pq[b];
+    }
+    cj.alpha = (pq > 0.0f && isfinite(pr / pq)) ? pr / pq : 0.0f;
+    c->alpha = cj.alpha;
+    sc_pool_run(g->pool, job_coarse_update, &cj, job_ranges(g, g->range));
+}
+#endif
+
 int sc_grid_solve(sc_grid *g, sc_nodes *n, float dt_s, float beta_s, float alpha_per_s,
                   uint32_t cg_iterations)
 {
@@ -819,6 +1151,11 @@ int sc_grid_solve(sc_grid *g, sc_nodes *n, float dt_s, float beta_s, float alpha
     const uint32_t ranges = job_ranges(g, g->range);
     /* Jacobi preconditioner, zero on Dirichlet DOFs (projects the CG onto the free DOFs) */
     sc_pool_run(g->pool, job_precond, &j, ranges);
+#if SC_GRID_COARSE
+    if (g->coarse != NULL) {
+        coarse_correct(g, cm, ck);
+    }
+#endif
     sc_grid_cg_out out;
     sc_grid_kern_selected()->cg(g, cm, ck, cg_iterations, &out);
     g->stats.cg_iterations_run = out.iterations;

@@ -130,6 +130,20 @@ _Static_assert(SC_GRID_POOL_RANGE % SC_GRID_CHUNK == 0u && SC_GRID_SUM_BLOCK % 1
 #endif
 #define SC_GRID_REST_COPY_CAP 16384u
 #define SC_GRID_REST_COPY (SC_MAX_NODES > SC_GRID_REST_COPY_CAP)
+/* The two-grid correction of the step's warm start (sc_grid_coarse below), in every build with
+ * the rest copy (the MCU's SRAM holds no second grid), on meshes of more than
+ * SC_GRID_COARSE_NODES nodes (48x24x24, 64x32x32: up to 32x16x16 the steps keep their bits).
+ * Why: the Jacobi-preconditioned CG moves a correction about one node per iteration, so a
+ * fixed count that settles a 32x16x16 press leaves a 64x32x32 one far from it (16 mm: the vein
+ * at 0.140 of its area with 10 iterations, 0.010 with 30; docs/physics.md). The smooth part of
+ * the error is what a grid of half the resolution solves well. */
+#define SC_GRID_COARSE SC_GRID_REST_COPY
+#ifndef SC_GRID_COARSE_NODES
+#define SC_GRID_COARSE_NODES 8192u
+#endif
+#ifndef SC_GRID_COARSE_ITERATIONS
+#define SC_GRID_COARSE_ITERATIONS 20u
+#endif
 /* The software prefetches of the mat-vec, the springs and the cell passes (sc_grid_kern.inc) run
  * only on meshes of more than this many nodes (sc_grid.prefetch, by the mesh alone; a hint changes
  * no result). On the x86-64-v4 EPYC of the earlier sessions they were worth 2x on the 64x32x32
@@ -266,6 +280,10 @@ typedef struct sc_grid {
     uint8_t forces_vanish_at_rest;
     const sc_pool_dev *pool; /* workers of the CG and the assembly (NULL: serial); sc_grid_init
                               * sets NULL */
+#if SC_GRID_COARSE
+    struct sc_grid_coarse *coarse; /* the two-grid correction (NULL: none; sc_grid_init sets NULL,
+                                      the owner builds it: sc_fem_init) */
+#endif
 
     /* ---- hot: matrix rows (node t at SC_GRID_HEAD + t) ---- */
     SC_ALIGN_HOT float d[6][SC_GRID_ROW];
@@ -299,6 +317,40 @@ typedef struct sc_grid {
 _Static_assert(offsetof(sc_grid, e) == offsetof(sc_grid, d) + 6u * SC_GRID_ROW * sizeof(float) &&
                    offsetof(sc_grid, f) == offsetof(sc_grid, e) + 27u * SC_GRID_ROW * sizeof(float),
                "the matrix rows d, e, f follow each other: row k at &d[0][0] + k SC_GRID_ROW");
+
+#if SC_GRID_COARSE
+/* The coarse grid of the two-grid correction: every other node of the fine grid along each axis
+ * (coarse node (a, b, c) at fine node (2a, 2b, 2c); a fine axis of n nodes gives (n + 1) / 2, the
+ * last fine node of an even n outside it), cells twice the size, holding the linear FEM's rest K
+ * of the fine materials averaged over each coarse cell and the fine masses restricted (the
+ * owner builds it, sc_fem.c). Each step of the fine grid then, before its CG (sc_grid_solve):
+ *   r_c = P^T r (free DOFs),  iterations coarse PCG iterations on A_c e_c = r_c from e_c = 0,
+ *   v += P e_c,  r -= A P e_c (one fine mat-vec)
+ * with P the trilinear interpolation (a fine node past the last coarse one takes its value) and
+ * A_c = cm M_c + ck K_c with the step's cm and ck; the coarse DOFs held are those of their fine
+ * nodes. The fine CG then starts from the corrected v: a warm start whose smooth error the
+ * coarse grid has removed (a fine residual of zero gives a correction of zero: the fine step's
+ * answer is still its own). Every loop is node-wise or the coarse grid's own CG: the same bits
+ * for every worker count. */
+typedef struct sc_grid_coarse {
+    uint32_t fine[3];    /* the fine grid's nodes per axis */
+    uint32_t iterations; /* coarse CG iterations per step */
+    float alpha;         /* the last step's scale of the correction (1: the coarse K's own) */
+    sc_grid grid;        /* coarse matrix, masses, solver vectors */
+    SC_ALIGN_HOT float lamv[5][SC_GRID_ROW]; /* lambda V, mu V per coarse cell (sc_grid_fem_in) */
+    SC_ALIGN_HOT float muv[5][SC_GRID_ROW];
+} sc_grid_coarse;
+
+/* The layout of a full box grid of nx x ny x nz nodes (every cell present, every node used) at
+ * origin_mm with cells of cell_mm: sc_grid_init without a mesh, for the coarse grid. Errors:
+ * SC_ERR_INVALID_ARG (NULL, counts outside 2..limits). */
+int sc_grid_init_box(sc_grid *g, uint32_t nx, uint32_t ny, uint32_t nz, const float origin_mm[3],
+                     const float cell_mm[3]);
+
+/* The coarse grid's layout for fine grid g (its nodes per axis (n + 1) / 2, cells twice g's,
+ * cell_mm the fine cells') and its masses restricted from g's (g's masses filled). */
+int sc_grid_coarse_init(sc_grid_coarse *c, const sc_grid *g, const float cell_mm[3]);
+#endif
 
 /* The FEM's element data for the cell kernel (sc_fem.c fills it at init). Tet q of the cell with
  * lowest node t (template order, SC_MESH_CELL_TETS) has lambda V and mu V at
