@@ -148,7 +148,8 @@ int sc_fem_init(sc_fem *f, const sc_mesh *m, const sc_material_table *mat, const
 /* Advance the nodes by dt_s: reads n->x, n->v (warm start) and the external forces n->f*,
  * writes n->x and n->v. Fixed nodes keep their position with zero velocity. Runs exactly
  * cg_iterations CG iterations (fewer only if r.z is exactly 0 or p.Ap <= 0, e.g. no free
- * DOF).
+ * DOF); on a mesh with the two-grid correction (sc_grid.h, sc_grid_coarse) the correction
+ * and cg_iterations - 1 of them (at least 1).
  * Cost: one element pass over the cells, O(T) (corotated: with a polar decomposition per tet,
  * at most 8 Newton iterations), plus cg_iterations grid mat-vecs, O(N) each.
  * Never allocates, cannot fail by contract: a non-finite solution leaves n unchanged, counts

@@ -233,7 +233,8 @@ typedef struct sc_grid_slot {
 
 /* Diagnostics of the last step. */
 typedef struct sc_grid_stats {
-    uint32_t cg_iterations_run; /* <= requested (early only on r.z = 0 or p.Ap <= 0) */
+    uint32_t cg_iterations_run; /* <= requested (early only on r.z = 0 or p.Ap <= 0); the
+                                   two-grid correction counts as one */
     float residual_ratio;       /* sqrt(r.z) after / before the CG of the last step */
     uint32_t unloaded_steps;    /* steps that started from the release warm start */
     uint32_t unstable_steps;    /* steps refused because the solution was not finite */
@@ -409,7 +410,9 @@ int sc_grid_load_rest(sc_grid *g);
 void sc_grid_clear(sc_grid *g, uint32_t which);
 
 /* Finish the step begun with the same dt, beta and alpha: the preconditioner, cg_iterations
- * PCG iterations (fewer only if r.z is exactly 0 or p.Ap <= 0), and n->x, n->v from the
+ * PCG iterations (fewer only if r.z is exactly 0 or p.Ap <= 0; with the two-grid correction,
+ * sc_grid.coarse, the correction and cg_iterations - 1 of them, at least 1: the same count of
+ * fine mat-vecs; stats.cg_iterations_run counts the correction as one), and n->x, n->v from the
  * solution; fixed DOFs keep their position with zero velocity. A free node's step is held to
  * step_max_mm (its free velocity components scaled together; counted in stats.clamped_nodes
  * and clamped_steps): the truncated CG's error, not motion. A non-finite solution leaves n

@@ -1216,10 +1216,10 @@ static void two_grid_correction_above_the_threshold_and_none_at_rest(void **stat
     }
 }
 
-/* One step of a press (a patch of the top moved 1 mm into the block) from rest: with 10 CG
- * iterations the corrected step is much nearer the solved one (200 iterations) than the plain
- * Jacobi CG's, whose error is the far field it has not reached; solved with or without the
- * correction, the step is the same. */
+/* One step of a press (a patch of the top moved 1 mm into the block) from rest: with a count of
+ * 10 (the correction and 9 CG iterations) the corrected step is much nearer the solved one (200)
+ * than the plain Jacobi CG's 10, whose error is the far field they have not reached; solved with
+ * or without the correction, the step is the same. */
 static double press_step_error(int coarse, uint32_t iterations, const sc_nodes *ref)
 {
     sc_fem_def def = sc_fem_default_def();
