@@ -913,10 +913,8 @@ int sc_grid_coarse_init(sc_grid_coarse *c, const sc_grid *g, const float cell_mm
     if (rc != SC_OK) {
         return rc;
     }
-    c->fine[0] = g->nx;
-    c->fine[1] = g->ny;
-    c->fine[2] = g->nz;
     c->iterations = SC_GRID_COARSE_ITERATIONS;
+    c->alpha = 0.0f;
     for (uint32_t t = 0; t < gc->node_count; t++) {
         gc->mass[h + t] = restrict_at(g, gc, t, g->mass, NULL); /* P^T M P, lumped */
     }

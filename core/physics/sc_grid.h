@@ -334,7 +334,6 @@ _Static_assert(offsetof(sc_grid, e) == offsetof(sc_grid, d) + 6u * SC_GRID_ROW *
  * answer is still its own). Every loop is node-wise or the coarse grid's own CG: the same bits
  * for every worker count. */
 typedef struct sc_grid_coarse {
-    uint32_t fine[3];    /* the fine grid's nodes per axis */
     uint32_t iterations; /* coarse CG iterations per step */
     float alpha;         /* the last step's scale of the correction (1: the coarse K's own) */
     sc_grid grid;        /* coarse matrix, masses, solver vectors */
