@@ -2023,6 +2023,15 @@ static void sample_line(line_w *w, const vol_ctx *vc, const sc_volume *v, const 
         first = first < 2u * w->run_count ? first : 2u * w->run_count;
         last = 2u * w->run_count;
     }
+#ifdef SC_ENABLE_VALIDATE
+    /* every word the line sampler gathers at is a position in the volume (or voxel 0) */
+    for (uint32_t a = 0; a < 3u; a++) {
+        const uint32_t wmax = (uint32_t)((uint64_t)(vc->xmax[a] + SC_W_HALF) >> SC_POS_SHIFT);
+        for (uint32_t kk = 0; kk < n; kk++) {
+            SC_VALIDATE(w->pos_h[a][kk] <= wmax);
+        }
+    }
+#endif
     {
         const vol_regs vr = {vc->vox, vc->lab, vc->stride[1], vc->stride[2], vc->la};
         vc->line(vr, b->lut_b_fx, n, w->pos_h[0], w->pos_h[1], w->pos_h[2], w->out,
