@@ -869,34 +869,37 @@ static uint32_t fine_of_coarse(uint32_t a, uint32_t n, uint32_t cn, uint32_t idx
     return k;
 }
 
-/* (P^T row)[I] over the fine nodes, z, y, x order; a fine node whose mask is 0 adds nothing
- * (mask NULL: every node) */
-static float restrict_at(const sc_grid *g, const sc_grid *gc, uint32_t t, const float *row,
-                         const float *mask)
+/* Row (b, k) of P^T src over the fine nodes whose mask is nonzero (mask NULL: every node): the
+ * fine rows (y, z) of the coarse row's column, weighted, then x; out[a] for its cnx nodes. */
+static void restrict_row(const sc_grid *g, const sc_grid *gc, uint32_t b, uint32_t k,
+                         const float *src, const float *mask, float out[SC_MAX_MESH_NX])
 {
-    const uint32_t a[3] = {t % gc->nx, (t / gc->nx) % gc->ny, t / gc->nxy};
-    const uint32_t n[3] = {g->nx, g->ny, g->nz}, cn[3] = {gc->nx, gc->ny, gc->nz};
-    uint32_t idx[3][3];
-    float w[3][3];
-    uint32_t k[3];
-    for (uint32_t ax = 0; ax < 3u; ax++) {
-        k[ax] = fine_of_coarse(a[ax], n[ax], cn[ax], idx[ax], w[ax]);
+    uint32_t iy[3], iz[3];
+    float wy[3], wz[3];
+    const uint32_t ky = fine_of_coarse(b, g->ny, gc->ny, iy, wy);
+    const uint32_t kz = fine_of_coarse(k, g->nz, gc->nz, iz, wz);
+    const uint32_t cnx = gc->nx, nx = g->nx;
+    for (uint32_t a = 0; a < cnx; a++) {
+        out[a] = 0.0f;
     }
-    const uint32_t h = SC_GRID_HEAD;
-    float sum = 0.0f;
-    for (uint32_t z = 0; z < k[2]; z++) {
-        for (uint32_t y = 0; y < k[1]; y++) {
-            const uint32_t base = g->nxy * idx[2][z] + g->nx * idx[1][y];
-            const float wzy = w[2][z] * w[1][y];
-            for (uint32_t x = 0; x < k[0]; x++) {
-                const uint32_t i = h + base + idx[0][x];
-                if (mask == NULL || nonzero(mask[i])) {
-                    sum += wzy * w[0][x] * row[i];
+    for (uint32_t z = 0; z < kz; z++) {
+        for (uint32_t y = 0; y < ky; y++) {
+            const float w = wz[z] * wy[y];
+            const uint32_t base = SC_GRID_HEAD + g->nxy * iz[z] + nx * iy[y];
+            const float *rr = &src[base], *m = mask != NULL ? &mask[base] : NULL;
+            for (uint32_t a = 0; a < cnx; a++) {
+                const uint32_t x = 2u * a;
+                float sum = (m == NULL || nonzero(m[x])) ? rr[x] : 0.0f;
+                if (a > 0u && (m == NULL || nonzero(m[x - 1u]))) {
+                    sum += 0.5f * rr[x - 1u];
                 }
+                if (x + 1u < nx && (m == NULL || nonzero(m[x + 1u]))) {
+                    sum += (a + 1u < cnx ? 0.5f : 1.0f) * rr[x + 1u];
+                }
+                out[a] += w * sum;
             }
         }
     }
-    return sum;
 }
 
 int sc_grid_coarse_init(sc_grid_coarse *c, const sc_grid *g, const float cell_mm[3])
@@ -915,8 +918,8 @@ int sc_grid_coarse_init(sc_grid_coarse *c, const sc_grid *g, const float cell_mm
     }
     c->iterations = SC_GRID_COARSE_ITERATIONS;
     c->alpha = 0.0f;
-    for (uint32_t t = 0; t < gc->node_count; t++) {
-        gc->mass[h + t] = restrict_at(g, gc, t, g->mass, NULL); /* P^T M P, lumped */
+    for (uint32_t t = 0; t < gc->node_count; t += gc->nx) { /* P^T M P, lumped */
+        restrict_row(g, gc, (t / gc->nx) % gc->ny, t / gc->nxy, g->mass, NULL, &gc->mass[h + t]);
     }
     return SC_OK;
 }
@@ -936,43 +939,6 @@ static void range_of(const sc_grid *g, uint32_t r, uint32_t *i0, uint32_t *i1)
     *i1 = *i0 + g->range < g->node_count ? *i0 + g->range : g->node_count;
 }
 
-/* Row (b, k) of r_c = P^T r over the free fine DOFs (pc nonzero): the fine rows (y, z) of its
- * column, weighted, then x; out[c][a] for the row's cnx nodes. */
-static void restrict_row(const sc_grid *g, const sc_grid *gc, uint32_t b, uint32_t k,
-                         float out[3][SC_MAX_MESH_NX])
-{
-    uint32_t iy[3], iz[3];
-    float wy[3], wz[3];
-    const uint32_t ky = fine_of_coarse(b, g->ny, gc->ny, iy, wy);
-    const uint32_t kz = fine_of_coarse(k, g->nz, gc->nz, iz, wz);
-    const uint32_t cnx = gc->nx, nx = g->nx;
-    for (uint32_t c = 0; c < 3u; c++) {
-        for (uint32_t a = 0; a < cnx; a++) {
-            out[c][a] = 0.0f;
-        }
-    }
-    for (uint32_t z = 0; z < kz; z++) {
-        for (uint32_t y = 0; y < ky; y++) {
-            const float w = wz[z] * wy[y];
-            const uint32_t base = SC_GRID_HEAD + g->nxy * iz[z] + nx * iy[y];
-            for (uint32_t c = 0; c < 3u; c++) {
-                const float *rr = &g->r[c][base], *m = &g->pc[c][base];
-                for (uint32_t a = 0; a < cnx; a++) {
-                    const uint32_t x = 2u * a;
-                    float sum = nonzero(m[x]) ? rr[x] : 0.0f;
-                    if (a > 0u && nonzero(m[x - 1u])) {
-                        sum += 0.5f * rr[x - 1u];
-                    }
-                    if (x + 1u < nx && nonzero(m[x + 1u])) {
-                        sum += (a + 1u < cnx ? 0.5f : 1.0f) * rr[x + 1u];
-                    }
-                    out[c][a] += w * sum;
-                }
-            }
-        }
-    }
-}
-
 /* coarse flags from the fine nodes under them, r_c = P^T r on the free fine DOFs, e_c = 0 */
 static void job_coarse_restrict(void *arg, uint32_t r)
 {
@@ -987,7 +953,9 @@ static void job_coarse_restrict(void *arg, uint32_t r)
     for (uint32_t t = i0; t < i1; t++) {
         const uint32_t ca[3] = {t % gc->nx, (t / gc->nx) % gc->ny, t / gc->nxy};
         if (t == i0 || ca[0] == 0u) {
-            restrict_row(g, gc, ca[1], ca[2], row);
+            for (uint32_t c = 0; c < 3u; c++) {
+                restrict_row(g, gc, ca[1], ca[2], g->r[c], g->pc[c], row[c]);
+            }
         }
         /* held where a fine node it carries whole is held: its own, and on an axis of an even
          * fine count the last fine node past it (else the coarse grid would miss that face's
