@@ -356,6 +356,17 @@ static void init_layout(sc_grid *g, uint32_t nx, uint32_t ny, uint32_t nz, const
     memset(g->cell_ok, 0, (size_t)used * sizeof(int32_t));
     memset(g->con, 1, (size_t)used); /* padding: held */
     memset(g->used, 0, nn);
+    /* the node and cell parities, and which origins have a cell: the grid's sizes alone */
+    const uint32_t h = SC_GRID_HEAD;
+    for (uint32_t t = 0; t < nn; t++) {
+        const uint32_t i = t % nx, j = (t / nx) % ny, k = t / nxy;
+        const int32_t odd = ((i + j + k) & 1u) != 0u ? -1 : 0;
+        g->odd[h + t] = odd;
+        if (i + 1u < nx && j + 1u < ny && k + 1u < nz) {
+            g->cell_ok[h + t] = -1;
+            g->cell_odd[h + t] = odd;
+        }
+    }
 #if SC_GRID_COARSE
     g->coarse = NULL;
 #endif
@@ -377,11 +388,8 @@ int sc_grid_init(sc_grid *g, const sc_mesh *m)
         g->x0[0][h + t] = m->rest_x[t];
         g->x0[1][h + t] = m->rest_y[t];
         g->x0[2][h + t] = m->rest_z[t];
-        g->odd[h + t] = ((i + j + k) & 1u) != 0u ? -1 : 0;
-        if (i + 1u < nx && j + 1u < ny && k + 1u < nz) {
+        if (g->cell_ok[h + t] != 0) {
             const uint32_t par = (i + j + k) & 1u;
-            g->cell_ok[h + t] = -1;
-            g->cell_odd[h + t] = par != 0u ? -1 : 0;
             const uint32_t cube = i + (nx - 1u) * (j + (ny - 1u) * k);
             for (uint32_t q = 0; q < 5u; q++) {
                 uint32_t v[4];
@@ -490,10 +498,16 @@ static uint32_t job_ranges(const sc_grid *g, uint32_t size)
     return (g->node_count + size - 1u) / size;
 }
 
-static void job_span(const step_job *j, uint32_t r, uint32_t size, uint32_t *i0, uint32_t *i1)
+/* nodes [i0, i1) of range r of `size` nodes of g (the last one cut at the node count) */
+static void node_span(const sc_grid *g, uint32_t r, uint32_t size, uint32_t *i0, uint32_t *i1)
 {
     *i0 = r * size;
-    *i1 = *i0 + size < j->g->node_count ? *i0 + size : j->g->node_count;
+    *i1 = *i0 + size < g->node_count ? *i0 + size : g->node_count;
+}
+
+static void job_span(const step_job *j, uint32_t r, uint32_t size, uint32_t *i0, uint32_t *i1)
+{
+    node_span(j->g, r, size, i0, i1);
 }
 
 /* loaded: a kinematic node or an external force that does not vanish at rest */
@@ -826,11 +840,6 @@ int sc_grid_init_box(sc_grid *g, uint32_t nx, uint32_t ny, uint32_t nz, const fl
         g->x0[0][h + t] = origin_mm[0] + (float)i * cell_mm[0];
         g->x0[1][h + t] = origin_mm[1] + (float)j * cell_mm[1];
         g->x0[2][h + t] = origin_mm[2] + (float)k * cell_mm[2];
-        g->odd[h + t] = ((i + j + k) & 1u) != 0u ? -1 : 0;
-        if (i + 1u < nx && j + 1u < ny && k + 1u < nz) {
-            g->cell_ok[h + t] = -1;
-            g->cell_odd[h + t] = ((i + j + k) & 1u) != 0u ? -1 : 0;
-        }
         g->used[t] = 1u; /* every node is a corner of a cell (each count at least 2) */
     }
     return SC_OK;
@@ -933,12 +942,6 @@ typedef struct coarse_job {
     float pr[SC_GRID_SUM_BLOCKS], pq[SC_GRID_SUM_BLOCKS];
 } coarse_job;
 
-static void range_of(const sc_grid *g, uint32_t r, uint32_t *i0, uint32_t *i1)
-{
-    *i0 = r * g->range;
-    *i1 = *i0 + g->range < g->node_count ? *i0 + g->range : g->node_count;
-}
-
 /* coarse flags from the fine nodes under them, r_c = P^T r on the free fine DOFs, e_c = 0 */
 static void job_coarse_restrict(void *arg, uint32_t r)
 {
@@ -946,7 +949,7 @@ static void job_coarse_restrict(void *arg, uint32_t r)
     const sc_grid *g = j->g;
     sc_grid *gc = j->gc;
     uint32_t i0, i1;
-    range_of(gc, r, &i0, &i1);
+    node_span(gc, r, gc->range, &i0, &i1);
     const uint32_t h = SC_GRID_HEAD;
     const uint32_t n[3] = {g->nx, g->ny, g->nz}, cn[3] = {gc->nx, gc->ny, gc->nz};
     float row[3][SC_MAX_MESH_NX];
@@ -988,7 +991,7 @@ static void job_coarse_prolong(void *arg, uint32_t r)
     sc_grid *g = j->g;
     const sc_grid *gc = j->gc;
     uint32_t i0, i1;
-    range_of(g, r, &i0, &i1);
+    node_span(g, r, g->range, &i0, &i1);
     const uint32_t h = SC_GRID_HEAD, cnx = gc->nx;
     float row[3][SC_MAX_MESH_NX];
     for (uint32_t i = i0; i < i1; i++) {
@@ -1028,10 +1031,10 @@ static void job_coarse_dots(void *arg, uint32_t b)
 {
     coarse_job *j = (coarse_job *)arg;
     const sc_grid *g = j->g;
-    const uint32_t i0 = SC_GRID_HEAD + b * g->sum_block;
-    const uint32_t i1 = SC_GRID_HEAD + (b * g->sum_block + g->sum_block < g->node_count
-                                            ? b * g->sum_block + g->sum_block
-                                            : g->node_count);
+    uint32_t i0, i1;
+    node_span(g, b, g->sum_block, &i0, &i1);
+    i0 += SC_GRID_HEAD;
+    i1 += SC_GRID_HEAD;
     float pr = 0.0f, pq = 0.0f;
     for (uint32_t c = 0; c < 3u; c++) {
         for (uint32_t i = i0; i < i1; i++) {
@@ -1049,7 +1052,7 @@ static void job_coarse_update(void *arg, uint32_t r)
     const coarse_job *j = (const coarse_job *)arg;
     sc_grid *g = j->g;
     uint32_t i0, i1;
-    range_of(g, r, &i0, &i1);
+    node_span(g, r, g->range, &i0, &i1);
     const uint32_t h = SC_GRID_HEAD;
     const float alpha = j->alpha;
     for (uint32_t c = 0; c < 3u; c++) {
