@@ -4,6 +4,7 @@
 #include "sc_err.h"
 
 static sc_simd s_selected = SC_SIMD_GENERIC;
+static sc_simd_prefetch s_prefetch = SC_SIMD_PREFETCH_MESH;
 
 int sc_simd_built(sc_simd v)
 {
@@ -55,6 +56,35 @@ const char *sc_simd_name(sc_simd v)
     case SC_SIMD_X86_64_V4:
         return "x86-64-v4";
     case SC_SIMD_COUNT:
+    default:
+        return "?";
+    }
+}
+
+int sc_simd_select_prefetch(sc_simd_prefetch p)
+{
+    if ((unsigned)p >= (unsigned)SC_SIMD_PREFETCH_COUNT) {
+        return SC_ERR_INVALID_ARG;
+    }
+    s_prefetch = p;
+    return SC_OK;
+}
+
+sc_simd_prefetch sc_simd_selected_prefetch(void)
+{
+    return s_prefetch;
+}
+
+const char *sc_simd_prefetch_name(sc_simd_prefetch p)
+{
+    switch (p) {
+    case SC_SIMD_PREFETCH_MESH:
+        return "mesh";
+    case SC_SIMD_PREFETCH_ON:
+        return "on";
+    case SC_SIMD_PREFETCH_OFF:
+        return "off";
+    case SC_SIMD_PREFETCH_COUNT:
     default:
         return "?";
     }

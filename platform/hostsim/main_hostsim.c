@@ -710,6 +710,12 @@ int main(int argc, char **argv)
                 "sc-hostsim: SONOCOMP_SIMD=%s refused (not built or not on this CPU), using %s\n",
                 getenv("SONOCOMP_SIMD"), sc_simd_name(sc_simd_selected()));
     }
+    /* the mat-vec's prefetch: a hint, the same bits either way; not measured here (the time is
+     * virtual), so the mesh decides unless SONOCOMP_PREFETCH says (sc_cpu.h) */
+    if (sc_cpu_select_prefetch(0, NULL) != SC_OK) {
+        fprintf(stderr, "sc-hostsim: SONOCOMP_PREFETCH=%s refused (mesh, on or off), by the mesh\n",
+                getenv("SONOCOMP_PREFETCH"));
+    }
 
     /* engine on the host simulator, cases mapped from files */
     sc_engine_def def = sc_engine_default_def();

@@ -50,6 +50,7 @@ enum { EXIT_OK = 0, EXIT_RUNTIME = 1, EXIT_USAGE = 2, EXIT_CONFIG = 3 };
 /* The engine object: static storage, locked and pre-faulted with the rest of the process. */
 static sc_engine g_engine;
 static sc_log_linux g_log;
+static sc_cpu_prefetch g_prefetch; /* how the mat-vec's prefetch was chosen (sc_cpu.h) */
 
 /* ---- null devices: can.interface = none, display.target = none ------------------------- */
 
@@ -473,6 +474,9 @@ static void final_report(const sc_engine *e, double wall_s, const char *stop_rea
     printf("  real time: mlockall %s, SCHED_FIFO %s, pinned %s, huge pages %s\n",
            rt->locked ? "yes" : "no", rt->fifo ? "yes" : "no", rt->pinned ? "yes" : "no",
            rt->huge ? "yes" : "no");
+    char pf_line[160];
+    sc_cpu_prefetch_describe(&g_prefetch, pf_line, sizeof pf_line);
+    printf("  kernels %s, %s\n", sc_simd_name(sc_simd_selected()), pf_line);
     printf("  %-16s %9s %9s %9s %9s %9s   (ms)\n", "", "count", "mean", "p50", "p99", "worst");
     print_stats_row("frame", &s->frame_stats);
     print_stats_row("wake-up latency", &s->lateness_stats);
@@ -710,9 +714,17 @@ int main(int argc, char **argv)
         sc_log_linux_msg(&g_log, SC_LOG_WARN, "simd", "SONOCOMP_SIMD=%s refused: not on this CPU",
                          getenv("SONOCOMP_SIMD"));
     }
-    sc_log_linux_msg(&g_log, SC_LOG_INFO, "start", "version=%s config=%s rate_hz=%u kernels=%s",
-                     SONOCOMP_VERSION, a.config_path ? a.config_path : "(defaults)",
-                     (unsigned)cfg.frame_rate_hz, sc_simd_name(sc_simd_selected()));
+    /* the mat-vec's prefetch for this CPU, measured (sc_cpu.h; SONOCOMP_PREFETCH overrides) */
+    if (sc_cpu_select_prefetch(1, &g_prefetch) != SC_OK) {
+        sc_log_linux_msg(&g_log, SC_LOG_WARN, "prefetch",
+                         "SONOCOMP_PREFETCH=%s refused or no memory to measure: by the mesh",
+                         getenv("SONOCOMP_PREFETCH") ? getenv("SONOCOMP_PREFETCH") : "");
+    }
+    sc_log_linux_msg(&g_log, SC_LOG_INFO, "start",
+                     "version=%s config=%s rate_hz=%u kernels=%s prefetch=%s", SONOCOMP_VERSION,
+                     a.config_path ? a.config_path : "(defaults)", (unsigned)cfg.frame_rate_hz,
+                     sc_simd_name(sc_simd_selected()),
+                     sc_simd_prefetch_name(sc_simd_selected_prefetch()));
     if (sc_rt_install_signals() != 0) {
         sc_log_linux_msg(&g_log, SC_LOG_WARN, "signals", "reason=\"cannot install handlers\"");
     }

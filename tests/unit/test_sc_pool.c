@@ -27,6 +27,7 @@
 #include "sc_material.h"
 #include "sc_pool_linux.h"
 #include "sc_test_tissue_scene.h"
+#include "sc_simd.h"
 #include "sc_tissue.h"
 
 static sc_tissue g_t; /* large: static */
@@ -101,6 +102,31 @@ static uint64_t scripted_run_on(run_kind kind, uint32_t workers, const sc_pool_d
 static uint64_t scripted_run(run_kind kind, uint32_t workers, uint64_t *ranges_run)
 {
     return scripted_run_on(kind, workers, NULL, ranges_run);
+}
+
+/* The mat-vec's software prefetch is a hint (sc_simd.h): forced on, forced off and by the mesh
+ * (on: 40x16x16 is above SC_GRID_PREFETCH_NODES) give the same state hash, serial and on two
+ * workers, for every method, so the platform's measured choice (sc_cpu.h) cannot change a
+ * result. */
+static void matvec_prefetch_on_and_off_give_the_same_state_hash(void **state)
+{
+    (void)state;
+    for (int k = 0; k < (int)RUN_KINDS; k++) {
+        uint64_t ranges = 0u, h[SC_SIMD_PREFETCH_COUNT][2];
+        for (int p = 0; p < (int)SC_SIMD_PREFETCH_COUNT; p++) {
+            assert_int_equal(sc_simd_select_prefetch((sc_simd_prefetch)p), SC_OK);
+            h[p][0] = scripted_run((run_kind)k, 0u, &ranges);
+            h[p][1] = scripted_run((run_kind)k, 2u, &ranges);
+            print_message("kind %d, prefetch %s: %016llx / %016llx\n", k,
+                          sc_simd_prefetch_name((sc_simd_prefetch)p), (unsigned long long)h[p][0],
+                          (unsigned long long)h[p][1]);
+        }
+        assert_true(g_t.fem.grid.prefetch == 1u); /* the mesh's rule would prefetch */
+        for (int p = 1; p < (int)SC_SIMD_PREFETCH_COUNT; p++) {
+            assert_true(h[p][0] == h[0][0] && h[p][1] == h[0][0]);
+        }
+    }
+    assert_int_equal(sc_simd_select_prefetch(SC_SIMD_PREFETCH_MESH), SC_OK);
 }
 
 static void state_hash_is_the_same_for_1_2_3_and_4_workers(void **state)
@@ -465,6 +491,7 @@ int main(void)
         cmocka_unit_test(host_pool_runs_every_range_once),
         cmocka_unit_test(collider_on_the_pool_gives_the_serial_contacts),
         cmocka_unit_test(state_hash_is_the_same_for_1_2_3_and_4_workers),
+        cmocka_unit_test(matvec_prefetch_on_and_off_give_the_same_state_hash),
         cmocka_unit_test(probe_force_is_the_same_for_every_worker_count),
         cmocka_unit_test(three_cell_ranges_give_the_same_hash_for_1_2_and_4_workers),
         cmocka_unit_test(linux_pool_threads_give_the_serial_state_hash),

@@ -409,6 +409,52 @@ static void selection_refuses_what_is_not_there(void **state)
     assert_int_equal(sc_simd_select(SC_SIMD_GENERIC), SC_OK);
 }
 
+/* The mat-vec's prefetch choice: an invalid one is refused and leaves the selection; the host
+ * helper takes SONOCOMP_PREFETCH (an unknown value refused, the mesh rule kept), and measured,
+ * reports both times and picks by its own margin rule (what it picks is this CPU's, not
+ * asserted). */
+static void prefetch_selection_refuses_what_is_not_there(void **state)
+{
+    (void)state;
+    assert_int_equal(sc_simd_selected_prefetch(), SC_SIMD_PREFETCH_MESH);
+    assert_int_equal(sc_simd_select_prefetch(SC_SIMD_PREFETCH_OFF), SC_OK);
+    assert_int_equal(sc_simd_select_prefetch(SC_SIMD_PREFETCH_COUNT), SC_ERR_INVALID_ARG);
+    assert_int_equal(sc_simd_select_prefetch((sc_simd_prefetch)-1), SC_ERR_INVALID_ARG);
+    assert_int_equal(sc_simd_selected_prefetch(), SC_SIMD_PREFETCH_OFF);
+    assert_string_equal(sc_simd_prefetch_name(SC_SIMD_PREFETCH_MESH), "mesh");
+    assert_string_equal(sc_simd_prefetch_name(SC_SIMD_PREFETCH_COUNT), "?");
+    sc_cpu_prefetch pf;
+    char line[160];
+    assert_int_equal(setenv("SONOCOMP_PREFETCH", "sometimes", 1), 0);
+    assert_int_equal(sc_cpu_select_prefetch(1, &pf), SC_ERR_INVALID_ARG);
+    assert_int_equal(sc_simd_selected_prefetch(), SC_SIMD_PREFETCH_MESH);
+    assert_int_equal(pf.measured, 0);
+    assert_int_equal(pf.forced, 0);
+    assert_int_equal(setenv("SONOCOMP_PREFETCH", "on", 1), 0);
+    assert_int_equal(sc_cpu_select_prefetch(1, &pf), SC_OK);
+    assert_int_equal(sc_simd_selected_prefetch(), SC_SIMD_PREFETCH_ON);
+    assert_int_equal(pf.forced, 1);
+    assert_int_equal(pf.measured, 0);
+    sc_cpu_prefetch_describe(&pf, line, sizeof line);
+    assert_non_null(strstr(line, "SONOCOMP_PREFETCH"));
+    assert_int_equal(unsetenv("SONOCOMP_PREFETCH"), 0);
+    assert_int_equal(sc_cpu_select_prefetch(0, &pf), SC_OK);
+    assert_int_equal(sc_simd_selected_prefetch(), SC_SIMD_PREFETCH_MESH);
+    assert_int_equal(sc_cpu_select_prefetch(1, &pf), SC_OK);
+    assert_int_equal(pf.measured, 1);
+    assert_true(pf.on_ms > 0.0 && pf.on_ms < 1e3 && pf.off_ms > 0.0 && pf.off_ms < 1e3);
+    const sc_simd_prefetch want =
+        pf.off_ms < pf.on_ms * (1.0 - SC_CPU_PREFETCH_MARGIN)  ? SC_SIMD_PREFETCH_OFF
+        : pf.on_ms < pf.off_ms * (1.0 - SC_CPU_PREFETCH_MARGIN) ? SC_SIMD_PREFETCH_ON
+                                                                : SC_SIMD_PREFETCH_MESH;
+    assert_int_equal(pf.chosen, want);
+    assert_int_equal(sc_simd_selected_prefetch(), want);
+    sc_cpu_prefetch_describe(&pf, line, sizeof line);
+    print_message("%s\n", line);
+    assert_non_null(strstr(line, "measured"));
+    assert_int_equal(sc_simd_select_prefetch(SC_SIMD_PREFETCH_MESH), SC_OK);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -418,6 +464,7 @@ int main(void)
         cmocka_unit_test(springs_one_pass_gives_the_two_pass_bits),
         cmocka_unit_test(face_sums_by_pair_give_the_whole_vector_bits),
         cmocka_unit_test(selection_refuses_what_is_not_there),
+        cmocka_unit_test(prefetch_selection_refuses_what_is_not_there),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
