@@ -151,7 +151,10 @@ _Static_assert(SC_GRID_POOL_RANGE % SC_GRID_CHUNK == 0u && SC_GRID_SUM_BLOCK % 1
  * (512 KiB L2) of the 25 Nov sessions they cost the L3-resident meshes issue slots: a 32x16x16
  * mat-vec took 0.112 ms with them and 0.098 ms without, and the stable MSDS frame 2.62-2.67 ms
  * against 2.45-2.48 ms (`bench-physics 100 stages`, alternated). 48x24x24 there: 0.42 against
- * 0.38 ms. 64x32x32 still needs them: 1.17-1.23 ms against 1.55-2.12 ms. */
+ * 0.38 ms. 64x32x32 still needs them: 1.17-1.23 ms against 1.55-2.12 ms. The mat-vec's are the
+ * CPU's choice above this rule (sc_simd.h, sc_simd_select_prefetch: on an Intel Xeon with 2 MiB
+ * of L2 the 64x32x32 product took 0.85 ms with them and 0.66 ms without); the assembly's follow
+ * this rule alone. */
 #ifndef SC_GRID_PREFETCH_NODES
 #define SC_GRID_PREFETCH_NODES 8192u
 #endif
