@@ -19,7 +19,7 @@ typedef struct sc_grid_cg_out {
 } sc_grid_cg_out;
 
 typedef struct sc_grid_kern {
-    /* z, p from r; cg_iterations PCG iterations on v, r (A = cm M + ck K). */
+    /* p from r; cg_iterations PCG iterations on v, r (A = cm M + ck K); z is not stored. */
     void (*cg)(sc_grid *g, float cm, float ck, uint32_t iterations, sc_grid_cg_out *out);
     /* q = (cm M + ck K) p (the CG's mat-vec, exposed for tests and benchmarks). */
     void (*matvec)(sc_grid *g, float cm, float ck);
