@@ -203,6 +203,23 @@ uint32_t sc_grid_asm_span(uint32_t nx, uint32_t ny, uint32_t nz)
 
 /* Everything of sc_grid_init but the rest positions and the cells' nodes: sizes, ranges,
  * templates, zeroed rows and masks (cell_ok, used and the rest positions are the caller's). */
+/* The node loops' ranges and the dot products' blocks (sc_grid.h): split, a multiple of four
+ * ranges of about SC_GRID_POOL_RANGE nodes (whole chunks) and a block per range; else ranges of
+ * SC_GRID_POOL_RANGE and one block of SC_GRID_SUM_BLOCK (the serial loop's sums). */
+static void set_ranges(sc_grid *g, int split)
+{
+    g->range = SC_GRID_POOL_RANGE;
+    g->sum_block = SC_GRID_SUM_BLOCK;
+    if (split) {
+        uint32_t count = (g->node_end + SC_GRID_POOL_RANGE - 1u) / SC_GRID_POOL_RANGE;
+        count = (count + 3u) / 4u * 4u;
+        const uint32_t size = (g->node_end + count - 1u) / count;
+        g->range = (size + SC_GRID_CHUNK - 1u) / SC_GRID_CHUNK * SC_GRID_CHUNK;
+        g->sum_block = g->range;
+    }
+    SC_ASSERT((g->node_end + g->range - 1u) / g->range <= SC_GRID_RANGES_MAX);
+}
+
 static void init_layout(sc_grid *g, uint32_t nx, uint32_t ny, uint32_t nz, const float cell_mm[3])
 {
     const uint32_t nxy = nx * ny, nn = nx * ny * nz;
@@ -222,16 +239,7 @@ static void init_layout(sc_grid *g, uint32_t nx, uint32_t ny, uint32_t nz, const
     SC_ASSERT(g->asm_span % SC_GRID_CELL_BLOCK == 0u &&
               g->asm_span > nxy + nx + SC_GRID_CELL_BLOCK &&
               (g->cell_end + g->asm_span - 1u) / g->asm_span <= SC_GRID_ASM_RANGES);
-    g->range = SC_GRID_POOL_RANGE;
-    if (g->node_end > SC_GRID_SUM_BLOCK) {
-        /* a multiple of four ranges (sc_grid.h), whole chunks */
-        uint32_t count = (g->node_end + SC_GRID_POOL_RANGE - 1u) / SC_GRID_POOL_RANGE;
-        count = (count + 3u) / 4u * 4u;
-        const uint32_t size = (g->node_end + count - 1u) / count;
-        g->range = (size + SC_GRID_CHUNK - 1u) / SC_GRID_CHUNK * SC_GRID_CHUNK;
-    }
-    SC_ASSERT((g->node_end + g->range - 1u) / g->range <= SC_GRID_RANGES_MAX);
-    g->sum_block = g->node_end > SC_GRID_SUM_BLOCK ? g->range : SC_GRID_SUM_BLOCK;
+    set_ranges(g, g->node_end > SC_GRID_SUM_BLOCK);
     g->rest_saved = 0u;
     g->rest_patched = 0u;
     g->prefetch = (uint8_t)(nn > SC_GRID_PREFETCH_NODES);
@@ -925,6 +933,11 @@ int sc_grid_coarse_init(sc_grid_coarse *c, const sc_grid *g, const float cell_mm
     if (rc != SC_OK) {
         return rc;
     }
+    /* the coarse grid's loops split as a large mesh's, whatever its size (32x16x16 under
+     * 64x32x32: 8 ranges of 1,024 nodes, 24x12x12 under 48x24x24: 4 of 864): with one block of
+     * 8,192 its CG's p.Ap and update jobs ran on the caller alone, 20 times a step, while the
+     * workers waited (sc_pool_run runs one range inline) */
+    set_ranges(gc, 1);
     c->iterations = SC_GRID_COARSE_ITERATIONS;
     c->alpha = 0.0f;
     for (uint32_t t = 0; t < gc->node_count; t += gc->nx) { /* P^T M P, lumped */
