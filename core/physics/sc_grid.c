@@ -201,8 +201,6 @@ uint32_t sc_grid_asm_span(uint32_t nx, uint32_t ny, uint32_t nz)
     return asm_span;
 }
 
-/* Everything of sc_grid_init but the rest positions and the cells' nodes: sizes, ranges,
- * templates, zeroed rows and masks (cell_ok, used and the rest positions are the caller's). */
 /* The node loops' ranges and the dot products' blocks (sc_grid.h): split, a multiple of four
  * ranges of about SC_GRID_POOL_RANGE nodes (whole chunks) and a block per range; else ranges of
  * SC_GRID_POOL_RANGE and one block of SC_GRID_SUM_BLOCK (the serial loop's sums). */
@@ -220,6 +218,8 @@ static void set_ranges(sc_grid *g, int split)
     SC_ASSERT((g->node_end + g->range - 1u) / g->range <= SC_GRID_RANGES_MAX);
 }
 
+/* Everything of sc_grid_init but the rest positions and the cells' nodes: sizes, ranges,
+ * templates, zeroed rows and masks (cell_ok, used and the rest positions are the caller's). */
 static void init_layout(sc_grid *g, uint32_t nx, uint32_t ny, uint32_t nz, const float cell_mm[3])
 {
     const uint32_t nxy = nx * ny, nn = nx * ny * nz;
@@ -936,7 +936,7 @@ int sc_grid_coarse_init(sc_grid_coarse *c, const sc_grid *g, const float cell_mm
     /* the coarse grid's loops split as a large mesh's, whatever its size (32x16x16 under
      * 64x32x32: 8 ranges of 1,024 nodes, 24x12x12 under 48x24x24: 4 of 864): with one block of
      * 8,192 its CG's p.Ap and update jobs ran on the caller alone, 20 times a step, while the
-     * workers waited (sc_pool_run runs one range inline) */
+     * workers waited (sc_pool_run runs a job of one range on the caller) */
     set_ranges(gc, 1);
     c->iterations = SC_GRID_COARSE_ITERATIONS;
     c->alpha = 0.0f;

@@ -334,8 +334,10 @@ _Static_assert(offsetof(sc_grid, e) == offsetof(sc_grid, d) + 6u * SC_GRID_ROW *
  * A_c = cm M_c + ck K_c with the step's cm and ck; the coarse DOFs held are those of their fine
  * nodes. The fine CG then starts from the corrected v: a warm start whose smooth error the
  * coarse grid has removed (a fine residual of zero gives a correction of zero: the fine step's
- * answer is still its own). Every loop is node-wise or the coarse grid's own CG: the same bits
- * for every worker count. */
+ * answer is still its own). Every loop is node-wise or the coarse grid's own CG, whose ranges
+ * and sum blocks are split as a large mesh's whatever its size (sc_grid_coarse_init: so that
+ * its dot products and updates run on the pool, not on the caller): the same bits for every
+ * worker count. */
 typedef struct sc_grid_coarse {
     uint32_t iterations; /* coarse CG iterations per step */
     float alpha;         /* the last step's scale of the correction (1: the coarse K's own) */
