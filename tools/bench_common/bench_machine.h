@@ -12,6 +12,9 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "sc_cpu.h"
+#include "sc_err.h"
+
 /* the value of the first "key\t: value" line of /proc/cpuinfo whose key is `key`, into out */
 static inline int bench_cpuinfo(const char *key, char *out, size_t size)
 {
@@ -88,6 +91,20 @@ static inline void bench_print_machine(void)
     bench_cache_size(3, l3, sizeof l3);
     printf("machine: %s (family %s model %s), %ld CPUs online, L2 %s, L3 %s per cpu0\n", name,
            fam, model, sysconf(_SC_NPROCESSORS_ONLN), l2, l3);
+}
+
+/* The mat-vec's prefetch as sonocomp chooses it (sc_cpu.h: measured, or SONOCOMP_PREFETCH),
+ * and its line: "mat-vec prefetch off (measured on 64x32x32: ...)" */
+static inline void bench_select_prefetch(const char *prog)
+{
+    sc_cpu_prefetch pf;
+    if (sc_cpu_select_prefetch(1, &pf) != SC_OK) {
+        fprintf(stderr, "%s: SONOCOMP_PREFETCH not mesh, on or off (or no memory to measure)\n",
+                prog);
+    }
+    char line[160];
+    sc_cpu_prefetch_describe(&pf, line, sizeof line);
+    printf("%s\n", line);
 }
 
 #endif /* BENCH_MACHINE_H */

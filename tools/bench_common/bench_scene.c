@@ -27,14 +27,7 @@ void bench_select_kernels(const char *prog)
     }
     printf("kernels: %s\n", sc_simd_name(sc_simd_selected()));
     bench_print_machine();
-    sc_cpu_prefetch pf;
-    if (sc_cpu_select_prefetch(1, &pf) != SC_OK) {
-        fprintf(stderr, "%s: SONOCOMP_PREFETCH not mesh, on or off (or no memory to measure)\n",
-                prog);
-    }
-    char line[160];
-    sc_cpu_prefetch_describe(&pf, line, sizeof line);
-    printf("%s\n", line);
+    bench_select_prefetch(prog);
 }
 
 static uint64_t clock_ns(clockid_t id)

@@ -338,13 +338,7 @@ int main(int argc, char **argv)
     }
     printf("kernels: %s\n", sc_simd_name(sc_simd_selected()));
     bench_print_machine();
-    sc_cpu_prefetch pf;
-    if (sc_cpu_select_prefetch(1, &pf) != SC_OK) {
-        fprintf(stderr, "bench-physics: SONOCOMP_PREFETCH not mesh, on or off\n");
-    }
-    char pf_line[160];
-    sc_cpu_prefetch_describe(&pf, pf_line, sizeof pf_line);
-    printf("%s\n", pf_line);
+    bench_select_prefetch("bench-physics");
     printf("pages: %s\n", pages);
     if (argc > 2 && strcmp(argv[2], "stable") == 0) {
         /* the stable MSDS and the FEMs at 32x16x16 only (the targets' measure) */
