@@ -11,8 +11,10 @@
  * The grid mat-vec's software prefetch (sc_simd.h) is chosen the same way, once at start, by
  * measuring it: sc_cpu_select_prefetch times the selected variant's mat-vec on a box grid of
  * the largest mesh the build takes (at most 64x32x32, its matrix rows filled with a stiffness
- * pattern) with and without the prefetch, alternated, and keeps the faster when it is faster
- * by more than SC_CPU_PREFETCH_MARGIN; else the mesh decides, as before. A hint changes no
+ * pattern) with and without the prefetch, alternated, and turns it off when that is faster
+ * by more than SC_CPU_PREFETCH_MARGIN; else the mesh decides, as before (a measured gain is
+ * not taken as "on" for every mesh: the box is the largest mesh, and the L2-resident ones lost
+ * by the prefetch on the EPYC hosts, sc_grid.h). A hint changes no
  * result, so a wrong pick costs time only. It allocates the grid (sizeof(sc_grid), about 47 MB
  * of address space, the rows of the box touched: about 20 MB) and frees it; about 30 ms.
  * SONOCOMP_PREFETCH=mesh|on|off forces the choice without measuring.
