@@ -647,6 +647,23 @@ static int derive_springs(sc_msds *s, const sc_mesh *m, const sc_material_table 
     return SC_OK;
 }
 
+/* 1 if no face-diagonal family has a spring at a node of even i + j + k (sc_msds.faces_odd) */
+static uint8_t faces_on_odd_nodes(const sc_msds *s)
+{
+    const uint32_t nx = s->nx, ny = s->nxy / s->nx;
+    for (uint32_t i = 0; i < s->node_count; i++) {
+        if (((i % nx + (i / nx) % ny + i / s->nxy) & 1u) != 0u) {
+            continue;
+        }
+        for (uint32_t d = 3u; d < SC_MSDS_FAMILIES; d++) {
+            if (s->k_n_per_mm[d][i] > 0.0f || s->k_n_per_mm[d][i] < 0.0f) {
+                return 0u;
+            }
+        }
+    }
+    return 1u;
+}
+
 int sc_msds_init_begin(sc_msds *s, const sc_mesh *m, const sc_springs *sp,
                        const sc_material_table *mat, const sc_msds_def *def)
 {
@@ -774,6 +791,7 @@ int sc_msds_init_begin(sc_msds *s, const sc_mesh *m, const sc_springs *sp,
     if (rc != SC_OK) {
         return rc;
     }
+    s->faces_odd = faces_on_odd_nodes(s);
     /* free-node flags first (inv_mass > 0), then sigma (sc_msds_init_step), then the masses */
     s->mass_scale = 1.0f;
     compute_masses(s);

@@ -189,6 +189,10 @@ typedef struct sc_msds {
     double scale_mu;   /* their Rayleigh quotient so far */
     uint32_t nx, nxy; /* grid shape and cell (rest geometry for the spectral estimate) */
     float cell_mm[3];
+    uint8_t faces_odd; /* 1: every face-diagonal spring (families 3-8) has its origin at a node of
+                          odd i + j + k (sc_mesh.c: a face diagonal joins the face's odd corners),
+                          k = 0 at every even one; the stable MSDS's springs may then skip the
+                          even nodes' face lanes (sc_grid_kern.inc, springs_pair) */
 } sc_msds;
 
 /* dt 0.01 s, 20 iterations (paper), mass scaling 1.2e-3 s^2, drag 2.5 / s, contact ratio

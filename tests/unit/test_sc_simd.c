@@ -253,15 +253,18 @@ static void face_sums_by_pair_give_the_whole_vector_bits(void **state)
 /* The stable MSDS's springs in one pass over the nodes (sc_grid.springs_fused, the meshes above
  * SC_GRID_SPRINGS_FUSED_NODES), run range by range with the cells (msds_assemble), give the bits
  * of the per-family passes followed by the cells' own pass, in every variant; on an odd grid too,
- * whose anti-diagonal blocks and first nodes take the masked lanes, and on 40 x 16 x 28, whose 16
- * cell ranges each start with nodes whose springs the range before runs. */
+ * whose anti-diagonal blocks and first nodes take the masked lanes, on 40 x 16 x 28, whose 16
+ * cell ranges each start with nodes whose springs the range before runs, and on rows of 64 and
+ * 32 nodes, where the x86-64-v4 and -v3 variants take the face springs on the odd nodes alone
+ * (springs_pair: rows of whole vectors of pairs; the generic one's 4 lanes on 40 x 16 x 28 too). */
 static void springs_one_pass_gives_the_two_pass_bits(void **state)
 {
     (void)state;
     const sc_simd best = sc_cpu_best_simd();
-    static const uint32_t shapes[3][3] = {{12u, 8u, 8u}, {11u, 7u, 6u}, {40u, 16u, 28u}};
+    static const uint32_t shapes[5][3] = {
+        {12u, 8u, 8u}, {11u, 7u, 6u}, {40u, 16u, 28u}, {64u, 5u, 6u}, {32u, 7u, 9u}};
     int compared = 0;
-    for (uint32_t sh = 0; sh < 3u; sh++) {
+    for (uint32_t sh = 0; sh < 5u; sh++) {
         assert_int_equal(sc_simd_select(SC_SIMD_GENERIC), SC_OK);
         const uint64_t ref = run_implicit_springs(shapes[sh][0], shapes[sh][1], shapes[sh][2], 2, 0);
         for (int v = 0; v < (int)SC_SIMD_COUNT; v++) {
