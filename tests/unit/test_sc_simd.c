@@ -129,6 +129,8 @@ static void variants_give_identical_bits(void **state)
 /* The implicit solvers (sc_grid_kern.inc: FEM linear and corotated, the stable MSDS) on the
  * mixed block: a press by kinematic nodes deep enough that tets meet the volume floor, with a
  * sideways force, then the release (the unloaded warm start). Returns the state hash. */
+static int g_no_face_pairs; /* 1: run_implicit_cfg's MSDS without springs_pair */
+
 static uint64_t run_implicit_cfg(uint32_t nx, uint32_t ny, uint32_t nz, int method,
                                  int springs_fused, int face_pairs)
 {
@@ -149,6 +151,11 @@ static uint64_t run_implicit_cfg(uint32_t nx, uint32_t ny, uint32_t nz, int meth
                      SC_OK);
     sc_msds_def md = sc_msds_default_def();
     assert_int_equal(sc_msds_init(&g_msds, &g_mesh, &g_sp, &g_mat, &md), SC_OK);
+    /* the grid's face diagonals join odd nodes only (springs_pair's premise, sc_msds.faces_odd) */
+    assert_int_equal(g_msds.faces_odd, 1);
+    if (g_no_face_pairs) {
+        g_msds.faces_odd = 0u; /* the whole-vector face springs (springs_pair refused) */
+    }
     sc_fem_def fd = sc_fem_default_def();
     fd.corotated = method == 1 ? 1u : 0u;
     assert_int_equal(sc_fem_init(&g_fem, &g_mesh, &g_mat, &fd), SC_OK);
@@ -279,6 +286,14 @@ static void springs_one_pass_gives_the_two_pass_bits(void **state)
                    sc_simd_name((sc_simd)v), (unsigned long long)h);
             assert_true(h == ref);
             compared++;
+            if (shapes[sh][0] % 32u == 0u) {
+                /* the same with the face springs over whole vectors (sc_msds.faces_odd 0) */
+                g_no_face_pairs = 1;
+                const uint64_t hw =
+                    run_implicit_springs(shapes[sh][0], shapes[sh][1], shapes[sh][2], 2, 1);
+                g_no_face_pairs = 0;
+                assert_true(hw == ref);
+            }
         }
     }
     assert_int_equal(sc_simd_select(SC_SIMD_GENERIC), SC_OK);
