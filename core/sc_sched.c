@@ -83,6 +83,9 @@ void sc_sched_begin_frame(sc_sched *s)
     (void)sc_clock_sleep_until_ns(s->clock, s->release_ns);
     s->start_ns = sc_clock_now_ns(s->clock);
     s->mark_ns = s->start_ns;
+    for (uint32_t i = 0; i < s->stage_count; i++) {
+        s->stages[i].last_ns = 0u; /* a stage this frame does not mark reads 0 */
+    }
     s->in_frame = 1;
 }
 
@@ -91,6 +94,7 @@ void sc_sched_stage_done(sc_sched *s, uint32_t stage)
     SC_ASSERT(s && s->in_frame && stage < s->stage_count);
     const uint64_t t = sc_clock_now_ns(s->clock);
     sc_stats_add(&s->stages[stage].stats, t - s->mark_ns);
+    s->stages[stage].last_ns = t - s->mark_ns;
     s->mark_ns = t;
 }
 

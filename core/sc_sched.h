@@ -28,6 +28,7 @@ typedef struct sc_sched_def {
 typedef struct sc_sched_stage {
     const char *name; /* static string */
     sc_stats stats;   /* execution time of this stage */
+    uint64_t last_ns; /* its time in the running (or last) frame; 0 until it is marked */
 } sc_sched_stage;
 
 typedef struct sc_frame_result {
@@ -72,7 +73,7 @@ int sc_sched_add_stage(sc_sched *s, const char *name);
 int sc_sched_set_rate(sc_sched *s, uint32_t rate_hz);
 
 /* Wait for the frame's release (the first frame releases immediately) and start timing it.
- * O(1) plus the sleep. */
+ * O(stages) plus the sleep. */
 void sc_sched_begin_frame(sc_sched *s);
 
 /* The stage `stage` (an index of sc_sched_add_stage) ended now: its time is the time since the

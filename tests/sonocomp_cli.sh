@@ -88,5 +88,20 @@ printf '(1700000000.000000) vcan0 123#0102\nnot a line\n' > "$WORK/short.log"
 contains "replay reported" "$WORK/replay.out" "1 frames over 0.000 s, 1 delivered (end of log reached), 1 malformed lines refused"
 contains "replay rejects logged" "$WORK/replay2.err" "event=can_replay_rejected"
 
+# --trace: every frame's times as CSV (a header, a row per frame, the stages named); a path
+# that cannot be written is refused before the run, named
+# shellcheck disable=SC2086
+"$BIN" $NODEV --frames 7 --trace "$WORK/trace.csv" > "$WORK/trace.out" 2>&1; check "--trace run" 0 $?
+contains "trace reported" "$WORK/trace.out" "7 frames written to $WORK/trace.csv, 0 past its capacity not kept"
+contains "trace header" "$WORK/trace.csv" "frame,wakeup_late_us,frame_us,missed,rx_us,physics_us,imaging_us"
+rows=$(tail -n +2 "$WORK/trace.csv" | grep -c '^[0-9][0-9]*,[0-9]')
+check "trace rows (one per frame)" 7 "$rows"
+last=$(tail -n 1 "$WORK/trace.csv" | cut -d, -f1)
+check "trace frames numbered from 0" 6 "$last"
+# shellcheck disable=SC2086
+"$BIN" $NODEV --frames 1 --trace "$WORK/no-such-dir/trace.csv" > /dev/null 2> "$WORK/trace.err"
+check "--trace to an unwritable path" 1 $?
+contains "unwritable trace named" "$WORK/trace.err" "sonocomp: --trace $WORK/no-such-dir/trace.csv: No such file or directory"
+
 [ "$fails" = 0 ] && echo "PASS" && exit 0
 echo "$fails checks failed"; exit 1

@@ -29,6 +29,7 @@
 #include "sc_cpu.h"
 #include "sc_kms_display.h"
 #include "sc_log_linux.h"
+#include "sc_frame_trace.h"
 #include "sc_png_sink.h"
 #include "sc_rt.h"
 #include "sc_pool_linux.h"
@@ -112,6 +113,7 @@ typedef struct cli {
     uint16_t can_udp_port;         /* --can-udp: CAN over UDP instead of SocketCAN */
     uint32_t workers;              /* --workers: solver workers, 0: one per CPU (default 1) */
     const char *hist_path;         /* --hist: frame and wake-up histograms as CSV at the end */
+    const char *trace_path;        /* --trace: every frame's times as CSV at the end */
 } cli;
 
 static void usage(FILE *f)
@@ -138,6 +140,10 @@ static void usage(FILE *f)
            "                        (sc-gateway --state-port P)\n"
            "      --hist FILE       at the end, write the frame-time and wake-up lateness\n"
            "                        histograms (CSV: bin upper bound us, counts)\n"
+           "      --trace FILE      at the end, write every frame's times (CSV: frame,\n"
+           "                        wake-up lateness, frame, missed, each stage, in us;\n"
+           "                        kept in memory during the run, up to an hour at 60 Hz\n"
+           "                        or the run's --frames / --seconds)\n"
            "      --workers N       solver worker threads, one per core from rt.cpu\n"
            "                        (0: one per online CPU; default 1: no thread);\n"
            "                        results are bit-identical for every N\n"
@@ -554,7 +560,7 @@ static int parse_cli(int argc, char **argv, cli *a)
     a->workers = 1u;
     optind = 0; /* glibc: a full re-initialisation, so that it can be called again */
     enum { OPT_CHECK = 1000, OPT_HELP_CONFIG, OPT_CASE_DIR, OPT_INJECT, OPT_CAN_REPLAY,
-           OPT_STATE_UDP, OPT_CAN_UDP, OPT_WORKERS, OPT_HIST };
+           OPT_STATE_UDP, OPT_CAN_UDP, OPT_WORKERS, OPT_HIST, OPT_TRACE };
     static const struct option lo[] = {{"config", required_argument, NULL, 'c'},
                                        {"set", required_argument, NULL, 's'},
                                        {"check-config", no_argument, NULL, OPT_CHECK},
@@ -566,6 +572,7 @@ static int parse_cli(int argc, char **argv, cli *a)
                                        {"can-udp", required_argument, NULL, OPT_CAN_UDP},
                                        {"workers", required_argument, NULL, OPT_WORKERS},
                                        {"hist", required_argument, NULL, OPT_HIST},
+                                       {"trace", required_argument, NULL, OPT_TRACE},
                                        {"frames", required_argument, NULL, 'n'},
                                        {"seconds", required_argument, NULL, 't'},
                                        {"help", no_argument, NULL, 'h'},
@@ -629,6 +636,9 @@ static int parse_cli(int argc, char **argv, cli *a)
         }
         case OPT_HIST:
             a->hist_path = optarg;
+            break;
+        case OPT_TRACE:
+            a->trace_path = optarg;
             break;
         case OPT_WORKERS: {
             errno = 0;
@@ -980,6 +990,24 @@ int main(int argc, char **argv)
         }
     }
 
+    static sc_frame_trace trace;
+    int trace_open = 0;
+    if (engine_ok && a.trace_path) {
+        /* room for the run's frames when its length is given (5 % over for a slow start) */
+        const uint64_t want =
+            a.frames
+                ? a.frames
+                : (a.seconds > 0.0 ? (uint64_t)(a.seconds * (double)cfg.frame_rate_hz * 1.05) + 64u
+                                   : 0u);
+        if (sc_frame_trace_open(&trace, a.trace_path, want, sc_engine_get_sched(e)) != 0) {
+            fprintf(stderr, "sonocomp: --trace %s: %s\n", a.trace_path, strerror(errno));
+            exit_code = EXIT_RUNTIME;
+            engine_ok = 0;
+        } else {
+            trace_open = 1;
+        }
+    }
+
     const char *stop_reason = "error";
     double wall_s = 0.0;
     if (engine_ok) {
@@ -1003,6 +1031,9 @@ int main(int argc, char **argv)
             const uint64_t misses0 = sc_engine_get_sched(e)->misses;
             sc_engine_step(e, &fr);
             const uint64_t now = sc_rt_now_ns();
+            if (trace_open) {
+                sc_frame_trace_add(&trace, &fr, sc_engine_get_sched(e));
+            }
             if (pool_started && fr.end_ns > fr.start_ns) {
                 const uint64_t busy = fr.end_ns - fr.start_ns, in_jobs = pool.job_ns - in_jobs0;
                 sc_stats_add(&g_alone, busy > in_jobs ? busy - in_jobs : 0u);
@@ -1077,6 +1108,17 @@ int main(int argc, char **argv)
         }
         if (a.hist_path && write_hist(a.hist_path, e) != 0) {
             fprintf(stderr, "sonocomp: --hist %s: %s\n", a.hist_path, strerror(errno));
+        }
+    }
+    if (trace_open) {
+        const uint32_t kept = trace.n;
+        const uint64_t dropped = trace.dropped;
+        if (sc_frame_trace_close(&trace) != 0) {
+            fprintf(stderr, "sonocomp: --trace %s: %s\n", a.trace_path, strerror(errno));
+            exit_code = exit_code == EXIT_OK ? EXIT_RUNTIME : exit_code;
+        } else {
+            printf("  frame trace     %u frames written to %s, %llu past its capacity not kept\n",
+                   (unsigned)kept, a.trace_path, (unsigned long long)dropped);
         }
     }
 

@@ -153,6 +153,27 @@ static void recent_misses_window_forgets_old_frames(void **state)
     assert_int_equal(f->sched.misses, 1);
 }
 
+/* Each stage's time in the last frame (sc_sched_stage.last_ns, the frame trace's columns):
+ * the time since the previous mark; a stage the frame does not mark reads 0. */
+static void stage_last_times_are_the_frame_s_own(void **state)
+{
+    fixture *f = *state;
+    sc_frame_result r;
+    f->cost_a_ns = 3000u;
+    f->cost_b_ns = 5000u;
+    run_frame(f, &r);
+    assert_int_equal(f->sched.stages[0].last_ns, 3000u);
+    assert_int_equal(f->sched.stages[1].last_ns, 5000u);
+    assert_int_equal(r.end_ns - r.start_ns, 8000u);
+    /* a frame that marks only stage 0 */
+    sc_sched_begin_frame(&f->sched);
+    sc_hs_clock_advance_ns(&f->clock, 700u);
+    sc_sched_stage_done(&f->sched, 0);
+    sc_sched_end_frame(&f->sched, &r);
+    assert_int_equal(f->sched.stages[0].last_ns, 700u);
+    assert_int_equal(f->sched.stages[1].last_ns, 0u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -163,6 +184,7 @@ int main(void)
         cmocka_unit_test_setup(frame_ending_exactly_on_deadline_is_not_a_miss, setup),
         cmocka_unit_test_setup(stage_limit_and_rate_range_are_enforced, setup),
         cmocka_unit_test_setup(recent_misses_window_forgets_old_frames, setup),
+        cmocka_unit_test_setup(stage_last_times_are_the_frame_s_own, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -5,7 +5,9 @@
 # SECONDS at 60 Hz and at 120 Hz, SCHED_FIFO, memory locked, the loop on CPU 0, while
 # stress-ng (or a busy loop when stress-ng is missing) loads CPU 1. Per run: sonocomp's final
 # table (frame time and wake-up lateness: mean, p50, p99, p99.9, worst; deadline misses) and
-# the two histograms (OUT/hist-METHOD-RATEhz.csv, bins of 1/16 octave of microseconds).
+# the two histograms (OUT/hist-METHOD-RATEhz.csv, bins of 1/16 octave of microseconds), and
+# every frame's times (OUT/trace-METHOD-RATEhz.csv: lateness, frame, missed, each stage, us),
+# which tell slow frames at the script's press or folds from a host's spread over the run.
 # Without SocketCAN the log is replayed in real time through --can-replay (tools/demo-live.sh).
 # It takes 4 x (SECONDS + ~5) s plus the case build (about 4.5 min at the default 60 s).
 #
@@ -61,7 +63,8 @@ for method in fem msds; do
             -s display.target=none -s rt.cpu=0 -s rt.sched_fifo=true -s rt.mlock=true \
             -s watchdog.device=soft -s status.line=off -s log.level=error \
             --workers "$WORKERS" --can-replay "$LOG" --seconds "$SECS" \
-            --hist "$OUT/hist-$method-${rate}hz.csv" 2> "$OUT/sonocomp-$method-${rate}hz.err" |
+            --hist "$OUT/hist-$method-${rate}hz.csv" --trace "$OUT/trace-$method-${rate}hz.csv" \
+            2> "$OUT/sonocomp-$method-${rate}hz.err" |
             sed -n '/final statistics/,$p'
     done
 done
