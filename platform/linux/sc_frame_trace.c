@@ -25,10 +25,17 @@ int sc_frame_trace_open(sc_frame_trace *t, const char *path, uint64_t frames, co
     for (uint32_t i = 0; i < t->stages; i++) {
         t->names[i] = s->stages[i].name;
     }
-    t->rec = calloc((size_t)t->cap * t->cols, sizeof(uint32_t));
+    const size_t bytes = (size_t)t->cap * t->cols * sizeof(uint32_t);
+    t->rec = malloc(bytes);
     if (t->rec == NULL) {
         errno = ENOMEM;
         return -1;
+    }
+    /* every page touched now, not on the frame loop's first write to it (locked memory is
+     * faulted in at the allocation; this covers a run without rt.mlock) */
+    volatile uint8_t *pg = (volatile uint8_t *)t->rec;
+    for (size_t o = 0; o < bytes; o += 4096u) {
+        pg[o] = 0u;
     }
     t->f = fopen(path, "w");
     if (t->f == NULL) {
