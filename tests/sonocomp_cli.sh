@@ -98,6 +98,18 @@ rows=$(tail -n +2 "$WORK/trace.csv" | grep -c '^[0-9][0-9]*,[0-9]')
 check "trace rows (one per frame)" 7 "$rows"
 last=$(tail -n 1 "$WORK/trace.csv" | cut -d, -f1)
 check "trace frames numbered from 0" 6 "$last"
+# the trace's summary (tools/rt_bench/trace_summary.sh, which rt_press prints after each run)
+"$SRC/tools/rt_bench/trace_summary.sh" "$WORK/trace.csv" 3 60 > "$WORK/tsum.out" 2>&1
+check "trace summary" 0 $?
+contains "trace summary counts the frames" "$WORK/tsum.out" "trace 7 frames: frame mean"
+contains "trace summary's windows" "$WORK/tsum.out" "windows of 3 frames: mean"
+contains "trace summary's slowest frames" "$WORK/tsum.out" "slowest 1 % (1 frames,"
+printf 'a,b\n1,2\n' > "$WORK/notrace.csv"
+"$SRC/tools/rt_bench/trace_summary.sh" "$WORK/notrace.csv" > /dev/null 2> "$WORK/tsum.err"
+check "trace summary of a file with no frame column" 1 $?
+contains "no frame column named" "$WORK/tsum.err" "trace_summary: no frame / frame_us column"
+"$SRC/tools/rt_bench/trace_summary.sh" "$WORK/trace.csv" -3 > /dev/null 2>&1
+check "trace summary with a bad window" 2 $?
 # shellcheck disable=SC2086
 "$BIN" $NODEV --frames 1 --trace "$WORK/no-such-dir/trace.csv" > /dev/null 2> "$WORK/trace.err"
 check "--trace to an unwritable path" 1 $?

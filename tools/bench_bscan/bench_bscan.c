@@ -331,8 +331,27 @@ static void print_needle_row(const sc_xform *probe, int frames)
            mn[0], mn[1], mn[1] - mn[0], drawn);
 }
 
+static void usage(FILE *f)
+{
+    fprintf(f, "usage: bench_bscan [png_dir] [frames]\n"
+               "       bench_bscan contact [cases_dir] [case] [frames] [msds|fem] [workers]\n"
+               "       bench_bscan contact-walker [cases_dir] [case] [frames] "
+               "[acoustics|no-acoustics]\n"
+               "       bench_bscan contact-hold [cases_dir] [case] [frames]\n");
+}
+
 int main(int argc, char **argv)
 {
+    if (argc > 1 && (strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "--help") == 0)) {
+        usage(stdout);
+        return 0;
+    }
+    if (argc > 1 && argv[1][0] == '-') {
+        /* an option it does not have, not a folder for the PNGs */
+        fprintf(stderr, "bench_bscan: unknown option %s\n", argv[1]);
+        usage(stderr);
+        return 2;
+    }
     /* the engine programs' kernel variant (sonocomp, sc-hostsim select it at start) */
     if (sc_cpu_select_simd() != SC_OK) {
         fprintf(stderr, "bench_bscan: SONOCOMP_SIMD names no variant of this CPU\n");

@@ -7,7 +7,8 @@
 # table (frame time and wake-up lateness: mean, p50, p99, p99.9, worst; deadline misses) and
 # the two histograms (OUT/hist-METHOD-RATEhz.csv, bins of 1/16 octave of microseconds), and
 # every frame's times (OUT/trace-METHOD-RATEhz.csv: lateness, frame, missed, each stage, us),
-# which tell slow frames at the script's press or folds from a host's spread over the run.
+# which tell slow frames at the script's press or folds from a host's spread over the run
+# (tools/rt_bench/trace_summary.sh, printed after each run).
 # Without SocketCAN the log is replayed in real time through --can-replay (tools/demo-live.sh).
 # It takes 4 x (SECONDS + ~5) s plus the case build (about 4.5 min at the default 60 s).
 #
@@ -66,5 +67,7 @@ for method in fem msds; do
             --hist "$OUT/hist-$method-${rate}hz.csv" --trace "$OUT/trace-$method-${rate}hz.csv" \
             2> "$OUT/sonocomp-$method-${rate}hz.err" |
             sed -n '/final statistics/,$p'
+        "$(dirname "$0")/trace_summary.sh" "$OUT/trace-$method-${rate}hz.csv" 30 "$rate" ||
+            echo "rt_press: no trace summary for $method at $rate Hz"
     done
 done
