@@ -114,6 +114,11 @@ check "trace summary with a bad window" 2 $?
 "$BIN" $NODEV --frames 1 --trace "$WORK/no-such-dir/trace.csv" > /dev/null 2> "$WORK/trace.err"
 check "--trace to an unwritable path" 1 $?
 contains "unwritable trace named" "$WORK/trace.err" "sonocomp: --trace $WORK/no-such-dir/trace.csv: No such file or directory"
+# a trace whose rows do not reach the file (a full device) is a runtime error, named
+# shellcheck disable=SC2086
+"$BIN" $NODEV --frames 3 --trace /dev/full > /dev/null 2> "$WORK/tracefull.err"
+check "--trace to a full device" 1 $?
+contains "full device named" "$WORK/tracefull.err" "sonocomp: --trace /dev/full: No space left on device"
 
 [ "$fails" = 0 ] && echo "PASS" && exit 0
 echo "$fails checks failed"; exit 1

@@ -87,9 +87,13 @@ int sc_frame_trace_close(sc_frame_trace *t)
         }
         if (ferror(t->f)) {
             rc = -1;
+            errno = errno != 0 ? errno : EIO;
         }
+        const int e = errno;
         if (fclose(t->f) != 0) {
-            rc = -1;
+            rc = -1; /* fclose's errno: the buffered rows did not reach the file */
+        } else if (rc != 0) {
+            errno = e;
         }
         t->f = NULL;
     }
