@@ -85,17 +85,17 @@ int sc_frame_trace_close(sc_frame_trace *t)
             }
             fputc('\n', t->f);
         }
-        if (ferror(t->f)) {
-            rc = -1;
-            errno = errno != 0 ? errno : EIO;
-        }
-        const int e = errno;
-        if (fclose(t->f) != 0) {
-            rc = -1; /* fclose's errno: the buffered rows did not reach the file */
-        } else if (rc != 0) {
-            errno = e;
+        /* the first failure's reason: a write's (EIO when the stream kept none), else fclose's
+         * (the buffered rows did not reach the file) */
+        int err = ferror(t->f) ? (errno != 0 ? errno : EIO) : 0;
+        if (fclose(t->f) != 0 && err == 0) {
+            err = errno;
         }
         t->f = NULL;
+        if (err != 0) {
+            rc = -1;
+            errno = err;
+        }
     }
     free(t->rec);
     t->rec = NULL;

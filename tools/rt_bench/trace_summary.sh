@@ -31,7 +31,7 @@ $col ~ /^[0-9]+$/ && $fcol ~ /^[0-9]+$/ { n++; t[n] = $col; fr[n] = $fcol; sum +
 END {
     if (bad) exit 1
     if (n == 0) { print "trace_summary: no frames" > "/dev/stderr"; exit 1 }
-    # the frame times sorted (insertion into a copy is O(n^2): a shell sort instead)
+    # the frame times sorted (POSIX awk has no sort: a shell sort of a copy)
     for (i = 1; i <= n; i++) s[i] = t[i]
     for (gap = int(n / 2); gap > 0; gap = int(gap / 2))
         for (i = gap + 1; i <= n; i++) {
