@@ -6,7 +6,8 @@
  * "in view" in a frame with probe contact where the B-scan's compression measure has its area
  * ratio, sc_bscan.h): the deepest compression reached (smallest image-area ratio now / rest),
  * the force on the probe at that frame (sc_tissue_probe_force_n), whether it coapted (ratio <=
- * coapt_ratio); over the exam the peak force and whether the artery was compressed below
+ * coapt_ratio); over the exam the peak force held for min_view_frames (0.1 s: a press, not a
+ * frame's transient of the solve, docs/assessment.md) and whether the artery was compressed below
  * artery_min_ratio; the trainee's call (normal / DVT, a CAN command) against the case's finding
  * (DVT when the case's mesh holds thrombus); the tracked needle's lumen entries (an arterial
  * puncture is a fault). A score sums the points of the criteria met
@@ -18,8 +19,10 @@
  *
  * Rules: fixed memory (one sc_assess inside the engine, sizeof asserted), no allocation, no OS,
  * deterministic (a pure function of the inputs in order). One writer. Costs: every function is
- * O(1) (sc_assess_score O(SC_ASSESS_CRITERIA)). Bad input (a non-finite ratio or force) is
- * treated as "not available", never asserted; a bad call value is refused (SC_ERR_RANGE).
+ * O(1) (sc_assess_score O(SC_ASSESS_CRITERIA)) but sc_assess_update, O(min_view_frames) (the
+ * held force's minimum: 6 by default, at most SC_ASSESS_HOLD_MAX). Bad input (a non-finite
+ * ratio or force) is treated as "not available", never asserted; a bad call value is refused
+ * (SC_ERR_RANGE).
  */
 #ifndef SC_ASSESS_H
 #define SC_ASSESS_H
@@ -98,8 +101,9 @@ typedef struct sc_assess_report {
     uint32_t resets;         /* assessment resets (command) since the engine started */
     uint32_t calls;          /* calls entered since the last reset (the last one counts) */
     sc_assess_vessel_rec vessel[SC_ASSESS_VESSELS];
-    float peak_force_n;        /* largest force in contact; -1: never available */
-    float venous_force_max_n;  /* largest force with the vein or thrombosed vein in view */
+    float peak_force_n;        /* largest force held in contact (the least of min_view_frames
+                                * contact frames in a row); -1: never held */
+    float venous_force_max_n;  /* largest force held with the vein or thrombosed vein in view */
     uint8_t artery_over;       /* the artery's ratio fell below artery_min_ratio */
     uint8_t call;              /* SC_ASSESS_CALL_*: the trainee's call (NONE: not yet) */
     uint8_t finding;           /* SC_ASSESS_CALL_NORMAL or _DVT: the case's truth */
@@ -118,11 +122,19 @@ typedef struct sc_assess_report {
 _Static_assert(SC_ASSESS_CRITERIA == 6u, "six criteria: the record's layout");
 _Static_assert(sizeof(sc_assess_report) == 104u, "assessment record layout (docs/assessment.md)");
 
+/* the largest min_view_frames (4.25 s at 60 Hz): the held force's window (sc_assess.hold) */
+#define SC_ASSESS_HOLD_MAX 255u
+
 typedef struct sc_assess {
     sc_assess_def def;
     sc_assess_report r;
     uint32_t artery_low_frames; /* consecutive contact frames with the artery in view below
                                  * artery_min_ratio; artery_over at min_view_frames of them */
+    uint32_t hold_n;            /* consecutive contact frames with a force, up to
+                                 * min_view_frames (contact lost, or no force: 0) */
+    uint32_t hold_at;           /* hold's next slot */
+    float hold[SC_ASSESS_HOLD_MAX]; /* the forces of the last hold_n of those frames (a ring of
+                                     * min_view_frames): their minimum is the force held */
 } sc_assess;
 
 /* coapt 0.05, artery 0.75, firm press 8 N, unsafe above 60 N, 6 frames (0.1 s) in view;
@@ -130,7 +142,8 @@ typedef struct sc_assess {
  * puncture 2 (10 in all). */
 sc_assess_def sc_assess_default_def(void);
 /* SC_ERR_INVALID_ARG (NULL), SC_ERR_NOT_FINITE, SC_ERR_RANGE (ratios outside (0, 1], forces
- * <= 0 or firm above max, more than 255 points in all). O(1). */
+ * <= 0 or firm above max, more than 255 points in all, min_view_frames above
+ * SC_ASSESS_HOLD_MAX). O(1). */
 int sc_assess_def_validate(const sc_assess_def *def);
 
 /* Validate def and start empty with finding NORMAL. Errors of sc_assess_def_validate. */
@@ -143,7 +156,7 @@ void sc_assess_reset(sc_assess *a);
 /* The trainee's call (SC_ASSESS_CALL_NORMAL or _DVT; SC_ERR_RANGE otherwise, nothing
  * changed). The last call counts. O(1). */
 int sc_assess_set_call(sc_assess *a, uint8_t call);
-/* One frame. O(1). */
+/* One frame. O(min_view_frames). */
 void sc_assess_update(sc_assess *a, const sc_assess_in *in);
 /* The criteria and score of a record under def (pure: writes criteria_met, points, score,
  * score_max of *r). O(SC_ASSESS_CRITERIA). */

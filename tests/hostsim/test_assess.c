@@ -136,7 +136,11 @@ static void neck_ijv_press_that_coapts_the_vein_scores_coaptation(void **state)
     assert_true(r->vessel[SC_ASSESS_VEIN].min_ratio <= 0.05f);
     assert_int_equal(r->vessel[SC_ASSESS_VEIN].coapted, 1);
     assert_true(r->vessel[SC_ASSESS_VEIN].force_at_min_n > 0.0f);
-    assert_true(r->peak_force_n >= r->vessel[SC_ASSESS_VEIN].force_at_min_n);
+    /* the peak force is the force held 0.1 s (sc_assess.h): below the frame's own at the
+     * vein's minimum here (a frame of the press's landing), a firm press and a safe one */
+    const sc_assess_def d = sc_assess_default_def();
+    assert_true(r->peak_force_n >= d.firm_force_n);
+    assert_true(r->peak_force_n <= d.force_max_n);
     assert_int_equal(r->vessel[SC_ASSESS_ARTERY].coapted, 0);
     assert_int_equal(r->artery_over, 0);
     assert_true(met(r, SC_ASSESS_CRIT_VEIN_IMAGED));

@@ -92,12 +92,64 @@ static void the_deepest_compression_and_its_force_are_kept(void **state)
     assert_int_equal(r->vessel[SC_ASSESS_VEIN].min_frame, 3);
     assert_int_equal(r->vessel[SC_ASSESS_VEIN].frames_in_view, 6);
     assert_int_equal(r->vessel[SC_ASSESS_VEIN].coapted, 0);
-    assert_float_equal(r->peak_force_n, 9.0f, 0.0f);
+    /* the peak is the force held for min_view_frames (6) frames: their least, 1 N here */
+    assert_float_equal(r->peak_force_n, 1.0f, 0.0f);
+    assert_float_equal(r->venous_force_max_n, 1.0f, 0.0f);
     assert_true(r->vessel[SC_ASSESS_THROMBUS].min_ratio < 0.0f);
-    /* non-finite inputs are "not available", never a minimum */
+    /* non-finite inputs are "not available", never a minimum, and break the hold */
     frame(1u, NAN, INFINITY, NAN, NAN);
     assert_float_equal(r->vessel[SC_ASSESS_VEIN].min_ratio, 0.12f, 0.0f);
-    assert_float_equal(r->peak_force_n, 9.0f, 0.0f);
+    assert_float_equal(r->peak_force_n, 1.0f, 0.0f);
+    for (int i = 0; i < 5; i++) {
+        frame(1u, 0.5f, 0.95f, -1.0f, 20.0f);
+    }
+    assert_float_equal(r->peak_force_n, 1.0f, 0.0f); /* five frames since the gap */
+    frame(1u, 0.5f, 0.95f, -1.0f, 20.0f);
+    assert_float_equal(r->peak_force_n, 20.0f, 0.0f);
+}
+
+static void the_peak_force_is_held_and_a_transient_is_not(void **state)
+{
+    (void)state;
+    const sc_assess_report *r = sc_assess_get(&a);
+    /* a press ramping to 12 N and held, with a two-frame transient of 80 N on the way (what
+     * the implicit step's truncated solve gives as a large mesh's contact grows) */
+    const float forces[12] = {2.0f, 4.0f, 6.0f, 80.0f, 80.0f, 8.0f,
+                              10.0f, 12.0f, 12.0f, 12.0f, 12.0f, 12.0f};
+    for (int i = 0; i < 12; i++) {
+        frame(1u, 0.4f, 0.95f, -1.0f, forces[i]);
+    }
+    assert_float_equal(r->peak_force_n, 10.0f, 0.0f); /* the last six: 10 to 12 N */
+    assert_true(met(SC_ASSESS_CRIT_FORCE_SAFE));
+    frame(1u, 0.4f, 0.95f, -1.0f, 12.0f);
+    assert_float_equal(r->peak_force_n, 12.0f, 0.0f);
+    /* a lift ends the hold: five frames of contact after it hold nothing */
+    frame(0u, -1.0f, -1.0f, -1.0f, 0.0f);
+    for (int i = 0; i < 5; i++) {
+        frame(1u, 0.4f, 0.95f, -1.0f, 50.0f);
+    }
+    assert_float_equal(r->peak_force_n, 12.0f, 0.0f);
+    frame(1u, 0.4f, 0.95f, -1.0f, 50.0f);
+    assert_float_equal(r->peak_force_n, 50.0f, 0.0f);
+    /* so does a reset */
+    sc_assess_reset(&a);
+    for (int i = 0; i < 5; i++) {
+        frame(1u, 0.4f, 0.95f, -1.0f, 30.0f);
+    }
+    assert_true(r->peak_force_n < 0.0f);
+    /* min_view_frames 1 (or 0): every frame's force is held */
+    sc_assess_def d = sc_assess_default_def();
+    d.min_view_frames = 0u;
+    sc_assess x;
+    assert_int_equal(sc_assess_init(&x, &d), SC_OK);
+    const sc_assess_in in = {.contact = 1u, .area_ratio = {0.5f, 0.95f, -1.0f}, .force_n = 7.0f};
+    sc_assess_update(&x, &in);
+    assert_float_equal(sc_assess_get(&x)->peak_force_n, 7.0f, 0.0f);
+    /* the window's limit */
+    d.min_view_frames = SC_ASSESS_HOLD_MAX;
+    assert_int_equal(sc_assess_def_validate(&d), SC_OK);
+    d.min_view_frames = SC_ASSESS_HOLD_MAX + 1u;
+    assert_int_equal(sc_assess_def_validate(&d), SC_ERR_RANGE);
 }
 
 static void the_vein_imaged_criterion_needs_min_view_frames(void **state)
@@ -131,6 +183,11 @@ static void a_firm_press_that_does_not_coapt_meets_the_compression_criterion(voi
     const sc_assess_def d = sc_assess_default_def();
     for (int i = 0; i < 6; i++) {
         frame(1u, 0.6f, 0.95f, 0.9f, d.firm_force_n * 0.9f);
+    }
+    assert_false(met(SC_ASSESS_CRIT_COMPRESSED));
+    /* held for min_view_frames (6): five frames at the firm force are not a firm press */
+    for (int i = 0; i < 5; i++) {
+        frame(1u, 0.6f, 0.95f, 0.85f, d.firm_force_n);
     }
     assert_false(met(SC_ASSESS_CRIT_COMPRESSED));
     frame(1u, 0.6f, 0.95f, 0.85f, d.firm_force_n);
@@ -185,6 +242,11 @@ static void an_unsafe_force_loses_the_force_criterion(void **state)
     const sc_assess_def d = sc_assess_default_def();
     for (int i = 0; i < 6; i++) {
         frame(1u, 0.3f, 0.9f, -1.0f, d.force_max_n);
+    }
+    assert_true(met(SC_ASSESS_CRIT_FORCE_SAFE));
+    /* over it for five frames (one short of min_view_frames): a transient, still safe */
+    for (int i = 0; i < 5; i++) {
+        frame(1u, 0.3f, 0.9f, -1.0f, d.force_max_n + 0.5f);
     }
     assert_true(met(SC_ASSESS_CRIT_FORCE_SAFE));
     frame(1u, 0.3f, 0.9f, -1.0f, d.force_max_n + 0.5f);
@@ -304,6 +366,7 @@ int main(void)
                                setup),
         cmocka_unit_test_setup(an_empty_exam_scores_nothing_and_says_not_available, setup),
         cmocka_unit_test_setup(the_deepest_compression_and_its_force_are_kept, setup),
+        cmocka_unit_test_setup(the_peak_force_is_held_and_a_transient_is_not, setup),
         cmocka_unit_test_setup(the_vein_imaged_criterion_needs_min_view_frames, setup),
         cmocka_unit_test_setup(coaptation_meets_the_compression_criterion, setup),
         cmocka_unit_test_setup(a_firm_press_that_does_not_coapt_meets_the_compression_criterion,
