@@ -356,7 +356,7 @@ int sc_canproto_decode_status_part(const sc_can_frame *f, sc_status_msg *s);
 typedef struct sc_assess_msg {
     float min_ratio[SC_ASSESS_VESSELS]; /* deepest compression: smallest area ratio; < 0 n/a */
     float force_at_min_n[SC_ASSESS_VESSELS]; /* force when it was reached; < 0 n/a */
-    float peak_force_n;                 /* largest force of the exam; < 0 n/a */
+    float peak_force_n;                 /* largest force held 0.1 s in the exam; < 0 n/a */
     uint8_t coapted[SC_ASSESS_VESSELS]; /* min ratio <= the coaptation threshold */
     uint8_t artery_over;                /* artery compressed below its limit */
     uint8_t call;                       /* SC_ASSESS_CALL_* entered by the trainee */

@@ -123,19 +123,27 @@ static void the_peak_force_is_held_and_a_transient_is_not(void **state)
     assert_true(met(SC_ASSESS_CRIT_FORCE_SAFE));
     frame(1u, 0.4f, 0.95f, -1.0f, 12.0f);
     assert_float_equal(r->peak_force_n, 12.0f, 0.0f);
-    /* a lift ends the hold: five frames of contact after it hold nothing */
-    frame(0u, -1.0f, -1.0f, -1.0f, 0.0f);
+    /* a lift ends the hold: five frames at 50 N before it and five after hold nothing (the
+     * window's last six before the lift still had a 12 N frame) */
     for (int i = 0; i < 5; i++) {
         frame(1u, 0.4f, 0.95f, -1.0f, 50.0f);
     }
     assert_float_equal(r->peak_force_n, 12.0f, 0.0f);
+    frame(0u, -1.0f, -1.0f, -1.0f, 0.0f);
+    for (int i = 0; i < 5; i++) {
+        frame(1u, 0.4f, 0.95f, -1.0f, 50.0f);
+        assert_float_equal(r->peak_force_n, 12.0f, 0.0f);
+    }
     frame(1u, 0.4f, 0.95f, -1.0f, 50.0f);
     assert_float_equal(r->peak_force_n, 50.0f, 0.0f);
-    /* so does a reset */
+    /* so do a reset and a case swap */
     sc_assess_reset(&a);
     for (int i = 0; i < 5; i++) {
         frame(1u, 0.4f, 0.95f, -1.0f, 30.0f);
     }
+    assert_true(r->peak_force_n < 0.0f);
+    assert_int_equal(sc_assess_begin_case(&a, SC_ASSESS_CALL_NORMAL), SC_OK);
+    frame(1u, 0.4f, 0.95f, -1.0f, 30.0f);
     assert_true(r->peak_force_n < 0.0f);
     /* min_view_frames 1 (or 0): every frame's force is held */
     sc_assess_def d = sc_assess_default_def();
@@ -145,9 +153,17 @@ static void the_peak_force_is_held_and_a_transient_is_not(void **state)
     const sc_assess_in in = {.contact = 1u, .area_ratio = {0.5f, 0.95f, -1.0f}, .force_n = 7.0f};
     sc_assess_update(&x, &in);
     assert_float_equal(sc_assess_get(&x)->peak_force_n, 7.0f, 0.0f);
-    /* the window's limit */
+    /* the window's limit, run: held after its 255th frame, the least of them */
     d.min_view_frames = SC_ASSESS_HOLD_MAX;
     assert_int_equal(sc_assess_def_validate(&d), SC_OK);
+    assert_int_equal(sc_assess_init(&x, &d), SC_OK);
+    for (uint32_t i = 0; i < SC_ASSESS_HOLD_MAX; i++) {
+        assert_true(sc_assess_get(&x)->peak_force_n < 0.0f);
+        const sc_assess_in w = {.contact = 1u, .area_ratio = {0.5f, 0.95f, -1.0f},
+                                .force_n = 20.0f + (float)(i % 7u)};
+        sc_assess_update(&x, &w);
+    }
+    assert_float_equal(sc_assess_get(&x)->peak_force_n, 20.0f, 0.0f);
     d.min_view_frames = SC_ASSESS_HOLD_MAX + 1u;
     assert_int_equal(sc_assess_def_validate(&d), SC_ERR_RANGE);
 }
