@@ -59,6 +59,16 @@ static void clear_record(sc_assess_report *r)
     }
 }
 
+/* A new exam on the same def: the record emptied (its resets and finding kept), the runs the
+ * artery check and the held force count restarted, and the empty record scored. */
+static void restart(sc_assess *a)
+{
+    clear_record(&a->r);
+    a->artery_low_frames = 0u;
+    a->hold_n = 0u;
+    sc_assess_score(&a->def, &a->r);
+}
+
 int sc_assess_init(sc_assess *a, const sc_assess_def *def)
 {
     if (a == NULL) {
@@ -71,10 +81,7 @@ int sc_assess_init(sc_assess *a, const sc_assess_def *def)
     memset(a, 0, sizeof(*a));
     a->def = *def;
     a->r.finding = SC_ASSESS_CALL_NORMAL;
-    clear_record(&a->r);
-    a->artery_low_frames = 0u;
-    a->hold_n = 0u;
-    sc_assess_score(&a->def, &a->r);
+    restart(a);
     return SC_OK;
 }
 
@@ -84,20 +91,14 @@ int sc_assess_begin_case(sc_assess *a, uint8_t finding)
         return SC_ERR_RANGE;
     }
     a->r.finding = finding;
-    clear_record(&a->r);
-    a->artery_low_frames = 0u;
-    a->hold_n = 0u;
-    sc_assess_score(&a->def, &a->r);
+    restart(a);
     return SC_OK;
 }
 
 void sc_assess_reset(sc_assess *a)
 {
     a->r.resets++;
-    clear_record(&a->r);
-    a->artery_low_frames = 0u;
-    a->hold_n = 0u;
-    sc_assess_score(&a->def, &a->r);
+    restart(a);
 }
 
 int sc_assess_set_call(sc_assess *a, uint8_t call)
