@@ -58,6 +58,30 @@ replay)
     expect "the replay's score equals the recording's ($s_rep, $s_rec)" $([ -n "$s_rec" ] && [ "$s_rec" = "$s_rep" ]; echo $?)
     grep -q 'call dvt, finding dvt' "$OUT/rep.out"
     expect "the call DVT came through the bundle's CAN log" $?
+    # the solver's budget is not recorded in a bundle: refused with one, used without one
+    "$HOSTSIM" --cases-dir "$CASES" --replay "$B" --cg-iterations 8 --every 0 --quiet \
+        --out "$OUT/rep8" > /dev/null 2> "$OUT/rep8.err"
+    rc=$?
+    expect "--cg-iterations with a bundle replay refused, exit 2 (rc $rc)" $([ $rc = 2 ]; echo $?)
+    grep -q 'does not record --cg-iterations' "$OUT/rep8.err"
+    expect "the refusal says why" $?
+    "$HOSTSIM" --cases-dir "$CASES" --case femoral-dvt --method fem --seconds 3 --depth 14 \
+        --every 0 --quiet --cg-iterations 8 --record-bundle "$OUT/cg8.scb" --out "$OUT/cg8" \
+        > /dev/null 2>&1
+    rc=$?
+    expect "--cg-iterations with --record-bundle refused, exit 2 (rc $rc)" $([ $rc = 2 ]; echo $?)
+    "$HOSTSIM" --cases-dir "$CASES" --case femoral-dvt --method fem --seconds 3 --depth 14 \
+        --every 0 --quiet --faults drop=20000 --cg-iterations 3 --out "$OUT/cg3" \
+        > "$OUT/cg3.out" 2>&1
+    rc=$?
+    expect "a run with --cg-iterations 3 exits 0 (rc $rc)" $([ $rc = 0 ]; echo $?)
+    grep -q '^method          fem, 3 CG iterations per frame' "$OUT/cg3/summary.txt"
+    expect "its summary names the budget" $?
+    grep -q '^method          fem, 10 CG iterations per frame' "$OUT/rep/summary.txt"
+    expect "the default budget in the replay's summary" $?
+    cut -d, -f1,9 "$OUT/cg3/frames.csv" > "$OUT/cg3.hashes"
+    cmp -s "$OUT/rec.hashes" "$OUT/cg3.hashes"
+    expect "3 CG iterations give other images than 10" $([ $? != 0 ]; echo $?)
     grep -q '^call dvt$' "$B" && grep -q '^finding dvt$' "$B"
     expect "the bundle's header holds the call and the finding" $?
     "$HOSTSIM" --list-bundles "$OUT" > "$OUT/list.json"

@@ -1,12 +1,14 @@
 #!/bin/sh
-# sonocomp_cli.sh SONOCOMP SOURCE_DIR WORKDIR: the engine binary's command line and exit
+# sonocomp_cli.sh SONOCOMP SOURCE_DIR WORKDIR [CASE]: the engine binary's command line and exit
 # conventions: --help/--version, usage errors (2), every refused configuration line reported
 # with file:line: key: reason (3), --check-config, a bounded run with a final report (0), a clean
-# stop on SIGTERM (0), a missing CAN interface (1).
+# stop on SIGTERM (0), a missing CAN interface (1); with CASE (a built case file), the solver's
+# configured CG budget reaching the engine.
 set -u
 BIN=$1
 SRC=$2
 WORK=$3
+CASE=${4:-}
 rm -rf "$WORK" && mkdir -p "$WORK"
 fails=0
 check() { # check DESCRIPTION EXPECTED_STATUS ACTUAL_STATUS
@@ -61,6 +63,24 @@ contains "stopped by the frame limit" "$WORK/run.out" "stopped by frame limit"
 contains "5 frames run" "$WORK/run.out" "; 5 frames at 60 Hz"
 contains "structured log" "$WORK/run.err" "level=info event=start"
 contains "missing case logged" "$WORK/run.err" "event=case_load_failed"
+
+"$BIN" -s physics.cg_iterations=0 --check-config > /dev/null 2> "$WORK/cg.err"
+check "physics.cg_iterations 0 refused" 3 $?
+contains "physics.cg_iterations range named" "$WORK/cg.err" "physics.cg_iterations=0: 0 is outside 1 .. 200"
+if [ -n "$CASE" ] && [ -f "$CASE" ]; then
+    RUNC="-s can.interface=none -s display.target=none -s rt.sched_fifo=false -s rt.mlock=false -s status.line=off -s case=$CASE"
+    # shellcheck disable=SC2086
+    "$BIN" $RUNC --frames 2 > "$WORK/cg10.out" 2>&1; check "run on $CASE" 0 $?
+    contains "the default CG budget in the report" "$WORK/cg10.out" "10 CG iterations per frame"
+    # shellcheck disable=SC2086
+    "$BIN" $RUNC -s physics.cg_iterations=7 -s physics.method=fem --frames 2 > "$WORK/cg7.out" 2>&1
+    check "run with physics.cg_iterations=7" 0 $?
+    contains "the configured method reaches the engine" "$WORK/cg7.out" "soft tissue: fem, mesh "
+    contains "the configured CG budget reaches the engine" "$WORK/cg7.out" ", 7 CG iterations per frame"
+else
+    echo "FAIL: no case file '$CASE' (build the target cases)"
+    fails=$((fails + 1))
+fi
 
 # shellcheck disable=SC2086
 "$BIN" $NODEV > "$WORK/term.out" 2> "$WORK/term.err" &

@@ -62,6 +62,7 @@ typedef struct options {
     uint32_t every;
     uint32_t png_width, png_height;
     int method; /* -1 keep default */
+    uint32_t cg_iterations; /* --cg-iterations; 0: the build's default */
     int fd;
     uint64_t seed;
     sc_hs_fault_plan faults;
@@ -90,6 +91,8 @@ static void usage(FILE *f)
             "  --csv FILE           timed poses instead of a script (t_s,x,y,z,qw,qx,qy,qz[,force])\n"
             "  --seconds S          simulated time (default 6)\n"
             "  --method msds|fem    soft-tissue solver (default msds)\n"
+            "  --cg-iterations N    CG iterations per frame of the implicit step, 1..%u\n"
+            "                       (default %u; not recorded in a bundle)\n"
             "  --point X,Y,Z        probe contact point, volume frame mm (default: over the vein)\n"
             "  --depth MM           press depth (default 8)\n"
             "  --fd                 CAN FD pose frames\n"
@@ -119,7 +122,8 @@ static void usage(FILE *f)
             "  --state-udp H:P      the console state stream to UDP H:P (docs/state-stream.md)\n"
             "  --state-out FILE     the state stream's records into FILE (u16 length + record)\n"
             "  --dlink-udp H:P      scan lines over the UDP display link to H:P as well\n"
-            "  --help, --version\n");
+            "  --help, --version\n",
+            (unsigned)SC_PHYS_ITERATIONS_MAX, (unsigned)SC_PHYS_CG_ITERATIONS_DEFAULT);
 }
 
 static int parse_u64(const char *s, uint64_t max, uint64_t *out)
@@ -165,7 +169,7 @@ static int parse_args(int argc, char **argv, options *o)
     enum { O_CASE = 256, O_CASES_DIR, O_OUT, O_SCRIPT, O_CSV, O_SECONDS, O_METHOD, O_POINT,
            O_DEPTH, O_FD, O_FAULTS, O_SEED, O_RECORD, O_REPLAY, O_EVERY, O_PNG, O_RAW, O_QUIET,
            O_HELP, O_VERSION, O_RX_COST, O_BUNDLE, O_LIST, O_CALL,
-           O_LIVE, O_CAN_UDP, O_STATE_UDP, O_STATE_OUT, O_DLINK_UDP };
+           O_LIVE, O_CAN_UDP, O_STATE_UDP, O_STATE_OUT, O_DLINK_UDP, O_CG };
     static const struct option opts[] = {
         {"case", required_argument, 0, O_CASE},     {"cases-dir", required_argument, 0, O_CASES_DIR},
         {"out", required_argument, 0, O_OUT},       {"script", required_argument, 0, O_SCRIPT},
@@ -185,6 +189,7 @@ static int parse_args(int argc, char **argv, options *o)
         {"state-udp", required_argument, 0, O_STATE_UDP},
         {"state-out", required_argument, 0, O_STATE_OUT},
         {"dlink-udp", required_argument, 0, O_DLINK_UDP},
+        {"cg-iterations", required_argument, 0, O_CG},
         {0, 0, 0, 0}};
     int c;
     opterr = 0;
@@ -214,6 +219,14 @@ static int parse_args(int argc, char **argv, options *o)
                 fprintf(stderr, "sc-hostsim: --method wants msds or fem, got '%s'\n", optarg);
                 return 2;
             }
+            break;
+        case O_CG:
+            if (parse_u64(optarg, SC_PHYS_ITERATIONS_MAX, &u) || u == 0u) {
+                fprintf(stderr, "sc-hostsim: --cg-iterations wants 1..%u, got '%s'\n",
+                        (unsigned)SC_PHYS_ITERATIONS_MAX, optarg);
+                return 2;
+            }
+            o->cg_iterations = (uint32_t)u;
             break;
         case O_POINT:
             if (sscanf(optarg, "%f,%f,%f", &o->point_mm[0], &o->point_mm[1], &o->point_mm[2]) != 3 ||
@@ -343,6 +356,13 @@ static int parse_args(int argc, char **argv, options *o)
     if (o->replay_path && (o->csv_path || o->record_path || o->bundle_path || o->call)) {
         fprintf(stderr, "sc-hostsim: --replay cannot be combined with --csv, --record, "
                         "--record-bundle or --call\n");
+        return 2;
+    }
+    if (o->cg_iterations != 0u && o->bundle_path) {
+        /* a bundle records the method, not the solver's budget: a session with another budget
+         * would not replay to its image hashes */
+        fprintf(stderr, "sc-hostsim: --cg-iterations cannot be combined with --record-bundle "
+                        "(a bundle does not record it)\n");
         return 2;
     }
     if (o->bundle_path) {
@@ -664,6 +684,12 @@ int main(int argc, char **argv)
             return 1;
         }
         bundle_replay = sc_bundle_is_bundle(bbuf, blen);
+        if (bundle_replay && o.cg_iterations != 0u) {
+            fprintf(stderr, "sc-hostsim: %s is a bundle, which does not record --cg-iterations: "
+                            "refused (it replays with the budget it was recorded with)\n",
+                    o.replay_path);
+            return 2;
+        }
         if (!bundle_replay) {
             free(bbuf);
             bbuf = NULL;
@@ -728,6 +754,9 @@ int main(int argc, char **argv)
     def.case_count = 3u;
     if (o.method >= 0) {
         def.tissue.method = (sc_tissue_method)o.method;
+    }
+    if (o.cg_iterations != 0u) {
+        def.tissue.fem.cg_iterations = o.cg_iterations;
     }
     rc = sc_hs_rig_init(&rig, &def, o.seed, 0);
     if (rc != SC_OK) {
@@ -1151,7 +1180,9 @@ int main(int argc, char **argv)
                 o.live.can_port ? "CAN over UDP, " : (replay ? "replay of " : (o.csv_path ? "csv " : "script ")),
                 o.live.can_port ? "live" : (replay ? o.replay_path : (o.csv_path ? o.csv_path : o.script)), o.seconds,
                 frames, def.sched.rate_hz);
-        fprintf(f, "method          %s\n", st.method == SC_TISSUE_FEM ? "fem" : "msds");
+        fprintf(f, "method          %s, %u CG iterations per frame\n",
+                st.method == SC_TISSUE_FEM ? "fem" : "msds",
+                tis ? (unsigned)tis->fem.def.cg_iterations : 0u);
         fprintf(f, "display         %" PRIu64 " complete frames, %" PRIu64
                    " incomplete, %" PRIu64 " protocol errors\n",
                 rig.display.frames_complete, rig.display.frames_incomplete,

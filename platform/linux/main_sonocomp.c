@@ -186,6 +186,7 @@ static void print_config(FILE *f, const sc_rtcfg *c)
     fprintf(f, "physics.method = %s\n", sc_rtcfg_method_name(c->physics_method));
     fprintf(f, "physics.iterations = %u\n", (unsigned)c->physics_iterations);
     fprintf(f, "physics.dt_s = %g\n", (double)c->physics_dt_s);
+    fprintf(f, "physics.cg_iterations = %u\n", (unsigned)c->physics_cg_iterations);
     fprintf(f, "image.geometry = %s\n", sc_rtcfg_geometry_name(c->image_geometry));
     fprintf(f, "image.depth_mm = %g\n", (double)c->image_depth_mm);
     fprintf(f, "image.width_mm = %g\n", (double)c->image_width_mm);
@@ -354,6 +355,7 @@ static sc_engine_def engine_def_from(const sc_rtcfg *c, const char *case_dir)
     d.tissue.method = c->physics_method == SC_RTCFG_METHOD_FEM ? SC_TISSUE_FEM : SC_TISSUE_MSDS;
     d.tissue.msds.iterations = c->physics_iterations;
     d.tissue.msds.dt_s = c->physics_dt_s;
+    d.tissue.fem.cg_iterations = c->physics_cg_iterations;
     const sc_xform calib = d.bscan.scan.image_to_probe;
     if (c->image_geometry == SC_RTCFG_GEOMETRY_CURVILINEAR) {
         d.bscan.scan = sc_scan_curvilinear_default_def();
@@ -483,6 +485,12 @@ static void final_report(const sc_engine *e, double wall_s, const char *stop_rea
     char pf_line[160];
     sc_cpu_prefetch_describe(&g_prefetch, pf_line, sizeof pf_line);
     printf("  kernels %s, %s\n", sc_simd_name(sc_simd_selected()), pf_line);
+    const sc_tissue *tis = sc_engine_get_tissue(e);
+    if (tis != NULL) {
+        printf("  soft tissue: %s, mesh %ux%ux%u, %u CG iterations per frame\n",
+               tis->method == SC_TISSUE_FEM ? "fem" : "msds", (unsigned)tis->mesh.nx,
+               (unsigned)tis->mesh.ny, (unsigned)tis->mesh.nz, (unsigned)tis->fem.def.cg_iterations);
+    }
     printf("  %-16s %9s %9s %9s %9s %9s   (ms)\n", "", "count", "mean", "p50", "p99", "worst");
     print_stats_row("frame", &s->frame_stats);
     print_stats_row("wake-up latency", &s->lateness_stats);

@@ -63,6 +63,7 @@ typedef struct sc_rtcfg {
     uint32_t physics_method;           /* sc_rtcfg_method */
     uint32_t physics_iterations;
     float physics_dt_s;
+    uint32_t physics_cg_iterations; /* CG iterations per frame: stable MSDS, FEM */
     uint32_t image_geometry; /* sc_rtcfg_geometry */
     float image_depth_mm;
     float image_width_mm;   /* linear aperture */

@@ -30,6 +30,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     SC_FUZZ_CHECK(cfg.image_lines <= SC_MAX_SCAN_LINES && cfg.image_samples <= SC_MAX_SCAN_SAMPLES);
     SC_FUZZ_CHECK(cfg.physics_iterations >= 1u && cfg.physics_iterations <= SC_PHYS_ITERATIONS_MAX);
     SC_FUZZ_CHECK(cfg.physics_dt_s >= 0.0001f && cfg.physics_dt_s <= 0.1f);
+    SC_FUZZ_CHECK(cfg.physics_cg_iterations >= 1u &&
+                  cfg.physics_cg_iterations <= SC_PHYS_ITERATIONS_MAX);
     SC_FUZZ_CHECK(cfg.rt_cpu >= -1 && cfg.rt_cpu <= 1023);
     SC_FUZZ_CHECK(cfg.display_port <= 65535u);
     for (uint32_t b = 0; b < SC_BSCAN_TGC_BANDS; b++) {

@@ -29,6 +29,7 @@ static void defaults_follow_the_compile_time_limits(void **state)
     assert_int_equal(c.frame_rate_hz, SC_FRAME_RATE_DEFAULT_HZ);
     assert_int_equal(c.physics_method, SC_RTCFG_METHOD_MSDS);
     assert_int_equal(c.physics_iterations, SC_PHYS_ITERATIONS_DEFAULT);
+    assert_int_equal(c.physics_cg_iterations, SC_PHYS_CG_ITERATIONS_DEFAULT);
     /* the default is printed with 6 decimals and parsed back: 0.01 round-trips exactly */
     assert_memory_equal(&c.physics_dt_s, &(float){SC_PHYS_DT_DEFAULT_S}, sizeof(float));
     assert_int_equal(c.image_geometry, SC_RTCFG_GEOMETRY_LINEAR);
@@ -97,6 +98,7 @@ static void documented_default_file_sets_every_key_to_its_default(void **state)
     assert_int_equal(c.frame_rate_hz, def.frame_rate_hz);
     assert_int_equal(c.physics_method, def.physics_method);
     assert_int_equal(c.physics_iterations, def.physics_iterations);
+    assert_int_equal(c.physics_cg_iterations, def.physics_cg_iterations);
     assert_memory_equal(&c.physics_dt_s, &def.physics_dt_s, sizeof(float));
     assert_int_equal(c.image_geometry, def.image_geometry);
     assert_memory_equal(&c.image_depth_mm, &def.image_depth_mm, sizeof(float));
@@ -128,6 +130,7 @@ static void every_key_accepts_a_valid_non_default_value(void **state)
                        "physics.method = fem\n"
                        "physics.iterations = 35\n"
                        "physics.dt_s = 2.5e-3\n"
+                       "physics.cg_iterations = 8\n"
                        "image.geometry = curvilinear\n"
                        "image.depth_mm = 120.5\n"
                        "image.width_mm = 50\n"
@@ -162,6 +165,7 @@ static void every_key_accepts_a_valid_non_default_value(void **state)
     assert_string_equal(c.case_path, "/var/lib/sonocomp/femoral vein.sccase");
     assert_int_equal(c.physics_method, SC_RTCFG_METHOD_FEM);
     assert_int_equal(c.physics_iterations, 35);
+    assert_int_equal(c.physics_cg_iterations, 8);
     /* decimal parsing: within one float ulp of the value (float has 24 bits) */
     assert_float_equal(c.physics_dt_s, 0.0025f, 0.0025f * 1.2e-7f);
     assert_int_equal(c.image_geometry, SC_RTCFG_GEOMETRY_CURVILINEAR);
@@ -246,6 +250,10 @@ static void every_class_of_bad_value_is_refused_with_a_reason(void **state)
         {"frame_rate_hz", "60 Hz", SC_ERR_CFG_VALUE},
         {"physics.iterations", "0", SC_ERR_CFG_RANGE},
         {"physics.iterations", "201", SC_ERR_CFG_RANGE},
+        {"physics.cg_iterations", "0", SC_ERR_CFG_RANGE},
+        {"physics.cg_iterations", "201", SC_ERR_CFG_RANGE},
+        {"physics.cg_iterations", "-3", SC_ERR_CFG_RANGE},
+        {"physics.cg_iterations", "8.5", SC_ERR_CFG_VALUE},
         {"image.lines", "15", SC_ERR_CFG_RANGE},
         {"image.lines", "513", SC_ERR_CFG_RANGE},
         {"image.samples", "0x100", SC_ERR_CFG_VALUE},

@@ -16,7 +16,10 @@
 #   defaults: 60 s, the phantom neck-ijv at its own mesh, 1 worker, out/rt_press
 # environment: RT_PRESS_LOAD=none leaves CPU 1 to the engine (a two-worker run uses both CPUs:
 #   the loop on CPU 0, its worker on CPU 1); RT_PRESS_RATES="60" runs only the rates listed
-#   (default "60 120").
+#   (default "60 120"); RT_PRESS_METHODS="msds" runs only the methods listed (default "fem
+#   msds"); RT_PRESS_SET="physics.cg_iterations=8 ..." passes each KEY=VALUE to sonocomp as -s.
+# After each run: the host's steal time over it (/proc/stat, all CPUs; the time the hypervisor
+# ran something else on this VM's CPUs), so a slow run can be told from a preempted one.
 set -eu
 BUILD=$1
 SECS=${2:-60}
@@ -56,17 +59,33 @@ fi
 trap '[ -n "$hog" ] && kill "$hog" 2> /dev/null; true' EXIT
 echo "machine: $(nproc) CPUs, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')," \
     "load average $(cut -d' ' -f1-3 /proc/loadavg), kernel $(uname -r)"
-echo "second core: $load; mesh: ${MESH:-the phantom's own}; workers: $WORKERS; $SECS s per run"
-for method in fem msds; do
+if [ -n "$MESH" ]; then mesh_desc=$MESH; else mesh_desc="the phantom's own"; fi
+sets=""
+for kv in ${RT_PRESS_SET:-}; do
+    case $kv in
+        *=*) sets="$sets -s $kv" ;;
+        *) echo "rt_press: RT_PRESS_SET wants KEY=VALUE words, got '$kv'"; exit 2 ;;
+    esac
+done
+echo "second core: $load; mesh: $mesh_desc; workers: $WORKERS; $SECS s per run;" \
+    "settings: ${RT_PRESS_SET:-the defaults}"
+# the steal column of /proc/stat's cpu line, in USER_HZ ticks (0 where the kernel has none)
+steal_ticks() { awk '/^cpu /{print ($9 == "" ? 0 : $9); exit}' /proc/stat 2> /dev/null || echo 0; }
+hz=$(getconf CLK_TCK 2> /dev/null || echo 100)
+for method in ${RT_PRESS_METHODS:-fem msds}; do
     for rate in $RATES; do
         echo "=== $method at $rate Hz ==="
-        "$ENGINE" -s "case=$CASE" -s physics.method=$method -s frame_rate_hz=$rate \
+        st0=$(steal_ticks)
+        # shellcheck disable=SC2086 # $sets is a list of -s KEY=VALUE words
+        "$ENGINE" -s "case=$CASE" -s physics.method=$method -s frame_rate_hz=$rate $sets \
             -s display.target=none -s rt.cpu=0 -s rt.sched_fifo=true -s rt.mlock=true \
             -s watchdog.device=soft -s status.line=off -s log.level=error \
             --workers "$WORKERS" --can-replay "$LOG" --seconds "$SECS" \
             --hist "$OUT/hist-$method-${rate}hz.csv" --trace "$OUT/trace-$method-${rate}hz.csv" \
             2> "$OUT/sonocomp-$method-${rate}hz.err" |
             sed -n '/final statistics/,$p'
+        st1=$(steal_ticks)
+        echo "host steal during the run: $(( (st1 - st0) * 1000 / hz )) ms over both CPUs"
         "$(dirname "$0")/trace_summary.sh" "$OUT/trace-$method-${rate}hz.csv" 30 "$rate" ||
             echo "rt_press: no trace summary for $method at $rate Hz"
     done
