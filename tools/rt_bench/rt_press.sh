@@ -10,7 +10,7 @@
 # which tell slow frames at the script's press or folds from a host's spread over the run
 # (tools/rt_bench/trace_summary.sh, printed after each run).
 # Without SocketCAN the log is replayed in real time through --can-replay (tools/demo-live.sh).
-# It takes 4 x (SECONDS + ~5) s plus the case build (about 4.5 min at the default 60 s).
+# It takes 10 s + 4 x (SECONDS + ~5) s plus the case build (about 4.7 min at the default 60 s).
 #
 # usage: tools/rt_bench/rt_press.sh BUILD_DIR [SECONDS] [MESH NX,NY,NZ] [WORKERS] [OUT_DIR]
 #   defaults: 60 s, the phantom neck-ijv at its own mesh, 1 worker, out/rt_press
@@ -18,7 +18,8 @@
 #   the loop on CPU 0, its worker on CPU 1); RT_PRESS_RATES="60" runs only the rates listed
 #   (default "60 120"); RT_PRESS_METHODS="msds" runs only the methods listed (default "fem
 #   msds"); RT_PRESS_SET="physics.cg_iterations=8 ..." passes each KEY=VALUE to sonocomp as -s.
-# After each run: the host's steal time over it (/proc/stat, all CPUs; the time the hypervisor
+# First the host's own spread (sc-host-noise: fixed work on the same CPUs for 10 s); after
+# each run: the host's steal time over it (/proc/stat, all CPUs; the time the hypervisor
 # ran something else on this VM's CPUs), so a slow run can be told from a preempted one.
 set -eu
 BUILD=$1
@@ -29,8 +30,9 @@ OUT=${5:-out/rt_press}
 ENGINE=$BUILD/platform/linux/sonocomp
 EMU=$BUILD/tools/tracker_emu/sc-tracker-emu
 CB=$BUILD/tools/casebuild/sc-casebuild
-for b in "$ENGINE" "$EMU" "$CB"; do
-    [ -x "$b" ] || { echo "rt_press: missing $b (build sonocomp sc-tracker-emu sc-casebuild)"; exit 2; }
+NOISE=$BUILD/tools/rt_bench/sc-host-noise
+for b in "$ENGINE" "$EMU" "$CB" "$NOISE"; do
+    [ -x "$b" ] || { echo "rt_press: missing $b (build sonocomp sc-tracker-emu sc-casebuild sc-host-noise)"; exit 2; }
 done
 mkdir -p "$OUT"
 CASE=$OUT/neck-ijv.scase
@@ -72,6 +74,9 @@ echo "second core: $load; mesh: $mesh_desc; workers: $WORKERS; $SECS s per run;"
 # the steal column of /proc/stat's cpu line, in USER_HZ ticks (0 where the kernel has none)
 steal_ticks() { awk '/^cpu /{print ($9 == "" ? 0 : $9); exit}' /proc/stat 2> /dev/null || echo 0; }
 hz=$(getconf CLK_TCK 2> /dev/null || echo 100)
+# the host's own spread first: fixed work on the engine's CPUs in its duty cycle (host_noise.c)
+echo "=== host noise: the same work every period, $WORKERS thread(s), 10 s ==="
+"$NOISE" --seconds 10 --threads "$WORKERS" || echo "rt_press: sc-host-noise failed"
 for method in ${RT_PRESS_METHODS:-fem msds}; do
     for rate in $RATES; do
         echo "=== $method at $rate Hz ==="
