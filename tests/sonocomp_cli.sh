@@ -66,7 +66,7 @@ contains "missing case logged" "$WORK/run.err" "event=case_load_failed"
 
 "$BIN" -s physics.cg_iterations=0 --check-config > /dev/null 2> "$WORK/cg.err"
 check "physics.cg_iterations 0 refused" 3 $?
-contains "physics.cg_iterations range named" "$WORK/cg.err" "physics.cg_iterations=0: 0 is outside 1 .. 200"
+contains "physics.cg_iterations range named" "$WORK/cg.err" "physics.cg_iterations=0: 0 is outside 1 .. "
 if [ -n "$CASE" ] && [ -f "$CASE" ]; then
     RUNC="-s can.interface=none -s display.target=none -s rt.sched_fifo=false -s rt.mlock=false -s status.line=off -s case=$CASE"
     # shellcheck disable=SC2086
