@@ -90,7 +90,7 @@ for method in ${RT_PRESS_METHODS:-fem msds}; do
             2> "$OUT/sonocomp-$method-${rate}hz.err" |
             sed -n '/final statistics/,$p'
         st1=$(steal_ticks)
-        echo "host steal during the run: $(( (st1 - st0) * 1000 / hz )) ms over both CPUs"
+        echo "host steal during the run: $(( (st1 - st0) * 1000 / hz )) ms over all CPUs"
         "$(dirname "$0")/trace_summary.sh" "$OUT/trace-$method-${rate}hz.csv" 30 "$rate" ||
             echo "rt_press: no trace summary for $method at $rate Hz"
     done
